@@ -1,0 +1,386 @@
+/**
+ * @file dpsm.h
+ * @brief The public C API of dpsm: granular surfaces moved by the Degenerate
+ *        Parabolic Sliding Model.
+ *
+ * A host creates a grid, sets its parameters, masks and sources, calls
+ * dpsm_step() once per time step, reads heights back and checks the mass
+ * balance. Everything here is plain C; C++ callers get `extern "C"`.
+ *
+ * Conventions:
+ * - Every function that can fail returns an `int` status: ::DPSM_OK (0) on
+ *   success, one of the other `DPSM_ERR_*` codes otherwise. A failed call leaves
+ *   the grid exactly as it was; dpsm_last_error() tells what went wrong.
+ * - Arrays hold `nx*ny` values (`nx` for a 1D grid), x fastest: cell `(i, j)`
+ *   is element `i + nx*j`, so a Fortran `h(nx, ny)` and a C `h[ny][nx]` match.
+ * - Sizes are `int64_t`; angles are in radians; heights, lengths and times are
+ *   in whatever consistent units the host uses.
+ * - A handle may be used by one thread at a time; any number of handles may be
+ *   used concurrently.
+ */
+#ifndef DPSM_DPSM_H
+#define DPSM_DPSM_H
+
+#include <stdint.h>
+
+#include <dpsm/dpsm_version.h>
+
+/** @cond INTERNAL */
+#if defined(_WIN32) && !defined(DPSM_STATIC_DEFINE)
+#  ifdef DPSM_BUILDING_LIBRARY
+#    define DPSM_API __declspec(dllexport)
+#  else
+#    define DPSM_API __declspec(dllimport)
+#  endif
+#elif defined(__GNUC__)
+#  define DPSM_API __attribute__((visibility("default")))
+#else
+#  define DPSM_API
+#endif
+/** @endcond */
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/**
+ * @brief An opaque grid: geometry, parameters, masks, sources, heights and the
+ *        mass ledger of one granular surface.
+ *
+ * Created by dpsm_create_1d() or dpsm_create_2d(), released by dpsm_destroy().
+ */
+typedef struct dpsm_grid dpsm_grid;
+
+/** @name Status codes
+ *  Returned by every function that can fail. @{ */
+/** Success. */
+#define DPSM_OK 0
+/** A required pointer argument (handle, array or output) was NULL. */
+#define DPSM_ERR_NULL_POINTER 1
+/** A value was out of range: NaN, infinite, non-positive where a positive value is needed, an angle outside (0, pi/2). */
+#define DPSM_ERR_INVALID_VALUE 2
+/** A size was zero, negative, or so large that the grid cannot be addressed. */
+#define DPSM_ERR_INVALID_SIZE 3
+/** An enumerated argument (side, boundary kind, cell kind, mass quantity, info item) is not one this library knows. */
+#define DPSM_ERR_UNKNOWN_ENUM 4
+/** The request does not apply to this grid (for example a y side of a 1D grid). */
+#define DPSM_ERR_NOT_APPLICABLE 5
+/** The step would need more sub-steps than the limit set with dpsm_set_max_substeps(). */
+#define DPSM_ERR_WORK_LIMIT 6
+/** Memory could not be allocated. */
+#define DPSM_ERR_OUT_OF_MEMORY 7
+/** An internal error; please report it. */
+#define DPSM_ERR_INTERNAL 8
+/** @} */
+
+/** @name Sides of the domain
+ *  For dpsm_set_boundary(). A 1D grid has only ::DPSM_XMIN and ::DPSM_XMAX. @{ */
+#define DPSM_XMIN 0 /**< The side at x = 0. */
+#define DPSM_XMAX 1 /**< The side at x = nx*dx. */
+#define DPSM_YMIN 2 /**< The side at y = 0 (2D only). */
+#define DPSM_YMAX 3 /**< The side at y = ny*dy (2D only). */
+/** @} */
+
+/** @name Boundary kinds
+ *  For dpsm_set_boundary(). @{ */
+/** Sand that reaches the side leaves the domain and is counted as outflow.
+ *  The outside acts as a cell of height 0 one cell width beyond the edge cell
+ *  (the paper's node held at h = 0). */
+#define DPSM_OPEN 0
+/** No flux crosses the side. The default for every side. */
+#define DPSM_WALL 1
+/** @} */
+
+/** @name Cell kinds
+ *  For dpsm_set_cell_kinds(). @{ */
+/** An ordinary cell whose height the model evolves. The default. */
+#define DPSM_CELL_SAND 0
+/** An obstacle: no flux crosses its faces and its height never changes. */
+#define DPSM_CELL_WALL 1
+/** A sink held at its height: sand that flows into it is counted as outflow
+ *  (and sand it feeds to a lower neighbour as negative outflow). */
+#define DPSM_CELL_OPEN 2
+/** @} */
+
+/** @name Mass quantities
+ *  For dpsm_get_mass(). Mass is `sum h*dx` in 1D and `sum h*dx*dy` in 2D over
+ *  sand cells (unit density). After any sequence of calls,
+ *  `TOTAL == SOURCED + EXTERNAL - OUTFLOW` to round-off. @{ */
+/** The mass on the grid now. */
+#define DPSM_MASS_TOTAL 0
+/** Net mass added by sources (negative where erosion dominated). */
+#define DPSM_MASS_SOURCED 1
+/** Net mass added or removed by the host: dpsm_set_heights() and cell-kind
+ *  changes that turn sand cells into wall or open cells or back. */
+#define DPSM_MASS_EXTERNAL 2
+/** Net mass that left through open sides and open cells. */
+#define DPSM_MASS_OUTFLOW 3
+/** @} */
+
+/** @name Step information
+ *  For dpsm_get_step_info(): what the last successful dpsm_step() did. @{ */
+/** The number of sub-steps it took. */
+#define DPSM_INFO_SUBSTEPS 0
+/** The simulated time it integrated before the surface came to rest (equal to
+ *  the requested `dt` when it did not come to rest). */
+#define DPSM_INFO_TIME_INTEGRATED 1
+/** 1 if the surface is at rest at its end, 0 otherwise. */
+#define DPSM_INFO_AT_REST 2
+/** The largest slope excess `|grad h| - tan(theta)` over all faces at its end
+ *  (0 when no face is steeper than the angle of repose). */
+#define DPSM_INFO_MAX_EXCESS_SLOPE 3
+/** @} */
+
+/** The default angle of repose: 30 degrees, in radians. */
+#define DPSM_DEFAULT_REPOSE_ANGLE 0.52359877559829887
+/** The default mobility `nu`. */
+#define DPSM_DEFAULT_MOBILITY 1.0
+/** The default rest tolerance (relative to tan(theta)); see dpsm_set_rest_tolerance(). */
+#define DPSM_DEFAULT_REST_TOLERANCE 1e-6
+/** The default limit on sub-steps per dpsm_step() of a driven scene; see dpsm_set_max_substeps(). */
+#define DPSM_DEFAULT_MAX_SUBSTEPS 10000000
+
+/**
+ * @brief Creates a 1D grid of `nx` cells of width `dx`.
+ *
+ * The new grid has all heights 0, both sides walls, every cell sand, no source,
+ * the angle of repose ::DPSM_DEFAULT_REPOSE_ANGLE and mobility ::DPSM_DEFAULT_MOBILITY.
+ *
+ * @param nx  number of cells, at least 1.
+ * @param dx  cell width, finite and positive.
+ * @param out receives the new grid, or NULL on failure.
+ * @return ::DPSM_OK, or ::DPSM_ERR_NULL_POINTER, ::DPSM_ERR_INVALID_SIZE,
+ *         ::DPSM_ERR_INVALID_VALUE, ::DPSM_ERR_OUT_OF_MEMORY. On failure the
+ *         message is read with `dpsm_last_error(NULL)`.
+ */
+DPSM_API int dpsm_create_1d(int64_t nx, double dx, dpsm_grid **out);
+
+/**
+ * @brief Creates a 2D grid of `nx` by `ny` cells of size `dx` by `dy`.
+ *
+ * Defaults as for dpsm_create_1d(); all four sides are walls.
+ *
+ * @param nx  number of cells along x, at least 1.
+ * @param ny  number of cells along y, at least 1.
+ * @param dx  cell size along x, finite and positive.
+ * @param dy  cell size along y, finite and positive.
+ * @param out receives the new grid, or NULL on failure.
+ * @return ::DPSM_OK, or ::DPSM_ERR_NULL_POINTER, ::DPSM_ERR_INVALID_SIZE (also
+ *         when `nx*ny` overflows), ::DPSM_ERR_INVALID_VALUE,
+ *         ::DPSM_ERR_OUT_OF_MEMORY. On failure the message is read with
+ *         `dpsm_last_error(NULL)`.
+ */
+DPSM_API int dpsm_create_2d(int64_t nx, int64_t ny, double dx, double dy, dpsm_grid **out);
+
+/**
+ * @brief Releases a grid and everything it holds.
+ * @param g the grid; NULL is allowed and does nothing.
+ */
+DPSM_API void dpsm_destroy(dpsm_grid *g);
+
+/**
+ * @brief Sets the angle of repose `theta`.
+ * @param g              the grid.
+ * @param theta_radians  strictly between 0 and pi/2.
+ * @return ::DPSM_OK, ::DPSM_ERR_NULL_POINTER or ::DPSM_ERR_INVALID_VALUE.
+ */
+DPSM_API int dpsm_set_repose_angle(dpsm_grid *g, double theta_radians);
+
+/**
+ * @brief Sets the mobility `nu` (the paper's `W * delta`): how fast a
+ *        supercritical slope relaxes.
+ * @param g   the grid.
+ * @param nu  finite and positive.
+ * @return ::DPSM_OK, ::DPSM_ERR_NULL_POINTER or ::DPSM_ERR_INVALID_VALUE.
+ */
+DPSM_API int dpsm_set_mobility(dpsm_grid *g, double nu);
+
+/**
+ * @brief Makes one side of the domain open or a wall.
+ * @param g     the grid.
+ * @param side  ::DPSM_XMIN, ::DPSM_XMAX, ::DPSM_YMIN or ::DPSM_YMAX (the last
+ *              two on 2D grids only).
+ * @param kind  ::DPSM_OPEN or ::DPSM_WALL.
+ * @return ::DPSM_OK, ::DPSM_ERR_NULL_POINTER, ::DPSM_ERR_UNKNOWN_ENUM, or
+ *         ::DPSM_ERR_NOT_APPLICABLE for a y side of a 1D grid.
+ */
+DPSM_API int dpsm_set_boundary(dpsm_grid *g, int side, int kind);
+
+/**
+ * @brief Sets the kind of every cell.
+ *
+ * A sand cell that becomes a wall or open cell takes its mass off the grid,
+ * and a wall or open cell that becomes sand brings its current height on; both
+ * are booked as ::DPSM_MASS_EXTERNAL.
+ *
+ * @param g      the grid.
+ * @param kinds  `nx*ny` values, each ::DPSM_CELL_SAND, ::DPSM_CELL_WALL or
+ *               ::DPSM_CELL_OPEN; NULL makes every cell sand.
+ * @return ::DPSM_OK, ::DPSM_ERR_NULL_POINTER or ::DPSM_ERR_UNKNOWN_ENUM.
+ */
+DPSM_API int dpsm_set_cell_kinds(dpsm_grid *g, const uint8_t *kinds);
+
+/**
+ * @brief Sets the height of every cell.
+ *
+ * The height of a wall cell is kept and reported but moves nothing; the height
+ * of an open cell is the level it holds. The change of mass on sand cells is
+ * booked as ::DPSM_MASS_EXTERNAL.
+ *
+ * @param g  the grid.
+ * @param h  `nx*ny` finite heights.
+ * @return ::DPSM_OK, ::DPSM_ERR_NULL_POINTER or ::DPSM_ERR_INVALID_VALUE.
+ */
+DPSM_API int dpsm_set_heights(dpsm_grid *g, const double *h);
+
+/**
+ * @brief Copies the height of every cell out.
+ * @param g  the grid.
+ * @param h  room for `nx*ny` values.
+ * @return ::DPSM_OK or ::DPSM_ERR_NULL_POINTER.
+ */
+DPSM_API int dpsm_get_heights(const dpsm_grid *g, double *h);
+
+/**
+ * @brief Sets the source `q`: height per unit time added to each cell
+ *        (deposition > 0, erosion < 0).
+ *
+ * The source acts on sand cells only; values given for wall and open cells are
+ * ignored. It stays in force for every following step until replaced.
+ *
+ * @param g  the grid.
+ * @param q  `nx*ny` finite values, or NULL for no source.
+ * @return ::DPSM_OK, ::DPSM_ERR_NULL_POINTER or ::DPSM_ERR_INVALID_VALUE.
+ */
+DPSM_API int dpsm_set_source(dpsm_grid *g, const double *q);
+
+/**
+ * @brief The largest stable explicit sub-step:
+ *        `1 / (2 nu cos(theta) (1/dx^2 + 1/dy^2))` in 2D, `dx^2 / (2 nu cos(theta))` in 1D.
+ *
+ * At this sub-step no pair of cells ever exchanges more sand than brings it to
+ * the angle of repose (the paper's bound), so the surface gains no new maximum
+ * or minimum. dpsm_step() picks its sub-steps from it.
+ *
+ * @param g   the grid.
+ * @param dt  receives the sub-step.
+ * @return ::DPSM_OK or ::DPSM_ERR_NULL_POINTER.
+ */
+DPSM_API int dpsm_stable_dt(const dpsm_grid *g, double *dt);
+
+/**
+ * @brief Advances the surface by exactly `dt`.
+ *
+ * Sub-steps of at most dpsm_stable_dt() are taken. When the surface is at rest
+ * (no face steeper than `tan(theta) * (1 + tol)`, see
+ * dpsm_set_rest_tolerance()) and nothing drives it (no source acts), stepping
+ * stops early: nothing would move in the remaining time. So a large `dt` on a
+ * collapsing pile costs the work to reach rest, not `dt / dpsm_stable_dt()`
+ * sub-steps.
+ *
+ * A scene that can flow forever (an active source, or open cells that feed sand)
+ * must finish all its sub-steps; if it would need more than the limit of
+ * dpsm_set_max_substeps(), the call fails at once with ::DPSM_ERR_WORK_LIMIT
+ * and changes nothing.
+ *
+ * @param g   the grid.
+ * @param dt  finite and positive.
+ * @return ::DPSM_OK, ::DPSM_ERR_NULL_POINTER, ::DPSM_ERR_INVALID_VALUE or
+ *         ::DPSM_ERR_WORK_LIMIT.
+ */
+DPSM_API int dpsm_step(dpsm_grid *g, double dt);
+
+/**
+ * @brief Reads one figure of the mass ledger.
+ * @param g         the grid.
+ * @param quantity  ::DPSM_MASS_TOTAL, ::DPSM_MASS_SOURCED,
+ *                  ::DPSM_MASS_EXTERNAL or ::DPSM_MASS_OUTFLOW.
+ * @param value     receives the figure.
+ * @return ::DPSM_OK, ::DPSM_ERR_NULL_POINTER or ::DPSM_ERR_UNKNOWN_ENUM.
+ */
+DPSM_API int dpsm_get_mass(const dpsm_grid *g, int quantity, double *value);
+
+/**
+ * @brief Reads what the last successful dpsm_step() did.
+ * @param g      the grid.
+ * @param item   ::DPSM_INFO_SUBSTEPS, ::DPSM_INFO_TIME_INTEGRATED,
+ *               ::DPSM_INFO_AT_REST or ::DPSM_INFO_MAX_EXCESS_SLOPE.
+ * @param value  receives the figure (0 for every item before the first step).
+ * @return ::DPSM_OK, ::DPSM_ERR_NULL_POINTER or ::DPSM_ERR_UNKNOWN_ENUM.
+ */
+DPSM_API int dpsm_get_step_info(const dpsm_grid *g, int item, double *value);
+
+/**
+ * @brief Reads the size of the grid.
+ * @param g   the grid.
+ * @param nx  receives the number of cells along x.
+ * @param ny  receives the number of cells along y (1 for a 1D grid).
+ * @return ::DPSM_OK or ::DPSM_ERR_NULL_POINTER.
+ */
+DPSM_API int dpsm_get_shape(const dpsm_grid *g, int64_t *nx, int64_t *ny);
+
+/**
+ * @brief Sets how close to the angle of repose counts as rest.
+ *
+ * The surface is at rest when no face slope exceeds `tan(theta) * (1 + tol)`.
+ * Supercritical slopes relax exponentially, so a smaller tolerance costs a
+ * little more time to rest; the final heights are off by at most about
+ * `tol * tan(theta) * L` over a slope of length `L`.
+ *
+ * @param g    the grid.
+ * @param tol  finite and positive; default ::DPSM_DEFAULT_REST_TOLERANCE.
+ * @return ::DPSM_OK, ::DPSM_ERR_NULL_POINTER or ::DPSM_ERR_INVALID_VALUE.
+ */
+DPSM_API int dpsm_set_rest_tolerance(dpsm_grid *g, double tol);
+
+/**
+ * @brief Limits the sub-steps one dpsm_step() of a driven scene may take.
+ *
+ * A driven scene (an active source, or open cells) may never come to rest, so
+ * dpsm_step() checks before it starts that `dt` needs no more than this many
+ * sub-steps, and fails with ::DPSM_ERR_WORK_LIMIT otherwise. Scenes that come
+ * to rest by themselves are not limited: they stop when at rest.
+ *
+ * @param g  the grid.
+ * @param n  at least 1; default ::DPSM_DEFAULT_MAX_SUBSTEPS.
+ * @return ::DPSM_OK, ::DPSM_ERR_NULL_POINTER or ::DPSM_ERR_INVALID_VALUE.
+ */
+DPSM_API int dpsm_set_max_substeps(dpsm_grid *g, int64_t n);
+
+/**
+ * @brief The message of the last failed call on `g`, or `""` if its last call
+ *        succeeded.
+ *
+ * With `g == NULL`: the message of the last failure in this thread that had no
+ * grid to keep it (a failed create, a NULL handle).
+ * The string stays valid until the next call on the same grid (or thread).
+ *
+ * @param g  the grid, or NULL.
+ * @return never NULL.
+ */
+DPSM_API const char *dpsm_last_error(const dpsm_grid *g);
+
+/**
+ * @brief A short name for a status code, e.g. `"DPSM_ERR_INVALID_VALUE"`.
+ * @param status  any integer.
+ * @return never NULL; `"unknown status"` for codes this library does not know.
+ */
+DPSM_API const char *dpsm_status_string(int status);
+
+/**
+ * @brief The version of the library actually linked, e.g. `"0.1.0"`.
+ * @return never NULL.
+ */
+DPSM_API const char *dpsm_version_string(void);
+
+/**
+ * @brief The version of the library actually linked as
+ *        `MAJOR*10000 + MINOR*100 + PATCH`; compare with ::DPSM_VERSION_NUMBER.
+ */
+DPSM_API int dpsm_version_number(void);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* DPSM_DPSM_H */

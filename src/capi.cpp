@@ -1,0 +1,324 @@
+// The C boundary. Every entry point checks its arguments, runs the core inside
+// `guarded`, and turns any exception into a status code and a message kept on
+// the handle (or, with no handle, per thread). Checks happen before the core
+// changes anything, so a failed call leaves the grid as it was.
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <new>
+#include <sstream>
+#include <string>
+
+#include "dpsm/dpsm.h"
+#include "error.hpp"
+#include "grid.hpp"
+#include "stepper.hpp"
+
+struct dpsm_grid {
+    explicit dpsm_grid(const dpsm::Geometry &geometry) : core(geometry) {}
+    dpsm::Grid core;
+    mutable std::string last_error;
+};
+
+namespace {
+
+using dpsm::Error;
+
+thread_local std::string error_without_grid;
+
+void record_error(const dpsm_grid *g, const char *message) noexcept {
+    try {
+        if (g)
+            g->last_error = message;
+        else
+            error_without_grid = message;
+    } catch (...) {
+        // Out of memory for the message itself: keep the old one.
+    }
+}
+
+template <class Body>
+int guarded(const dpsm_grid *g, const char *function, Body &&body) noexcept {
+    try {
+        body();
+        if (g)
+            g->last_error.clear();
+        else
+            error_without_grid.clear();
+        return DPSM_OK;
+    } catch (const Error &e) {
+        record_error(g, e.what());
+        return e.status();
+    } catch (const std::bad_alloc &) {
+        record_error(g, (std::string(function) + ": out of memory").c_str());
+        return DPSM_ERR_OUT_OF_MEMORY;
+    } catch (const std::exception &e) {
+        record_error(g, e.what());
+        return DPSM_ERR_INTERNAL;
+    } catch (...) {
+        record_error(g, "dpsm: internal error of unknown kind");
+        return DPSM_ERR_INTERNAL;
+    }
+}
+
+template <class... Parts>
+[[noreturn]] void fail(int status, const char *function, const Parts &...parts) {
+    std::ostringstream msg;
+    msg.precision(17);
+    msg << function << ": ";
+    (msg << ... << parts);
+    throw Error(status, msg.str());
+}
+
+void require_grid(const dpsm_grid *g, const char *function) {
+    if (!g) fail(DPSM_ERR_NULL_POINTER, function, "the grid is NULL");
+}
+
+void require_pointer(const void *p, const char *function, const char *name) {
+    if (!p) fail(DPSM_ERR_NULL_POINTER, function, name, " is NULL");
+}
+
+void require_finite(double value, const char *function, const char *name) {
+    if (!std::isfinite(value)) fail(DPSM_ERR_INVALID_VALUE, function, name, " = ", value, " is not finite");
+}
+
+void require_positive(double value, const char *function, const char *name) {
+    require_finite(value, function, name);
+    if (!(value > 0.0)) fail(DPSM_ERR_INVALID_VALUE, function, name, " = ", value, " must be positive");
+}
+
+const char *describe(double value) { return std::isnan(value) ? "NaN" : value > 0 ? "+Inf" : "-Inf"; }
+
+// Names the first non-finite element by its index and cell.
+void require_finite_array(const dpsm_grid *g, const double *values, const char *function, const char *name) {
+    require_pointer(values, function, name);
+    const dpsm::Geometry &geo = g->core.geometry();
+    const std::int64_t n = geo.cells();
+    for (std::int64_t c = 0; c < n; ++c) {
+        if (!std::isfinite(values[c]))
+            fail(DPSM_ERR_INVALID_VALUE, function, name, "[", c, "] (cell i = ", c % geo.nx, ", j = ", c / geo.nx,
+                 ") is ", describe(values[c]));
+    }
+}
+
+void require_size(std::int64_t n, const char *function, const char *name) {
+    if (n < 1) fail(DPSM_ERR_INVALID_SIZE, function, name, " = ", n, " must be at least 1");
+}
+
+// The largest number of cells we agree to address: every per-cell array must
+// fit in memory indices with room to spare.
+constexpr std::int64_t kMaxCells = std::numeric_limits<std::int64_t>::max() / 64;
+
+int create(int dim, std::int64_t nx, std::int64_t ny, double dx, double dy, dpsm_grid **out, const char *function) {
+    if (out) *out = nullptr;
+    return guarded(nullptr, function, [&] {
+        require_pointer(out, function, "out");
+        require_size(nx, function, "nx");
+        require_size(ny, function, "ny");
+        if (nx > kMaxCells / ny)
+            fail(DPSM_ERR_INVALID_SIZE, function, "nx * ny = ", nx, " * ", ny, " cells is more than this library can address (", kMaxCells, ")");
+        require_positive(dx, function, "dx");
+        require_positive(dy, function, "dy");
+        *out = new dpsm_grid(dpsm::Geometry{dim, nx, ny, dx, dy});
+    });
+}
+
+}  // namespace
+
+extern "C" {
+
+int dpsm_create_1d(int64_t nx, double dx, dpsm_grid **out) {
+    return create(1, nx, 1, dx, 1.0, out, "dpsm_create_1d");
+}
+
+int dpsm_create_2d(int64_t nx, int64_t ny, double dx, double dy, dpsm_grid **out) {
+    return create(2, nx, ny, dx, dy, out, "dpsm_create_2d");
+}
+
+void dpsm_destroy(dpsm_grid *g) { delete g; }
+
+int dpsm_set_repose_angle(dpsm_grid *g, double theta) {
+    const char *fn = "dpsm_set_repose_angle";
+    return guarded(g, fn, [&] {
+        require_grid(g, fn);
+        require_finite(theta, fn, "theta");
+        if (!(theta > 0.0 && theta < 0.5 * M_PI))
+            fail(DPSM_ERR_INVALID_VALUE, fn, "theta = ", theta, " radians is outside (0, pi/2)");
+        g->core.set_repose_angle(theta);
+    });
+}
+
+int dpsm_set_mobility(dpsm_grid *g, double nu) {
+    const char *fn = "dpsm_set_mobility";
+    return guarded(g, fn, [&] {
+        require_grid(g, fn);
+        require_positive(nu, fn, "nu");
+        g->core.set_mobility(nu);
+    });
+}
+
+int dpsm_set_boundary(dpsm_grid *g, int side, int kind) {
+    const char *fn = "dpsm_set_boundary";
+    return guarded(g, fn, [&] {
+        require_grid(g, fn);
+        if (side < DPSM_XMIN || side > DPSM_YMAX)
+            fail(DPSM_ERR_UNKNOWN_ENUM, fn, "side = ", side, " is not DPSM_XMIN, DPSM_XMAX, DPSM_YMIN or DPSM_YMAX");
+        if (kind != DPSM_OPEN && kind != DPSM_WALL)
+            fail(DPSM_ERR_UNKNOWN_ENUM, fn, "kind = ", kind, " is not DPSM_OPEN or DPSM_WALL");
+        if (g->core.geometry().dim == 1 && side >= DPSM_YMIN)
+            fail(DPSM_ERR_NOT_APPLICABLE, fn, "a 1D grid has no y sides (side = ", side, ")");
+        g->core.set_side_open(side, kind == DPSM_OPEN);
+    });
+}
+
+int dpsm_set_cell_kinds(dpsm_grid *g, const uint8_t *kinds) {
+    const char *fn = "dpsm_set_cell_kinds";
+    return guarded(g, fn, [&] {
+        require_grid(g, fn);
+        if (kinds) {
+            const dpsm::Geometry &geo = g->core.geometry();
+            for (std::int64_t c = 0; c < geo.cells(); ++c)
+                if (kinds[c] > DPSM_CELL_OPEN)
+                    fail(DPSM_ERR_UNKNOWN_ENUM, fn, "kinds[", c, "] (cell i = ", c % geo.nx, ", j = ", c / geo.nx,
+                         ") = ", static_cast<int>(kinds[c]), " is not DPSM_CELL_SAND, DPSM_CELL_WALL or DPSM_CELL_OPEN");
+        }
+        g->core.set_cell_kinds(kinds);
+    });
+}
+
+int dpsm_set_heights(dpsm_grid *g, const double *h) {
+    const char *fn = "dpsm_set_heights";
+    return guarded(g, fn, [&] {
+        require_grid(g, fn);
+        require_finite_array(g, h, fn, "h");
+        g->core.set_heights(h);
+    });
+}
+
+int dpsm_get_heights(const dpsm_grid *g, double *h) {
+    const char *fn = "dpsm_get_heights";
+    return guarded(g, fn, [&] {
+        require_grid(g, fn);
+        require_pointer(h, fn, "h");
+        const std::vector<double> &heights = g->core.heights();
+        std::copy(heights.begin(), heights.end(), h);
+    });
+}
+
+int dpsm_set_source(dpsm_grid *g, const double *q) {
+    const char *fn = "dpsm_set_source";
+    return guarded(g, fn, [&] {
+        require_grid(g, fn);
+        if (q) require_finite_array(g, q, fn, "q");
+        g->core.set_source(q);
+    });
+}
+
+int dpsm_stable_dt(const dpsm_grid *g, double *dt) {
+    const char *fn = "dpsm_stable_dt";
+    return guarded(g, fn, [&] {
+        require_grid(g, fn);
+        require_pointer(dt, fn, "dt");
+        *dt = dpsm::stable_dt(g->core);
+    });
+}
+
+int dpsm_step(dpsm_grid *g, double dt) {
+    const char *fn = "dpsm_step";
+    return guarded(g, fn, [&] {
+        require_grid(g, fn);
+        require_positive(dt, fn, "dt");
+        dpsm::step(g->core, dt);
+    });
+}
+
+int dpsm_get_mass(const dpsm_grid *g, int quantity, double *value) {
+    const char *fn = "dpsm_get_mass";
+    return guarded(g, fn, [&] {
+        require_grid(g, fn);
+        require_pointer(value, fn, "value");
+        const dpsm::MassLedger &ledger = g->core.ledger();
+        switch (quantity) {
+            case DPSM_MASS_TOTAL: *value = g->core.total_mass(); break;
+            case DPSM_MASS_SOURCED: *value = ledger.sourced.value(); break;
+            case DPSM_MASS_EXTERNAL: *value = ledger.external.value(); break;
+            case DPSM_MASS_OUTFLOW: *value = ledger.outflow.value(); break;
+            default:
+                fail(DPSM_ERR_UNKNOWN_ENUM, fn, "quantity = ", quantity,
+                     " is not DPSM_MASS_TOTAL, DPSM_MASS_SOURCED, DPSM_MASS_EXTERNAL or DPSM_MASS_OUTFLOW");
+        }
+    });
+}
+
+int dpsm_get_step_info(const dpsm_grid *g, int item, double *value) {
+    const char *fn = "dpsm_get_step_info";
+    return guarded(g, fn, [&] {
+        require_grid(g, fn);
+        require_pointer(value, fn, "value");
+        const dpsm::StepInfo &info = g->core.last_step();
+        switch (item) {
+            case DPSM_INFO_SUBSTEPS: *value = static_cast<double>(info.substeps); break;
+            case DPSM_INFO_TIME_INTEGRATED: *value = info.time_integrated; break;
+            case DPSM_INFO_AT_REST: *value = info.at_rest ? 1.0 : 0.0; break;
+            case DPSM_INFO_MAX_EXCESS_SLOPE: *value = info.max_excess_slope; break;
+            default:
+                fail(DPSM_ERR_UNKNOWN_ENUM, fn, "item = ", item,
+                     " is not DPSM_INFO_SUBSTEPS, DPSM_INFO_TIME_INTEGRATED, DPSM_INFO_AT_REST or"
+                     " DPSM_INFO_MAX_EXCESS_SLOPE");
+        }
+    });
+}
+
+int dpsm_get_shape(const dpsm_grid *g, int64_t *nx, int64_t *ny) {
+    const char *fn = "dpsm_get_shape";
+    return guarded(g, fn, [&] {
+        require_grid(g, fn);
+        require_pointer(nx, fn, "nx");
+        require_pointer(ny, fn, "ny");
+        *nx = g->core.geometry().nx;
+        *ny = g->core.geometry().ny;
+    });
+}
+
+int dpsm_set_rest_tolerance(dpsm_grid *g, double tol) {
+    const char *fn = "dpsm_set_rest_tolerance";
+    return guarded(g, fn, [&] {
+        require_grid(g, fn);
+        require_positive(tol, fn, "tol");
+        g->core.set_rest_tolerance(tol);
+    });
+}
+
+int dpsm_set_max_substeps(dpsm_grid *g, int64_t n) {
+    const char *fn = "dpsm_set_max_substeps";
+    return guarded(g, fn, [&] {
+        require_grid(g, fn);
+        if (n < 1) fail(DPSM_ERR_INVALID_VALUE, fn, "n = ", n, " must be at least 1");
+        g->core.set_max_substeps(n);
+    });
+}
+
+const char *dpsm_last_error(const dpsm_grid *g) {
+    return g ? g->last_error.c_str() : error_without_grid.c_str();
+}
+
+const char *dpsm_status_string(int status) {
+    switch (status) {
+        case DPSM_OK: return "DPSM_OK";
+        case DPSM_ERR_NULL_POINTER: return "DPSM_ERR_NULL_POINTER";
+        case DPSM_ERR_INVALID_VALUE: return "DPSM_ERR_INVALID_VALUE";
+        case DPSM_ERR_INVALID_SIZE: return "DPSM_ERR_INVALID_SIZE";
+        case DPSM_ERR_UNKNOWN_ENUM: return "DPSM_ERR_UNKNOWN_ENUM";
+        case DPSM_ERR_NOT_APPLICABLE: return "DPSM_ERR_NOT_APPLICABLE";
+        case DPSM_ERR_WORK_LIMIT: return "DPSM_ERR_WORK_LIMIT";
+        case DPSM_ERR_OUT_OF_MEMORY: return "DPSM_ERR_OUT_OF_MEMORY";
+        case DPSM_ERR_INTERNAL: return "DPSM_ERR_INTERNAL";
+        default: return "unknown status";
+    }
+}
+
+const char *dpsm_version_string(void) { return DPSM_VERSION_STRING; }
+
+int dpsm_version_number(void) { return DPSM_VERSION_NUMBER; }
+
+}  // extern "C"

@@ -1,0 +1,19 @@
+// The one exception type of the core. The C boundary (capi.cpp) turns it into a
+// status code and a per-handle message; nothing else may cross that boundary.
+#pragma once
+
+#include <stdexcept>
+#include <string>
+
+namespace dpsm {
+
+class Error : public std::runtime_error {
+public:
+    Error(int status, const std::string &message) : std::runtime_error(message), status_(status) {}
+    int status() const noexcept { return status_; }
+
+private:
+    int status_;
+};
+
+}  // namespace dpsm

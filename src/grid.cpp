@@ -1,0 +1,78 @@
+#include "grid.hpp"
+
+#include <cmath>
+
+#include "dpsm/dpsm.h"
+
+namespace dpsm {
+
+Grid::Grid(const Geometry &geometry)
+    : geometry_(geometry),
+      repose_angle_(DPSM_DEFAULT_REPOSE_ANGLE),
+      tan_repose_(std::tan(DPSM_DEFAULT_REPOSE_ANGLE)),
+      mobility_(DPSM_DEFAULT_MOBILITY),
+      rest_tolerance_(DPSM_DEFAULT_REST_TOLERANCE),
+      max_substeps_(DPSM_DEFAULT_MAX_SUBSTEPS),
+      heights_(static_cast<std::size_t>(geometry.cells()), 0.0),
+      kinds_(static_cast<std::size_t>(geometry.cells()), kSand),
+      rate_(static_cast<std::size_t>(geometry.cells()), 0.0) {}
+
+void Grid::set_repose_angle(double theta) {
+    repose_angle_ = theta;
+    tan_repose_ = std::tan(theta);
+}
+
+static double sand_sum(const std::vector<double> &values, const std::vector<std::uint8_t> &kinds) {
+    CompensatedSum sum;
+    for (std::size_t c = 0; c < values.size(); ++c)
+        if (kinds[c] == kSand) sum.add(values[c]);
+    return sum.value();
+}
+
+double Grid::total_mass() const { return sand_sum(heights_, kinds_) * geometry_.cell_area(); }
+
+void Grid::set_heights(const double *h) {
+    // Book the difference cell by cell so that a host that changes a few cells
+    // of a large pile gets the change exactly, not a difference of two large sums.
+    CompensatedSum change;
+    for (std::size_t c = 0; c < heights_.size(); ++c) {
+        if (kinds_[c] == kSand) change.add(h[c] - heights_[c]);
+        heights_[c] = h[c];
+    }
+    ledger_.external.add(change.value() * geometry_.cell_area());
+}
+
+void Grid::set_cell_kinds(const std::uint8_t *kinds) {
+    CompensatedSum change;
+    std::int64_t walls = 0, opens = 0;
+    for (std::size_t c = 0; c < kinds_.size(); ++c) {
+        const std::uint8_t next = kinds ? kinds[c] : static_cast<std::uint8_t>(kSand);
+        if (kinds_[c] == kSand && next != kSand) change.add(-heights_[c]);
+        if (kinds_[c] != kSand && next == kSand) change.add(heights_[c]);
+        kinds_[c] = next;
+        walls += next == kWall;
+        opens += next == kOpen;
+    }
+    wall_cells_ = walls;
+    open_cells_ = opens;
+    ledger_.external.add(change.value() * geometry_.cell_area());
+    update_source_summary();
+}
+
+void Grid::set_source(const double *q) {
+    if (q)
+        source_.assign(q, q + heights_.size());
+    else
+        source_.clear();
+    update_source_summary();
+}
+
+void Grid::update_source_summary() {
+    bool nonzero = false;
+    for (std::size_t c = 0; c < source_.size() && !nonzero; ++c)
+        nonzero = kinds_[c] == kSand && source_[c] != 0.0;
+    source_rate_nonzero_ = nonzero;
+    source_mass_rate_ = nonzero ? sand_sum(source_, kinds_) * geometry_.cell_area() : 0.0;
+}
+
+}  // namespace dpsm

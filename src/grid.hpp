@@ -1,0 +1,102 @@
+// The state of one granular surface: geometry, parameters, masks, source,
+// heights and the mass ledger. Grid keeps the ledger consistent with every
+// change the host makes; the arguments reach it already checked by capi.cpp.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "ledger.hpp"
+
+namespace dpsm {
+
+enum Side { kXMin = 0, kXMax = 1, kYMin = 2, kYMax = 3 };
+enum CellKind : std::uint8_t { kSand = 0, kWall = 1, kOpen = 2 };
+
+struct Geometry {
+    int dim;             // 1 or 2
+    std::int64_t nx, ny; // ny == 1 in 1D
+    double dx, dy;       // dy == 1 in 1D, so that cell_area() is dx
+
+    std::int64_t cells() const { return nx * ny; }
+    double cell_area() const { return dx * dy; }
+};
+
+// What the last step did, for dpsm_get_step_info.
+struct StepInfo {
+    std::int64_t substeps = 0;
+    double time_integrated = 0.0;
+    bool at_rest = false;
+    double max_excess_slope = 0.0;
+};
+
+class Grid {
+public:
+    explicit Grid(const Geometry &geometry);
+
+    const Geometry &geometry() const { return geometry_; }
+
+    // Parameters.
+    double repose_angle() const { return repose_angle_; }
+    double tan_repose() const { return tan_repose_; }
+    void set_repose_angle(double theta);
+    double mobility() const { return mobility_; }
+    void set_mobility(double nu) { mobility_ = nu; }
+    double rest_tolerance() const { return rest_tolerance_; }
+    void set_rest_tolerance(double tol) { rest_tolerance_ = tol; }
+    std::int64_t max_substeps() const { return max_substeps_; }
+    void set_max_substeps(std::int64_t n) { max_substeps_ = n; }
+    bool side_open(int side) const { return side_open_[side]; }
+    void set_side_open(int side, bool open) { side_open_[side] = open; }
+
+    // Cell data, x fastest.
+    const std::vector<double> &heights() const { return heights_; }
+    std::vector<double> &heights_for_stepping() { return heights_; }
+    const std::vector<std::uint8_t> &kinds() const { return kinds_; }
+    const std::vector<double> &source() const { return source_; }  // empty: none
+    bool has_obstacles() const { return wall_cells_ > 0 || open_cells_ > 0; }
+    bool has_open_cells() const { return open_cells_ > 0; }
+    bool source_active() const { return source_rate_nonzero_; }
+    double source_mass_rate() const { return source_mass_rate_; }
+
+    void set_heights(const double *h);                // books the change as external mass
+    void set_cell_kinds(const std::uint8_t *kinds);   // NULL: all sand; books mass that comes or goes
+    void set_source(const double *q);                 // NULL: none
+
+    // Mass on sand cells now, a compensated sum.
+    double total_mass() const;
+    MassLedger &ledger() { return ledger_; }
+    const MassLedger &ledger() const { return ledger_; }
+
+    // Scratch space the kernels use; sized once.
+    std::vector<double> &rate_workspace() { return rate_; }
+
+    StepInfo &last_step() { return last_step_; }
+    const StepInfo &last_step() const { return last_step_; }
+
+private:
+    void update_source_summary();
+
+    Geometry geometry_;
+    double repose_angle_;
+    double tan_repose_;
+    double mobility_;
+    double rest_tolerance_;
+    std::int64_t max_substeps_;
+    std::array<bool, 4> side_open_{};
+
+    std::vector<double> heights_;
+    std::vector<std::uint8_t> kinds_;
+    std::vector<double> source_;
+    std::vector<double> rate_;
+    std::int64_t wall_cells_ = 0;
+    std::int64_t open_cells_ = 0;
+    bool source_rate_nonzero_ = false;
+    double source_mass_rate_ = 0.0;
+
+    MassLedger ledger_;
+    StepInfo last_step_;
+};
+
+}  // namespace dpsm

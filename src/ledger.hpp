@@ -1,0 +1,35 @@
+// The mass ledger: what sources, the host and the open boundaries did to the
+// mass on the grid. Each account is a compensated (Neumaier) sum, so the
+// balance total == sourced + external - outflow closes to round-off over
+// millions of sub-steps. Do not build this file with -ffast-math: it would
+// optimise the compensation away.
+#pragma once
+
+#include <cmath>
+
+namespace dpsm {
+
+class CompensatedSum {
+public:
+    void add(double x) noexcept {
+        const double t = sum_ + x;
+        if (std::fabs(sum_) >= std::fabs(x))
+            correction_ += (sum_ - t) + x;
+        else
+            correction_ += (x - t) + sum_;
+        sum_ = t;
+    }
+    double value() const noexcept { return sum_ + correction_; }
+
+private:
+    double sum_ = 0.0;
+    double correction_ = 0.0;
+};
+
+struct MassLedger {
+    CompensatedSum sourced;   // mass added by sources
+    CompensatedSum external;  // mass added by the host's own calls
+    CompensatedSum outflow;   // mass that left through open sides and cells
+};
+
+}  // namespace dpsm

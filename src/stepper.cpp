@@ -1,0 +1,87 @@
+#include "stepper.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include "closure.hpp"
+#include "dpsm/dpsm.h"
+#include "error.hpp"
+#include "kernels.hpp"
+
+namespace dpsm {
+
+double stable_dt(const Grid &grid) {
+    const Geometry &geo = grid.geometry();
+    const double stiffness = slide_flux_max_derivative(grid.mobility(), grid.repose_angle());
+    double inverse_spacing2 = 1.0 / (geo.dx * geo.dx);
+    if (geo.dim == 2) inverse_spacing2 += 1.0 / (geo.dy * geo.dy);
+    return 1.0 / (2.0 * stiffness * inverse_spacing2);
+}
+
+namespace {
+
+// Without a source, the slide flux only carries sand downhill, so the energy
+// sum (h - L)^2 over sand cells falls whenever sand moves, as long as every
+// held level (open sides at 0, open cells) is the same L: the surface must come
+// to rest. Held levels that differ can keep sand flowing between them forever.
+bool can_flow_forever(const Grid &grid) {
+    if (grid.source_active()) return true;
+    if (!grid.has_open_cells()) return false;
+    const Geometry &geo = grid.geometry();
+    bool any_side_open = grid.side_open(kXMin) || grid.side_open(kXMax);
+    if (geo.dim == 2) any_side_open = any_side_open || grid.side_open(kYMin) || grid.side_open(kYMax);
+    bool have_level = any_side_open;
+    double level = 0.0;
+    const std::vector<double> &h = grid.heights();
+    const std::vector<std::uint8_t> &kind = grid.kinds();
+    for (std::size_t c = 0; c < h.size(); ++c) {
+        if (kind[c] != kOpen) continue;
+        if (have_level && h[c] != level) return true;
+        level = h[c];
+        have_level = true;
+    }
+    return false;
+}
+
+}  // namespace
+
+void step(Grid &grid, double dt) {
+    const double dt_max = stable_dt(grid);
+    const double needed = std::ceil(dt / dt_max);
+    if (can_flow_forever(grid) && needed > static_cast<double>(grid.max_substeps())) {
+        std::ostringstream msg;
+        msg << "dpsm_step: dt = " << dt << " needs " << needed << " sub-steps of at most " << dt_max
+            << " in a scene that may never come to rest (an active source or open cells at different"
+               " levels), more than the limit of "
+            << grid.max_substeps() << "; take shorter steps or raise the limit with dpsm_set_max_substeps";
+        throw Error(DPSM_ERR_WORK_LIMIT, msg.str());
+    }
+    // A count beyond 2^53 cannot be reached before rest anyway: step at dt_max
+    // until the surface rests (it must, or the check above would have refused).
+    const bool bounded = needed <= 9007199254740992.0;
+    const std::int64_t substeps = bounded ? std::max<std::int64_t>(1, static_cast<std::int64_t>(needed)) : INT64_MAX;
+    const double sub_dt = bounded ? dt / static_cast<double>(substeps) : dt_max;
+    const double rest_excess = grid.rest_tolerance() * grid.tan_repose();
+    const bool source_active = grid.source_active();
+    std::vector<double> &rate = grid.rate_workspace();
+    MassLedger &ledger = grid.ledger();
+
+    StepInfo info;
+    for (std::int64_t k = 0; k < substeps; ++k) {
+        const SweepResult sweep = pairwise_rates(grid, rate);
+        info.max_excess_slope = std::max(0.0, sweep.max_excess_slope);
+        if (!source_active && sweep.max_excess_slope <= rest_excess) {
+            info.at_rest = true;
+            break;
+        }
+        apply_rates(grid, rate, sub_dt);
+        ledger.outflow.add(sweep.outflow_rate * sub_dt);
+        if (source_active) ledger.sourced.add(grid.source_mass_rate() * sub_dt);
+        ++info.substeps;
+    }
+    info.time_integrated = info.at_rest ? static_cast<double>(info.substeps) * sub_dt : dt;
+    grid.last_step() = info;
+}
+
+}  // namespace dpsm
