@@ -14,6 +14,7 @@ Grid::Grid(const Geometry &geometry)
       rest_tolerance_(DPSM_DEFAULT_REST_TOLERANCE),
       max_substeps_(DPSM_DEFAULT_MAX_SUBSTEPS),
       heights_(static_cast<std::size_t>(geometry.cells()), 0.0),
+      residuals_(static_cast<std::size_t>(geometry.cells()), 0.0),
       kinds_(static_cast<std::size_t>(geometry.cells()), kSand),
       rate_(static_cast<std::size_t>(geometry.cells()), 0.0) {}
 
@@ -38,6 +39,7 @@ void Grid::set_heights(const double *h) {
     for (std::size_t c = 0; c < heights_.size(); ++c) {
         if (kinds_[c] == kSand) change.add(h[c] - heights_[c]);
         heights_[c] = h[c];
+        residuals_[c] = 0.0;
     }
     ledger_.external.add(change.value() * geometry_.cell_area());
 }
@@ -49,6 +51,7 @@ void Grid::set_cell_kinds(const std::uint8_t *kinds) {
         const std::uint8_t next = kinds ? kinds[c] : static_cast<std::uint8_t>(kSand);
         if (kinds_[c] == kSand && next != kSand) change.add(-heights_[c]);
         if (kinds_[c] != kSand && next == kSand) change.add(heights_[c]);
+        if (kinds_[c] != next) residuals_[c] = 0.0;
         kinds_[c] = next;
         walls += next == kWall;
         opens += next == kOpen;

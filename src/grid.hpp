@@ -53,6 +53,10 @@ public:
     // Cell data, x fastest.
     const std::vector<double> &heights() const { return heights_; }
     std::vector<double> &heights_for_stepping() { return heights_; }
+    // What each cell's last updates lost to rounding, carried into its next
+    // update (a per-cell TwoSum), so that a surface at steady state under a
+    // source does not leak mass one half-ulp at a time.
+    std::vector<double> &height_residuals() { return residuals_; }
     const std::vector<std::uint8_t> &kinds() const { return kinds_; }
     const std::vector<double> &source() const { return source_; }  // empty: none
     bool has_obstacles() const { return wall_cells_ > 0 || open_cells_ > 0; }
@@ -87,6 +91,7 @@ private:
     std::array<bool, 4> side_open_{};
 
     std::vector<double> heights_;
+    std::vector<double> residuals_;
     std::vector<std::uint8_t> kinds_;
     std::vector<double> source_;
     std::vector<double> rate_;

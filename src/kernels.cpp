@@ -87,14 +87,24 @@ SweepResult pairwise_rates(const Grid &grid, std::vector<double> &rate) {
 
 void apply_rates(Grid &grid, const std::vector<double> &rate, double dt) {
     std::vector<double> &h = grid.heights_for_stepping();
+    std::vector<double> &residual = grid.height_residuals();
     const std::vector<std::uint8_t> &kind = grid.kinds();
     const std::vector<double> &q = grid.source();
     const std::size_t n = h.size();
+    // h += increment as a TwoSum: what rounding drops is kept in residual and
+    // added back next time, so mass is not lost one half-ulp at a time.
+    auto add = [&](std::size_t c, double increment) {
+        const double b = increment + residual[c];
+        const double s = h[c] + b;
+        const double b_virtual = s - h[c];
+        residual[c] = (h[c] - (s - b_virtual)) + (b - b_virtual);
+        h[c] = s;
+    };
     // rate is 0 on wall and open cells, so only the source needs the mask.
     if (q.empty()) {
-        for (std::size_t c = 0; c < n; ++c) h[c] += dt * rate[c];
+        for (std::size_t c = 0; c < n; ++c) add(c, dt * rate[c]);
     } else {
-        for (std::size_t c = 0; c < n; ++c) h[c] += dt * (rate[c] + (kind[c] == kSand ? q[c] : 0.0));
+        for (std::size_t c = 0; c < n; ++c) add(c, dt * (rate[c] + (kind[c] == kSand ? q[c] : 0.0)));
     }
 }
 
