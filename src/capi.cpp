@@ -109,17 +109,17 @@ void require_size(std::int64_t n, const char *function, const char *name) {
 // fit in memory indices with room to spare.
 constexpr std::int64_t kMaxCells = std::numeric_limits<std::int64_t>::max() / 64;
 
-int create(int dim, std::int64_t nx, std::int64_t ny, double dx, double dy, dpsm_grid **out, const char *function) {
+int create(int dim, bool axisymmetric, std::int64_t nx, std::int64_t ny, double dx, double dy, dpsm_grid **out, const char *function) {
     if (out) *out = nullptr;
     return guarded(nullptr, function, [&] {
         require_pointer(out, function, "out");
-        require_size(nx, function, "nx");
+        require_size(nx, function, axisymmetric ? "nr" : "nx");
         require_size(ny, function, "ny");
         if (nx > kMaxCells / ny)
             fail(DPSM_ERR_INVALID_SIZE, function, "nx * ny = ", nx, " * ", ny, " cells is more than this library can address (", kMaxCells, ")");
-        require_positive(dx, function, "dx");
+        require_positive(dx, function, axisymmetric ? "dr" : "dx");
         require_positive(dy, function, "dy");
-        *out = new dpsm_grid(dpsm::Geometry{dim, nx, ny, dx, dy});
+        *out = new dpsm_grid(dpsm::Geometry{dim, axisymmetric, nx, ny, dx, dy});
     });
 }
 
@@ -128,11 +128,15 @@ int create(int dim, std::int64_t nx, std::int64_t ny, double dx, double dy, dpsm
 extern "C" {
 
 int dpsm_create_1d(int64_t nx, double dx, dpsm_grid **out) {
-    return create(1, nx, 1, dx, 1.0, out, "dpsm_create_1d");
+    return create(1, false, nx, 1, dx, 1.0, out, "dpsm_create_1d");
 }
 
 int dpsm_create_2d(int64_t nx, int64_t ny, double dx, double dy, dpsm_grid **out) {
-    return create(2, nx, ny, dx, dy, out, "dpsm_create_2d");
+    return create(2, false, nx, ny, dx, dy, out, "dpsm_create_2d");
+}
+
+int dpsm_create_axisymmetric(int64_t nr, double dr, dpsm_grid **out) {
+    return create(1, true, nr, 1, dr, 1.0, out, "dpsm_create_axisymmetric");
 }
 
 void dpsm_destroy(dpsm_grid *g) { delete g; }
@@ -157,6 +161,19 @@ int dpsm_set_mobility(dpsm_grid *g, double nu) {
     });
 }
 
+int dpsm_set_scheme(dpsm_grid *g, int scheme) {
+    const char *fn = "dpsm_set_scheme";
+    return guarded(g, fn, [&] {
+        require_grid(g, fn);
+        if (scheme != DPSM_SCHEME_PAIRWISE && scheme != DPSM_SCHEME_ISOTROPIC)
+            fail(DPSM_ERR_UNKNOWN_ENUM, fn, "scheme = ", scheme, " is not DPSM_SCHEME_PAIRWISE or DPSM_SCHEME_ISOTROPIC");
+        // In 1D and on the axisymmetric grid there is no transverse slope:
+        // both schemes are the same, and the grid keeps its pairwise sweep.
+        if (g->core.geometry().dim == 2)
+            g->core.set_scheme(scheme == DPSM_SCHEME_ISOTROPIC ? dpsm::kIsotropic : dpsm::kPairwise);
+    });
+}
+
 int dpsm_set_boundary(dpsm_grid *g, int side, int kind) {
     const char *fn = "dpsm_set_boundary";
     return guarded(g, fn, [&] {
@@ -167,6 +184,8 @@ int dpsm_set_boundary(dpsm_grid *g, int side, int kind) {
             fail(DPSM_ERR_UNKNOWN_ENUM, fn, "kind = ", kind, " is not DPSM_OPEN or DPSM_WALL");
         if (g->core.geometry().dim == 1 && side >= DPSM_YMIN)
             fail(DPSM_ERR_NOT_APPLICABLE, fn, "a 1D grid has no y sides (side = ", side, ")");
+        if (g->core.geometry().axisymmetric && side == DPSM_XMIN)
+            fail(DPSM_ERR_NOT_APPLICABLE, fn, "DPSM_XMIN of an axisymmetric grid is the axis, not a boundary");
         g->core.set_side_open(side, kind == DPSM_OPEN);
     });
 }

@@ -16,32 +16,38 @@ Grid::Grid(const Geometry &geometry)
       heights_(static_cast<std::size_t>(geometry.cells()), 0.0),
       residuals_(static_cast<std::size_t>(geometry.cells()), 0.0),
       kinds_(static_cast<std::size_t>(geometry.cells()), kSand),
-      rate_(static_cast<std::size_t>(geometry.cells()), 0.0) {}
+      rate_(static_cast<std::size_t>(geometry.cells()), 0.0),
+      scheme_(geometry.dim == 2 ? kIsotropic : kPairwise) {
+    if (geometry.dim == 2) {
+        transverse_x_.assign(rate_.size(), 0.0);
+        transverse_y_.assign(rate_.size(), 0.0);
+    }
+}
 
 void Grid::set_repose_angle(double theta) {
     repose_angle_ = theta;
     tan_repose_ = std::tan(theta);
 }
 
-static double sand_sum(const std::vector<double> &values, const std::vector<std::uint8_t> &kinds) {
+double Grid::sand_mass(const double *values) const {
     CompensatedSum sum;
-    for (std::size_t c = 0; c < values.size(); ++c)
-        if (kinds[c] == kSand) sum.add(values[c]);
+    for (std::size_t c = 0; c < kinds_.size(); ++c)
+        if (kinds_[c] == kSand) sum.add(values[c] * geometry_.cell_area(static_cast<std::int64_t>(c)));
     return sum.value();
 }
 
-double Grid::total_mass() const { return sand_sum(heights_, kinds_) * geometry_.cell_area(); }
+double Grid::total_mass() const { return sand_mass(heights_.data()); }
 
 void Grid::set_heights(const double *h) {
     // Book the difference cell by cell so that a host that changes a few cells
     // of a large pile gets the change exactly, not a difference of two large sums.
     CompensatedSum change;
     for (std::size_t c = 0; c < heights_.size(); ++c) {
-        if (kinds_[c] == kSand) change.add(h[c] - heights_[c]);
+        if (kinds_[c] == kSand) change.add((h[c] - heights_[c]) * geometry_.cell_area(static_cast<std::int64_t>(c)));
         heights_[c] = h[c];
         residuals_[c] = 0.0;
     }
-    ledger_.external.add(change.value() * geometry_.cell_area());
+    ledger_.external.add(change.value());
 }
 
 void Grid::set_cell_kinds(const std::uint8_t *kinds) {
@@ -49,8 +55,9 @@ void Grid::set_cell_kinds(const std::uint8_t *kinds) {
     std::int64_t walls = 0, opens = 0;
     for (std::size_t c = 0; c < kinds_.size(); ++c) {
         const std::uint8_t next = kinds ? kinds[c] : static_cast<std::uint8_t>(kSand);
-        if (kinds_[c] == kSand && next != kSand) change.add(-heights_[c]);
-        if (kinds_[c] != kSand && next == kSand) change.add(heights_[c]);
+        const double mass = heights_[c] * geometry_.cell_area(static_cast<std::int64_t>(c));
+        if (kinds_[c] == kSand && next != kSand) change.add(-mass);
+        if (kinds_[c] != kSand && next == kSand) change.add(mass);
         if (kinds_[c] != next) residuals_[c] = 0.0;
         kinds_[c] = next;
         walls += next == kWall;
@@ -58,7 +65,7 @@ void Grid::set_cell_kinds(const std::uint8_t *kinds) {
     }
     wall_cells_ = walls;
     open_cells_ = opens;
-    ledger_.external.add(change.value() * geometry_.cell_area());
+    ledger_.external.add(change.value());
     update_source_summary();
 }
 
@@ -75,7 +82,7 @@ void Grid::update_source_summary() {
     for (std::size_t c = 0; c < source_.size() && !nonzero; ++c)
         nonzero = kinds_[c] == kSand && source_[c] != 0.0;
     source_rate_nonzero_ = nonzero;
-    source_mass_rate_ = nonzero ? sand_sum(source_, kinds_) * geometry_.cell_area() : 0.0;
+    source_mass_rate_ = nonzero ? sand_mass(source_.data()) : 0.0;
 }
 
 }  // namespace dpsm

@@ -14,13 +14,26 @@ namespace dpsm {
 enum Side { kXMin = 0, kXMax = 1, kYMin = 2, kYMax = 3 };
 enum CellKind : std::uint8_t { kSand = 0, kWall = 1, kOpen = 2 };
 
+enum Scheme { kPairwise = 0, kIsotropic = 1 };
+
 struct Geometry {
     int dim;             // 1 or 2
+    bool axisymmetric;   // a 1D grid in radius r: cell i spans [i dx, (i+1) dx]
     std::int64_t nx, ny; // ny == 1 in 1D
-    double dx, dy;       // dy == 1 in 1D, so that cell_area() is dx
+    double dx, dy;       // dy == 1 in 1D, so that a cell's area is dx
 
     std::int64_t cells() const { return nx * ny; }
-    double cell_area() const { return dx * dy; }
+    // The area (1D: length; axisymmetric: the ring's area 2 pi r dr) that
+    // turns a cell's height into its mass.
+    double cell_area(std::int64_t c) const {
+        return axisymmetric ? kTwoPi * (static_cast<double>(c) + 0.5) * dx * dx : dx * dy;
+    }
+    // The length (axisymmetric: circumference) of the x face on the high side
+    // of cell i; the face at the axis has length 0.
+    double x_face_length(std::int64_t i) const {
+        return axisymmetric ? kTwoPi * static_cast<double>(i + 1) * dx : dy;
+    }
+    static constexpr double kTwoPi = 6.283185307179586476925;
 };
 
 // What the last step did, for dpsm_get_step_info.
@@ -47,6 +60,8 @@ public:
     void set_rest_tolerance(double tol) { rest_tolerance_ = tol; }
     std::int64_t max_substeps() const { return max_substeps_; }
     void set_max_substeps(std::int64_t n) { max_substeps_ = n; }
+    Scheme scheme() const { return scheme_; }
+    void set_scheme(Scheme scheme) { scheme_ = scheme; }
     bool side_open(int side) const { return side_open_[side]; }
     void set_side_open(int side, bool open) { side_open_[side] = open; }
 
@@ -70,11 +85,16 @@ public:
 
     // Mass on sand cells now, a compensated sum.
     double total_mass() const;
+    // Mass of values (heights or source rates) on sand cells: sum v * area.
+    double sand_mass(const double *values) const;
     MassLedger &ledger() { return ledger_; }
     const MassLedger &ledger() const { return ledger_; }
 
     // Scratch space the kernels use; sized once.
     std::vector<double> &rate_workspace() { return rate_; }
+    // Transverse slopes per cell for the isotropic scheme (2D only).
+    std::vector<double> &transverse_x_workspace() { return transverse_x_; }
+    std::vector<double> &transverse_y_workspace() { return transverse_y_; }
 
     StepInfo &last_step() { return last_step_; }
     const StepInfo &last_step() const { return last_step_; }
@@ -95,6 +115,8 @@ private:
     std::vector<std::uint8_t> kinds_;
     std::vector<double> source_;
     std::vector<double> rate_;
+    std::vector<double> transverse_x_, transverse_y_;
+    Scheme scheme_;
     std::int64_t wall_cells_ = 0;
     std::int64_t open_cells_ = 0;
     bool source_rate_nonzero_ = false;

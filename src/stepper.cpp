@@ -64,18 +64,17 @@ void step(Grid &grid, double dt) {
     const double sub_dt = bounded ? dt / static_cast<double>(substeps) : dt_max;
     const double rest_excess = grid.rest_tolerance() * grid.tan_repose();
     const bool source_active = grid.source_active();
-    std::vector<double> &rate = grid.rate_workspace();
     MassLedger &ledger = grid.ledger();
 
     StepInfo info;
     for (std::int64_t k = 0; k < substeps; ++k) {
-        const SweepResult sweep = pairwise_rates(grid, rate);
+        const SweepResult sweep = slide_rates(grid);
         info.max_excess_slope = std::max(0.0, sweep.max_excess_slope);
         if (!source_active && sweep.max_excess_slope <= rest_excess) {
             info.at_rest = true;
             break;
         }
-        apply_rates(grid, rate, sub_dt);
+        apply_rates(grid, sub_dt);
         ledger.outflow.add(sweep.outflow_rate * sub_dt);
         if (source_active) ledger.sourced.add(grid.source_mass_rate() * sub_dt);
         ++info.substeps;

@@ -1,5 +1,4 @@
-/* The physics of the pairwise scheme (the paper's Eq. 12): conservation, the
- * discrete maximum principle, the paper's steady states and scenes (Eqs. 15-16,
+/* The physics of both schemes: conservation, the discrete maximum principle, the paper's steady states and scenes (Eqs. 15-16,
  * Figs. 3c and 4a), obstacles, open cells, and steps far beyond the stable one.
  * Each test prints the figure it checks, so a failing run says by how much. */
 #include <math.h>
@@ -32,23 +31,26 @@ static void rough_terrain(double *h, size_t n, double amplitude, unsigned seed) 
 static void test_mass_is_conserved_between_walls(void **state) {
     (void)state;
     const int64_t nx = 48, ny = 32;
-    dpsm_grid *g = NULL;
-    CHECK_OK(NULL, dpsm_create_2d(nx, ny, 0.1, 0.07, &g));
-    double *h = malloc(sizeof(double) * nx * ny);
-    rough_terrain(h, nx * ny, 2.0, 7u);
-    CHECK_OK(g, dpsm_set_heights(g, h));
-    const double m0 = read_ledger(g).total;
-    for (int k = 0; k < 20; ++k) CHECK_OK(g, dpsm_step(g, 0.01));
-    const ledger_t l = read_ledger(g);
-    const double drift = fabs(l.total - m0) / m0;
-    print_message("walls: relative mass drift %.2e, ledger residual %.2e, outflow %g\n", drift,
-                  ledger_residual(g), l.outflow);
-    assert_true(drift < 1e-13);
-    assert_true(ledger_residual(g) < 1e-13);
-    assert_true(l.outflow == 0.0);
-    assert_true(l.sourced == 0.0);
-    free(h);
-    dpsm_destroy(g);
+    for (int scheme = DPSM_SCHEME_PAIRWISE; scheme <= DPSM_SCHEME_ISOTROPIC; ++scheme) {
+        dpsm_grid *g = NULL;
+        CHECK_OK(NULL, dpsm_create_2d(nx, ny, 0.1, 0.07, &g));
+        CHECK_OK(g, dpsm_set_scheme(g, scheme));
+        double *h = malloc(sizeof(double) * nx * ny);
+        rough_terrain(h, nx * ny, 2.0, 7u);
+        CHECK_OK(g, dpsm_set_heights(g, h));
+        const double m0 = read_ledger(g).total;
+        for (int k = 0; k < 20; ++k) CHECK_OK(g, dpsm_step(g, 0.01));
+        const ledger_t l = read_ledger(g);
+        const double drift = fabs(l.total - m0) / m0;
+        print_message("walls, %s: relative mass drift %.2e, ledger residual %.2e, outflow %g\n",
+                      scheme ? "isotropic" : "pairwise", drift, ledger_residual(g), l.outflow);
+        assert_true(drift < 1e-13);
+        assert_true(ledger_residual(g) < 1e-13);
+        assert_true(l.outflow == 0.0);
+        assert_true(l.sourced == 0.0);
+        free(h);
+        dpsm_destroy(g);
+    }
 }
 
 /* Without sources the surface gains no new maximum or minimum (open sides
@@ -56,9 +58,11 @@ static void test_mass_is_conserved_between_walls(void **state) {
 static void test_no_new_extrema_without_source(void **state) {
     (void)state;
     const int64_t nx = 40, ny = 40;
-    for (int open = 0; open <= 1; ++open) {
+    for (int run = 0; run < 4; ++run) {
+        const int open = run & 1, scheme = run >> 1;
         dpsm_grid *g = NULL;
         CHECK_OK(NULL, dpsm_create_2d(nx, ny, 1.0, 1.0, &g));
+        CHECK_OK(g, dpsm_set_scheme(g, scheme));
         if (open) set_all_sides(g, DPSM_OPEN, 2);
         double *h = malloc(sizeof(double) * nx * ny);
         rough_terrain(h, nx * ny, 5.0, 11u + open);
@@ -72,8 +76,8 @@ static void test_no_new_extrema_without_source(void **state) {
             worst_over = fmax(worst_over, max_of(h, nx * ny) - hmax);
             worst_under = fmax(worst_under, hmin - min_of(h, nx * ny));
         }
-        print_message("%s sides: worst new maximum %+.2e, worst new minimum %+.2e\n", open ? "open" : "wall",
-                      worst_over, worst_under);
+        print_message("%s sides, %s: worst new maximum %+.2e, worst new minimum %+.2e\n", open ? "open" : "wall",
+                      scheme ? "isotropic" : "pairwise", worst_over, worst_under);
         assert_true(worst_over <= 0.0);
         assert_true(worst_under <= 0.0);
         free(h);
@@ -169,10 +173,11 @@ static void test_filling_between_two_walls_fig_3c(void **state) {
 
 /* Pours q over a square open table of side 1 until the pile is steady and
  * returns its heights (n*n values, caller frees) and the outflow rate. */
-static double *steady_pile_on_open_table(int64_t n, double q, double nu, double theta, double t_end,
+static double *steady_pile_on_open_table(int64_t n, int scheme, double q, double nu, double theta, double t_end,
                                          double *outflow_rate) {
     dpsm_grid *g = NULL;
     CHECK_OK(NULL, dpsm_create_2d(n, n, 1.0 / n, 1.0 / n, &g));
+    CHECK_OK(g, dpsm_set_scheme(g, scheme));
     CHECK_OK(g, dpsm_set_repose_angle(g, theta));
     CHECK_OK(g, dpsm_set_mobility(g, nu));
     set_all_sides(g, DPSM_OPEN, 2);
@@ -213,7 +218,7 @@ static void test_steady_pile_on_square_open_table_fig_4a(void **state) {
     const int64_t n = 40;
     const double q = 0.5, nu = 1.0, theta = deg(30.0);
     double outflow_rate;
-    double *h = steady_pile_on_open_table(n, q, nu, theta, 5.0, &outflow_rate);
+    double *h = steady_pile_on_open_table(n, DPSM_SCHEME_PAIRWISE, q, nu, theta, 5.0, &outflow_rate);
     const double centre = h[n / 2 + n * (n / 2)];
     print_message("Fig. 4a: outflow rate %.8f vs poured %.8f; asymmetry %.1e; centre %.4f (tan(theta) L/2 = %.4f)\n",
                   outflow_rate, q, square_asymmetry(h, n), centre, tan(theta) * 0.5);
@@ -232,7 +237,7 @@ static void test_pairwise_scheme_builds_a_pyramid(void **state) {
     const int64_t n = 40;
     const double q = 0.01, nu = 1.0, theta = deg(30.0), dx = 1.0 / n;
     double outflow_rate, worst = 0.0;
-    double *h = steady_pile_on_open_table(n, q, nu, theta, 60.0, &outflow_rate);
+    double *h = steady_pile_on_open_table(n, DPSM_SCHEME_PAIRWISE, q, nu, theta, 60.0, &outflow_rate);
     for (int64_t k = 0; k < n / 2; ++k) {
         const double pyramid = tan(theta) * (k + 1) * dx; /* the open side is a node 1 dx beyond */
         worst = fmax(worst, fabs(h[k + n * k] - pyramid) / pyramid);

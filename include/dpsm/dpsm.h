@@ -91,6 +91,21 @@ typedef struct dpsm_grid dpsm_grid;
 #define DPSM_WALL 1
 /** @} */
 
+/** @name Schemes
+ *  For dpsm_set_scheme(): how a face's slope is measured. @{ */
+/** The paper's pairwise exchange (its Eq. 12): the slope of a face is the
+ *  height difference of its two cells over their distance. It limits the slope
+ *  along each grid axis, not |grad h|, so in 2D it builds pyramids where sand
+ *  builds cones and does not converge to the exact deposit. Kept to reproduce
+ *  the paper. */
+#define DPSM_SCHEME_PAIRWISE 0
+/** A flux-form scheme on the full gradient: each face adds to its normal
+ *  difference the transverse slope (the mean of its two cells' central
+ *  differences across it), so the flux law acts on |grad h| and deposits
+ *  converge to the exact ones under refinement. The default in 2D. */
+#define DPSM_SCHEME_ISOTROPIC 1
+/** @} */
+
 /** @name Cell kinds
  *  For dpsm_set_cell_kinds(). @{ */
 /** An ordinary cell whose height the model evolves. The default. */
@@ -173,6 +188,22 @@ DPSM_API int dpsm_create_1d(int64_t nx, double dx, dpsm_grid **out);
 DPSM_API int dpsm_create_2d(int64_t nx, int64_t ny, double dx, double dy, dpsm_grid **out);
 
 /**
+ * @brief Creates an axisymmetric grid of `nr` rings of width `dr`.
+ *
+ * Cell `i` spans radii `[i*dr, (i+1)*dr]`; heights are `h(r)` of a surface of
+ * revolution. The axis (::DPSM_XMIN) is a symmetry line, not a boundary; the
+ * outer side ::DPSM_XMAX is a wall by default and may be made open. Mass is the
+ * volume `sum h * 2 pi r_i dr` with `r_i = (i + 1/2) dr`. Otherwise it behaves
+ * like a 1D grid (arrays of `nr` values, no y sides).
+ *
+ * @param nr  number of rings, at least 1.
+ * @param dr  ring width, finite and positive.
+ * @param out receives the new grid, or NULL on failure.
+ * @return as dpsm_create_1d().
+ */
+DPSM_API int dpsm_create_axisymmetric(int64_t nr, double dr, dpsm_grid **out);
+
+/**
  * @brief Releases a grid and everything it holds.
  * @param g the grid; NULL is allowed and does nothing.
  */
@@ -196,13 +227,27 @@ DPSM_API int dpsm_set_repose_angle(dpsm_grid *g, double theta_radians);
 DPSM_API int dpsm_set_mobility(dpsm_grid *g, double nu);
 
 /**
+ * @brief Chooses how face slopes are measured: ::DPSM_SCHEME_ISOTROPIC (the
+ *        default) or ::DPSM_SCHEME_PAIRWISE.
+ *
+ * On 1D and axisymmetric grids the two are the same; the call is accepted and
+ * changes nothing.
+ *
+ * @param g       the grid.
+ * @param scheme  ::DPSM_SCHEME_PAIRWISE or ::DPSM_SCHEME_ISOTROPIC.
+ * @return ::DPSM_OK, ::DPSM_ERR_NULL_POINTER or ::DPSM_ERR_UNKNOWN_ENUM.
+ */
+DPSM_API int dpsm_set_scheme(dpsm_grid *g, int scheme);
+
+/**
  * @brief Makes one side of the domain open or a wall.
  * @param g     the grid.
  * @param side  ::DPSM_XMIN, ::DPSM_XMAX, ::DPSM_YMIN or ::DPSM_YMAX (the last
  *              two on 2D grids only).
  * @param kind  ::DPSM_OPEN or ::DPSM_WALL.
  * @return ::DPSM_OK, ::DPSM_ERR_NULL_POINTER, ::DPSM_ERR_UNKNOWN_ENUM, or
- *         ::DPSM_ERR_NOT_APPLICABLE for a y side of a 1D grid.
+ *         ::DPSM_ERR_NOT_APPLICABLE for a y side of a 1D grid or the axis of an
+ *         axisymmetric grid.
  */
 DPSM_API int dpsm_set_boundary(dpsm_grid *g, int side, int kind);
 
@@ -256,7 +301,8 @@ DPSM_API int dpsm_set_source(dpsm_grid *g, const double *q);
 
 /**
  * @brief The largest stable explicit sub-step:
- *        `1 / (2 nu cos(theta) (1/dx^2 + 1/dy^2))` in 2D, `dx^2 / (2 nu cos(theta))` in 1D.
+ *        `1 / (2 nu cos(theta) (1/dx^2 + 1/dy^2))` in 2D, `dx^2 / (2 nu cos(theta))`
+ *        in 1D and on the axisymmetric grid.
  *
  * At this sub-step no pair of cells ever exchanges more sand than brings it to
  * the angle of repose (the paper's bound), so the surface gains no new maximum
