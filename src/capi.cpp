@@ -105,6 +105,27 @@ void require_size(std::int64_t n, const char *function, const char *name) {
     if (n < 1) fail(DPSM_ERR_INVALID_SIZE, function, name, " = ", n, " must be at least 1");
 }
 
+// Checks that [i0, i0+ni) x [j0, j0+nj) lies on the grid, without overflow.
+dpsm::Grid::Block require_block(const dpsm_grid *g, std::int64_t i0, std::int64_t j0, std::int64_t ni,
+                                std::int64_t nj, const char *function) {
+    const dpsm::Geometry &geo = g->core.geometry();
+    if (ni < 1 || nj < 1)
+        fail(DPSM_ERR_INVALID_SIZE, function, "the block is ni = ", ni, " by nj = ", nj, " cells; both must be at least 1");
+    if (i0 < 0 || j0 < 0 || i0 > geo.nx - ni || j0 > geo.ny - nj)
+        fail(DPSM_ERR_INVALID_SIZE, function, "the block [", i0, ", ", i0, " + ", ni, ") x [", j0, ", ", j0, " + ", nj,
+             ") does not lie on the ", geo.nx, " x ", geo.ny, " grid");
+    return {i0, j0, ni, nj};
+}
+
+// Names the first non-finite value of a block by its index and cell.
+void require_finite_block(const double *values, const dpsm::Grid::Block &b, const char *function, const char *name) {
+    require_pointer(values, function, name);
+    for (std::int64_t k = 0; k < b.ni * b.nj; ++k)
+        if (!std::isfinite(values[k]))
+            fail(DPSM_ERR_INVALID_VALUE, function, name, "[", k, "] (cell i = ", b.i0 + k % b.ni, ", j = ", b.j0 + k / b.ni,
+                 ") is ", describe(values[k]));
+}
+
 // The largest number of cells we agree to address: every per-cell array must
 // fit in memory indices with room to spare.
 constexpr std::int64_t kMaxCells = std::numeric_limits<std::int64_t>::max() / 64;
@@ -210,7 +231,45 @@ int dpsm_set_heights(dpsm_grid *g, const double *h) {
     return guarded(g, fn, [&] {
         require_grid(g, fn);
         require_finite_array(g, h, fn, "h");
-        g->core.set_heights(h);
+        g->core.write_heights(g->core.whole(), h, false);
+    });
+}
+
+int dpsm_set_heights_region(dpsm_grid *g, int64_t i0, int64_t j0, int64_t ni, int64_t nj, const double *h) {
+    const char *fn = "dpsm_set_heights_region";
+    return guarded(g, fn, [&] {
+        require_grid(g, fn);
+        const dpsm::Grid::Block block = require_block(g, i0, j0, ni, nj, fn);
+        require_finite_block(h, block, fn, "h");
+        g->core.write_heights(block, h, false);
+    });
+}
+
+int dpsm_add_heights_region(dpsm_grid *g, int64_t i0, int64_t j0, int64_t ni, int64_t nj, const double *dh) {
+    const char *fn = "dpsm_add_heights_region";
+    return guarded(g, fn, [&] {
+        require_grid(g, fn);
+        const dpsm::Grid::Block block = require_block(g, i0, j0, ni, nj, fn);
+        require_finite_block(dh, block, fn, "dh");
+        const std::vector<double> &h = g->core.heights();
+        const std::int64_t nx = g->core.geometry().nx;
+        for (std::int64_t k = 0; k < ni * nj; ++k) {
+            const std::int64_t c = (i0 + k % ni) + nx * (j0 + k / ni);
+            if (!std::isfinite(h[c] + dh[k]))
+                fail(DPSM_ERR_INVALID_VALUE, fn, "dh[", k, "] = ", dh[k], " added to cell i = ", c % nx, ", j = ", c / nx,
+                     " of height ", h[c], " overflows");
+        }
+        g->core.write_heights(block, dh, true);
+    });
+}
+
+int dpsm_get_heights_region(const dpsm_grid *g, int64_t i0, int64_t j0, int64_t ni, int64_t nj, double *h) {
+    const char *fn = "dpsm_get_heights_region";
+    return guarded(g, fn, [&] {
+        require_grid(g, fn);
+        const dpsm::Grid::Block block = require_block(g, i0, j0, ni, nj, fn);
+        require_pointer(h, fn, "h");
+        g->core.read_heights(block, h);
     });
 }
 
@@ -219,8 +278,7 @@ int dpsm_get_heights(const dpsm_grid *g, double *h) {
     return guarded(g, fn, [&] {
         require_grid(g, fn);
         require_pointer(h, fn, "h");
-        const std::vector<double> &heights = g->core.heights();
-        std::copy(heights.begin(), heights.end(), h);
+        g->core.read_heights(g->core.whole(), h);
     });
 }
 
@@ -314,6 +372,15 @@ int dpsm_set_max_substeps(dpsm_grid *g, int64_t n) {
         require_grid(g, fn);
         if (n < 1) fail(DPSM_ERR_INVALID_VALUE, fn, "n = ", n, " must be at least 1");
         g->core.set_max_substeps(n);
+    });
+}
+
+int dpsm_set_threads(dpsm_grid *g, int n) {
+    const char *fn = "dpsm_set_threads";
+    return guarded(g, fn, [&] {
+        require_grid(g, fn);
+        if (n < 0) fail(DPSM_ERR_INVALID_VALUE, fn, "n = ", n, " must be at least 0 (0: OpenMP's default)");
+        g->core.set_threads(n);
     });
 }
 

@@ -38,16 +38,26 @@ double Grid::sand_mass(const double *values) const {
 
 double Grid::total_mass() const { return sand_mass(heights_.data()); }
 
-void Grid::set_heights(const double *h) {
+void Grid::write_heights(const Block &block, const double *values, bool add) {
     // Book the difference cell by cell so that a host that changes a few cells
     // of a large pile gets the change exactly, not a difference of two large sums.
     CompensatedSum change;
-    for (std::size_t c = 0; c < heights_.size(); ++c) {
-        if (kinds_[c] == kSand) change.add((h[c] - heights_[c]) * geometry_.cell_area(static_cast<std::int64_t>(c)));
-        heights_[c] = h[c];
-        residuals_[c] = 0.0;
-    }
+    for (std::int64_t j = 0; j < block.nj; ++j)
+        for (std::int64_t i = 0; i < block.ni; ++i) {
+            const std::int64_t c = (block.i0 + i) + geometry_.nx * (block.j0 + j);
+            const double v = values[i + block.ni * j];
+            const double next = add ? heights_[c] + v : v;
+            if (kinds_[c] == kSand) change.add((next - heights_[c]) * geometry_.cell_area(c));
+            heights_[c] = next;
+            residuals_[c] = 0.0;
+        }
     ledger_.external.add(change.value());
+}
+
+void Grid::read_heights(const Block &block, double *values) const {
+    for (std::int64_t j = 0; j < block.nj; ++j)
+        for (std::int64_t i = 0; i < block.ni; ++i)
+            values[i + block.ni * j] = heights_[(block.i0 + i) + geometry_.nx * (block.j0 + j)];
 }
 
 void Grid::set_cell_kinds(const std::uint8_t *kinds) {

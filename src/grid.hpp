@@ -60,6 +60,8 @@ public:
     void set_rest_tolerance(double tol) { rest_tolerance_ = tol; }
     std::int64_t max_substeps() const { return max_substeps_; }
     void set_max_substeps(std::int64_t n) { max_substeps_ = n; }
+    int threads() const { return threads_; }  // 0: OpenMP's default
+    void set_threads(int n) { threads_ = n; }
     Scheme scheme() const { return scheme_; }
     void set_scheme(Scheme scheme) { scheme_ = scheme; }
     bool side_open(int side) const { return side_open_[side]; }
@@ -79,7 +81,15 @@ public:
     bool source_active() const { return source_rate_nonzero_; }
     double source_mass_rate() const { return source_mass_rate_; }
 
-    void set_heights(const double *h);                // books the change as external mass
+    // A block of cells [i0, i0+ni) x [j0, j0+nj), values x fastest: sets the
+    // heights (add = false) or adds to them (add = true), booking the change
+    // on sand cells as external mass.
+    struct Block {
+        std::int64_t i0, j0, ni, nj;
+    };
+    Block whole() const { return {0, 0, geometry_.nx, geometry_.ny}; }
+    void write_heights(const Block &block, const double *values, bool add);
+    void read_heights(const Block &block, double *values) const;
     void set_cell_kinds(const std::uint8_t *kinds);   // NULL: all sand; books mass that comes or goes
     void set_source(const double *q);                 // NULL: none
 
@@ -117,6 +127,7 @@ private:
     std::vector<double> rate_;
     std::vector<double> transverse_x_, transverse_y_;
     Scheme scheme_;
+    int threads_ = 0;
     std::int64_t wall_cells_ = 0;
     std::int64_t open_cells_ = 0;
     bool source_rate_nonzero_ = false;

@@ -287,6 +287,53 @@ DPSM_API int dpsm_set_heights(dpsm_grid *g, const double *h);
 DPSM_API int dpsm_get_heights(const dpsm_grid *g, double *h);
 
 /**
+ * @brief Sets the heights of a block of cells, leaving the others as they are.
+ *
+ * For a host that changes a few cells between steps (deposition from a flow
+ * solver): only the cells of the block, and their neighbours, are looked at
+ * again by the next step. The change of mass on sand cells is booked as
+ * ::DPSM_MASS_EXTERNAL.
+ *
+ * @param g   the grid.
+ * @param i0  first column of the block, `0 <= i0`.
+ * @param j0  first row of the block, `0 <= j0` (0 on a 1D grid).
+ * @param ni  columns in the block, at least 1, `i0 + ni <= nx`.
+ * @param nj  rows in the block, at least 1, `j0 + nj <= ny` (1 on a 1D grid).
+ * @param h   `ni*nj` finite heights, x fastest: cell `(i0+i, j0+j)` is `h[i + ni*j]`.
+ * @return ::DPSM_OK, ::DPSM_ERR_NULL_POINTER, ::DPSM_ERR_INVALID_SIZE (a block
+ *         that does not lie on the grid) or ::DPSM_ERR_INVALID_VALUE.
+ */
+DPSM_API int dpsm_set_heights_region(dpsm_grid *g, int64_t i0, int64_t j0, int64_t ni, int64_t nj, const double *h);
+
+/**
+ * @brief Adds to the heights of a block of cells (deposition > 0, erosion < 0).
+ *
+ * As dpsm_set_heights_region(), but `dh` is added to each cell.
+ *
+ * @param g   the grid.
+ * @param i0  first column of the block.
+ * @param j0  first row of the block.
+ * @param ni  columns in the block.
+ * @param nj  rows in the block.
+ * @param dh  `ni*nj` finite changes, x fastest.
+ * @return ::DPSM_OK, ::DPSM_ERR_NULL_POINTER, ::DPSM_ERR_INVALID_SIZE or
+ *         ::DPSM_ERR_INVALID_VALUE (also when a sum overflows).
+ */
+DPSM_API int dpsm_add_heights_region(dpsm_grid *g, int64_t i0, int64_t j0, int64_t ni, int64_t nj, const double *dh);
+
+/**
+ * @brief Copies the heights of a block of cells out.
+ * @param g   the grid.
+ * @param i0  first column of the block.
+ * @param j0  first row of the block.
+ * @param ni  columns in the block.
+ * @param nj  rows in the block.
+ * @param h   room for `ni*nj` values, x fastest.
+ * @return ::DPSM_OK, ::DPSM_ERR_NULL_POINTER or ::DPSM_ERR_INVALID_SIZE.
+ */
+DPSM_API int dpsm_get_heights_region(const dpsm_grid *g, int64_t i0, int64_t j0, int64_t ni, int64_t nj, double *h);
+
+/**
  * @brief Sets the source `q`: height per unit time added to each cell
  *        (deposition > 0, erosion < 0).
  *
@@ -392,6 +439,21 @@ DPSM_API int dpsm_set_rest_tolerance(dpsm_grid *g, double tol);
  * @return ::DPSM_OK, ::DPSM_ERR_NULL_POINTER or ::DPSM_ERR_INVALID_VALUE.
  */
 DPSM_API int dpsm_set_max_substeps(dpsm_grid *g, int64_t n);
+
+/**
+ * @brief Sets how many threads dpsm_step() may use on this grid.
+ *
+ * Results do not depend on the number of threads: every face flux is computed
+ * the same way whichever thread computes it, and sums are taken in a fixed
+ * order. Without OpenMP support in the build the library runs on one thread
+ * and accepts any valid `n`.
+ *
+ * @param g  the grid.
+ * @param n  at least 0; 0 (the default) means OpenMP's default, usually one
+ *           thread per core.
+ * @return ::DPSM_OK, ::DPSM_ERR_NULL_POINTER or ::DPSM_ERR_INVALID_VALUE.
+ */
+DPSM_API int dpsm_set_threads(dpsm_grid *g, int n);
 
 /**
  * @brief The message of the last failed call on `g`, or `""` if its last call
