@@ -141,8 +141,9 @@ typedef struct dpsm_grid dpsm_grid;
 #define DPSM_INFO_TIME_INTEGRATED 1
 /** 1 if the surface is at rest at its end, 0 otherwise. */
 #define DPSM_INFO_AT_REST 2
-/** The largest slope excess `|grad h| - tan(theta)` over all faces at its end
- *  (0 when no face is steeper than the angle of repose). */
+/** The largest slope excess `|grad h| - tan(theta)` over all faces, measured
+ *  at the start of its last sub-step, or when it found rest (0 when no face is
+ *  steeper than the angle of repose). */
 #define DPSM_INFO_MAX_EXCESS_SLOPE 3
 /** @} */
 
@@ -349,11 +350,15 @@ DPSM_API int dpsm_set_source(dpsm_grid *g, const double *q);
 /**
  * @brief The largest stable explicit sub-step:
  *        `1 / (2 nu cos(theta) (1/dx^2 + 1/dy^2))` in 2D, `dx^2 / (2 nu cos(theta))`
- *        in 1D and on the axisymmetric grid.
+ *        in 1D, `3 dr^2 / (8 nu cos(theta))` on the axisymmetric grid.
  *
- * At this sub-step no pair of cells ever exchanges more sand than brings it to
- * the angle of repose (the paper's bound), so the surface gains no new maximum
- * or minimum. dpsm_step() picks its sub-steps from it.
+ * `cos(theta)` is the largest slope of the flux law. At this sub-step no pair
+ * of cells exchanges more sand than brings it to the angle of repose (the
+ * paper's bound on the mass exchanged per step) and, for the pairwise scheme
+ * and on 1D and axisymmetric grids, every new height is a weighted mean of old
+ * ones, so the surface gains no new maximum or minimum. For the isotropic
+ * scheme this is tested on rough terrains, not proven. dpsm_step() picks its
+ * sub-steps from it.
  *
  * @param g   the grid.
  * @param dt  receives the sub-step.
@@ -371,10 +376,13 @@ DPSM_API int dpsm_stable_dt(const dpsm_grid *g, double *dt);
  * collapsing pile costs the work to reach rest, not `dt / dpsm_stable_dt()`
  * sub-steps.
  *
- * A scene that can flow forever (an active source, or open cells that feed sand)
- * must finish all its sub-steps; if it would need more than the limit of
+ * A scene that may flow forever must finish all its sub-steps: one with an
+ * active source, or with held levels that differ (open cells at different
+ * heights, or an open cell not at 0 while a side is open), between which sand
+ * can run without end. If it would need more than the limit of
  * dpsm_set_max_substeps(), the call fails at once with ::DPSM_ERR_WORK_LIMIT
- * and changes nothing.
+ * and changes nothing. Any other scene comes to rest by itself (its energy
+ * falls while sand moves) and is not limited.
  *
  * @param g   the grid.
  * @param dt  finite and positive.
@@ -429,7 +437,7 @@ DPSM_API int dpsm_set_rest_tolerance(dpsm_grid *g, double tol);
 /**
  * @brief Limits the sub-steps one dpsm_step() of a driven scene may take.
  *
- * A driven scene (an active source, or open cells) may never come to rest, so
+ * A scene that may flow forever (see dpsm_step()) may never come to rest, so
  * dpsm_step() checks before it starts that `dt` needs no more than this many
  * sub-steps, and fails with ::DPSM_ERR_WORK_LIMIT otherwise. Scenes that come
  * to rest by themselves are not limited: they stop when at rest.

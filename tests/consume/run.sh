@@ -1,0 +1,147 @@
+#!/usr/bin/env bash
+# Install/consume test: installs a built dpsm to a temporary prefix and builds
+# small programs against it from outside the source tree, as a user would.
+#
+#   usage: run.sh <build-dir> <source-dir>
+#
+#  1. cmake --install <build-dir> --prefix <tmp>/prefix
+#  2. pkg-config: cc prog.c $(pkg-config --cflags --libs dpsm), also as C++ and
+#     linked statically with `pkg-config --static`; each program is run.
+#  3. CMake: a project with find_package(dpsm 0.1 CONFIG REQUIRED) linking
+#     dpsm::dpsm and dpsm::dpsm_static; both programs are run; requests for
+#     versions 1.0 and 0.99 must be refused.
+#  4. Relocation: the prefix is moved elsewhere; no installed file may name the
+#     old prefix, and the pkg-config and CMake builds must work from the new place.
+set -euo pipefail
+
+if [[ $# -ne 2 ]]; then
+    echo "usage: $0 <build-dir> <source-dir>" >&2
+    exit 2
+fi
+build=$(cd "$1" && pwd)
+src=$(cd "$2" && pwd)
+here=$src/tests/consume
+CC=${CC:-cc}
+CXX=${CXX:-c++}
+
+work=$(mktemp -d "${TMPDIR:-/tmp}/dpsm-consume.XXXXXX")
+trap 'rm -rf "$work"' EXIT
+
+say() { printf '== %s\n' "$*"; }
+fail() {
+    printf 'FAIL: %s\n' "$*" >&2
+    exit 1
+}
+need() { command -v "$1" >/dev/null 2>&1 || fail "$1 is not installed"; }
+need cmake
+need pkg-config
+need "$CC"
+need "$CXX"
+need readelf
+
+version=$(sed -n 's/^#define DPSM_VERSION_STRING "\(.*\)"$/\1/p' "$build/include/dpsm/dpsm_version.h")
+[[ -n $version ]] || fail "no DPSM_VERSION_STRING in $build/include/dpsm/dpsm_version.h"
+soversion=${version%%.*}
+
+# ---- 1. install -------------------------------------------------------------
+say "cmake --install $build --prefix $work/prefix"
+cmake --install "$build" --prefix "$work/prefix" >"$work/install.log" ||
+    { cat "$work/install.log"; fail "cmake --install failed"; }
+
+# Finds the one installed file called $2 under prefix $1 (lib or lib64 or lib/<triplet>).
+installed() {
+    local found
+    found=$(find "$1" -name "$2" -print -quit)
+    [[ -n $found ]] || fail "$2 was not installed under $1"
+    printf '%s\n' "$found"
+}
+for f in dpsm.h dpsm_version.h "libdpsm.so.$soversion" libdpsm.a dpsm.pc dpsmConfig.cmake \
+    dpsmConfigVersion.cmake dpsmTargets.cmake; do
+    installed "$work/prefix" "$f" >/dev/null
+done
+[[ -f $work/prefix/include/dpsm/dpsm.h && -f $work/prefix/include/dpsm/dpsm_version.h ]] ||
+    fail "the headers are not in <prefix>/include/dpsm"
+
+# ---- 2. pkg-config ----------------------------------------------------------
+# Builds and runs prog.c against the prefix $1 with pkg-config, into directory $2.
+# The flags from pkg-config are split into words on purpose, as in a Makefile.
+# shellcheck disable=SC2086
+pkgconfig_build() {
+    local prefix=$1 out=$2 pcdir libdir cflags libs static_libs
+    mkdir -p "$out"
+    pcdir=$(dirname "$(installed "$prefix" dpsm.pc)")
+    export PKG_CONFIG_PATH=$pcdir
+    say "pkg-config against $prefix (PKG_CONFIG_PATH=$pcdir)"
+
+    [[ $(pkg-config --modversion dpsm) == "$version" ]] ||
+        fail "pkg-config --modversion dpsm gives '$(pkg-config --modversion dpsm)', expected $version"
+    [[ $(realpath "$(pkg-config --variable=prefix dpsm)") == "$(realpath "$prefix")" ]] ||
+        fail "pkg-config prefix '$(pkg-config --variable=prefix dpsm)' is not $prefix"
+    libdir=$(realpath "$(pkg-config --variable=libdir dpsm)")
+    [[ -e $libdir/libdpsm.so ]] || fail "pkg-config libdir $libdir holds no libdpsm.so"
+    cflags=$(pkg-config --cflags dpsm)
+    libs=$(pkg-config --libs dpsm)
+    echo "   cflags: $cflags"
+    echo "   libs:   $libs"
+
+    # C, shared, run through LD_LIBRARY_PATH.
+    (cd "$out" && set -x && $CC -std=c99 -Wall -Wextra -Wpedantic -Werror "$here/prog.c" -o prog_c $cflags $libs -lm) 2>&1 ||
+        fail "C build with pkg-config failed"
+    [[ $(LD_LIBRARY_PATH=$libdir ldd "$out/prog_c") == *"libdpsm.so.$soversion => $libdir/"* ]] ||
+        fail "prog_c does not load libdpsm.so.$soversion from $libdir"
+    LD_LIBRARY_PATH=$libdir "$out/prog_c" || fail "prog_c (C, pkg-config) failed"
+
+    # C++, shared, run through an rpath.
+    (cd "$out" && set -x && $CXX -x c++ -std=c++11 -Wall -Wextra -Werror "$here/prog.c" -o prog_cxx $cflags $libs \
+        -Wl,-rpath,"$libdir") 2>&1 || fail "C++ build with pkg-config failed"
+    "$out/prog_cxx" || fail "prog_cxx (C++, pkg-config) failed"
+
+    # C, static: libdpsm.a plus Libs.private (the C++ runtime).
+    static_libs=$(pkg-config --static --libs dpsm | sed 's/-ldpsm\( \|$\)/-l:libdpsm.a\1/')
+    (cd "$out" && set -x && $CC -std=c99 "$here/prog.c" -o prog_static $cflags $static_libs) 2>&1 ||
+        fail "static C build with 'pkg-config --static' failed"
+    if [[ $(readelf -d "$out/prog_static") == *"Shared library: [libdpsm"* ]]; then
+        fail "prog_static still needs the shared libdpsm"
+    fi
+    "$out/prog_static" || fail "prog_static (C, static, pkg-config) failed"
+    unset PKG_CONFIG_PATH
+}
+
+# Builds and runs the CMake project against the prefix $1, in directory $2.
+cmake_build() {
+    local prefix=$1 out=$2 found_dir libdir
+    say "CMake find_package(dpsm 0.1 CONFIG REQUIRED) against $prefix"
+    cmake -S "$here/cmake" -B "$out" -DCMAKE_BUILD_TYPE=Release -DCMAKE_PREFIX_PATH="$prefix" \
+        -DCMAKE_FIND_USE_PACKAGE_REGISTRY=OFF -DCMAKE_C_COMPILER="$CC" >"$out.log" 2>&1 ||
+        { cat "$out.log"; fail "configuring the CMake consumer failed"; }
+    found_dir=$(sed -n 's/^dpsm_DIR:PATH=//p' "$out/CMakeCache.txt")
+    [[ $(realpath "$found_dir") == "$(realpath "$prefix")"/* ]] ||
+        fail "find_package found dpsm in $found_dir, not under $prefix"
+    cmake --build "$out" >>"$out.log" 2>&1 || { cat "$out.log"; fail "building the CMake consumer failed"; }
+    libdir=$(dirname "$(installed "$prefix" "libdpsm.so.$soversion")")
+    [[ $(ldd "$out/consumer") == *"libdpsm.so.$soversion => $libdir/"* ]] ||
+        fail "consumer does not load libdpsm.so.$soversion from $libdir through its rpath"
+    "$out/consumer" || fail "consumer (CMake, dpsm::dpsm) failed"
+    "$out/consumer_static" || fail "consumer_static (CMake, dpsm::dpsm_static) failed"
+    if [[ $(readelf -d "$out/consumer_static") == *"Shared library: [libdpsm"* ]]; then
+        fail "consumer_static still needs the shared libdpsm"
+    fi
+    cmake -DCMAKE_PREFIX_PATH="$prefix" -DCMAKE_FIND_USE_PACKAGE_REGISTRY=OFF -P "$here/version_check.cmake" ||
+        fail "the package version check failed"
+}
+
+pkgconfig_build "$work/prefix" "$work/pc"
+cmake_build "$work/prefix" "$work/cm"
+
+# ---- 4. relocation ----------------------------------------------------------
+say "relocation: no installed file names the prefix"
+if grep -rl -- "$work/prefix" "$work/prefix"; then
+    fail "the files above name the install prefix $work/prefix: the install is not relocatable"
+fi
+mkdir -p "$work/elsewhere/deeper"
+mv "$work/prefix" "$work/elsewhere/deeper/moved"
+[[ ! -e $work/prefix ]] || fail "the old prefix is still there"
+pkgconfig_build "$work/elsewhere/deeper/moved" "$work/pc-moved"
+cmake_build "$work/elsewhere/deeper/moved" "$work/cm-moved"
+
+say "install/consume checks passed"
