@@ -111,9 +111,12 @@ dpsm::Grid::Block require_block(const dpsm_grid *g, std::int64_t i0, std::int64_
     const dpsm::Geometry &geo = g->core.geometry();
     if (ni < 1 || nj < 1)
         fail(DPSM_ERR_INVALID_SIZE, function, "the block is ni = ", ni, " by nj = ", nj, " cells; both must be at least 1");
-    if (i0 < 0 || j0 < 0 || i0 > geo.nx - ni || j0 > geo.ny - nj)
-        fail(DPSM_ERR_INVALID_SIZE, function, "the block [", i0, ", ", i0, " + ", ni, ") x [", j0, ", ", j0, " + ", nj,
-             ") does not lie on the ", geo.nx, " x ", geo.ny, " grid");
+    if (i0 < 0 || i0 > geo.nx - ni)
+        fail(DPSM_ERR_INVALID_SIZE, function, "the block's columns i0 = ", i0, " .. i0 + ni = ", i0, " + ", ni,
+             " do not lie in [0, nx = ", geo.nx, "]");
+    if (j0 < 0 || j0 > geo.ny - nj)
+        fail(DPSM_ERR_INVALID_SIZE, function, "the block's rows j0 = ", j0, " .. j0 + nj = ", j0, " + ", nj,
+             " do not lie in [0, ny = ", geo.ny, "]");
     return {i0, j0, ni, nj};
 }
 
@@ -137,7 +140,9 @@ int create(int dim, bool axisymmetric, std::int64_t nx, std::int64_t ny, double 
         require_size(nx, function, axisymmetric ? "nr" : "nx");
         require_size(ny, function, "ny");
         if (nx > kMaxCells / ny)
-            fail(DPSM_ERR_INVALID_SIZE, function, "nx * ny = ", nx, " * ", ny, " cells is more than this library can address (", kMaxCells, ")");
+            fail(DPSM_ERR_INVALID_SIZE, function, axisymmetric ? "nr = " : "nx * ny = ", nx, axisymmetric ? "" : " * ",
+                 axisymmetric ? std::string() : std::to_string(ny), " cells is more than this library can address (",
+                 kMaxCells, ")");
         require_positive(dx, function, axisymmetric ? "dr" : "dx");
         require_positive(dy, function, "dy");
         *out = new dpsm_grid(dpsm::Geometry{dim, axisymmetric, nx, ny, dx, dy});
@@ -206,7 +211,7 @@ int dpsm_set_boundary(dpsm_grid *g, int side, int kind) {
         if (g->core.geometry().dim == 1 && side >= DPSM_YMIN)
             fail(DPSM_ERR_NOT_APPLICABLE, fn, "a 1D grid has no y sides (side = ", side, ")");
         if (g->core.geometry().axisymmetric && side == DPSM_XMIN)
-            fail(DPSM_ERR_NOT_APPLICABLE, fn, "DPSM_XMIN of an axisymmetric grid is the axis, not a boundary");
+            fail(DPSM_ERR_NOT_APPLICABLE, fn, "side = DPSM_XMIN of an axisymmetric grid is the axis, not a boundary");
         g->core.set_side_open(side, kind == DPSM_OPEN);
     });
 }

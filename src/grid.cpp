@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "dpsm/dpsm.h"
+#include "tiled_sweep.hpp"
 
 namespace dpsm {
 
@@ -14,19 +15,27 @@ Grid::Grid(const Geometry &geometry)
       rest_tolerance_(DPSM_DEFAULT_REST_TOLERANCE),
       max_substeps_(DPSM_DEFAULT_MAX_SUBSTEPS),
       heights_(static_cast<std::size_t>(geometry.cells()), 0.0),
-      residuals_(static_cast<std::size_t>(geometry.cells()), 0.0),
+      residuals_(static_cast<std::size_t>(geometry.cells()), 0.0f),
       kinds_(static_cast<std::size_t>(geometry.cells()), kSand),
       rate_(static_cast<std::size_t>(geometry.cells()), 0.0),
       scheme_(geometry.dim == 2 ? kIsotropic : kPairwise) {
     if (geometry.dim == 2) {
-        transverse_x_.assign(rate_.size(), 0.0);
-        transverse_y_.assign(rate_.size(), 0.0);
+        active_ = std::make_unique<ActiveSet>(geometry.nx, geometry.ny);
+        active_->refresh_masks(*this);
     }
+}
+
+Grid::~Grid() = default;
+
+TiledWorkspace &Grid::tiled_workspace() {
+    if (!tiled_) tiled_ = std::make_unique<TiledWorkspace>();
+    return *tiled_;
 }
 
 void Grid::set_repose_angle(double theta) {
     repose_angle_ = theta;
     tan_repose_ = std::tan(theta);
+    touched_everywhere();
 }
 
 double Grid::sand_mass(const double *values) const {
@@ -49,9 +58,10 @@ void Grid::write_heights(const Block &block, const double *values, bool add) {
             const double next = add ? heights_[c] + v : v;
             if (kinds_[c] == kSand) change.add((next - heights_[c]) * geometry_.cell_area(c));
             heights_[c] = next;
-            residuals_[c] = 0.0;
+            residuals_[c] = 0.0f;
         }
     ledger_.external.add(change.value());
+    if (active_) active_->mark_block(block.i0, block.j0, block.ni, block.nj);
 }
 
 void Grid::read_heights(const Block &block, double *values) const {
@@ -68,7 +78,7 @@ void Grid::set_cell_kinds(const std::uint8_t *kinds) {
         const double mass = heights_[c] * geometry_.cell_area(static_cast<std::int64_t>(c));
         if (kinds_[c] == kSand && next != kSand) change.add(-mass);
         if (kinds_[c] != kSand && next == kSand) change.add(mass);
-        if (kinds_[c] != next) residuals_[c] = 0.0;
+        if (kinds_[c] != next) residuals_[c] = 0.0f;
         kinds_[c] = next;
         walls += next == kWall;
         opens += next == kOpen;
@@ -77,6 +87,10 @@ void Grid::set_cell_kinds(const std::uint8_t *kinds) {
     open_cells_ = opens;
     ledger_.external.add(change.value());
     update_source_summary();
+    if (active_) {
+        active_->refresh_masks(*this);
+        active_->mark_all();
+    }
 }
 
 void Grid::set_source(const double *q) {
@@ -93,6 +107,7 @@ void Grid::update_source_summary() {
         nonzero = kinds_[c] == kSand && source_[c] != 0.0;
     source_rate_nonzero_ = nonzero;
     source_mass_rate_ = nonzero ? sand_mass(source_.data()) : 0.0;
+    if (active_) active_->refresh_source(*this);
 }
 
 }  // namespace dpsm

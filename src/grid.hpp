@@ -5,8 +5,10 @@
 
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <vector>
 
+#include "active_set.hpp"
 #include "ledger.hpp"
 
 namespace dpsm {
@@ -37,6 +39,8 @@ struct Geometry {
 };
 
 // What the last step did, for dpsm_get_step_info.
+struct TiledWorkspace;
+
 struct StepInfo {
     std::int64_t substeps = 0;
     double time_integrated = 0.0;
@@ -47,6 +51,9 @@ struct StepInfo {
 class Grid {
 public:
     explicit Grid(const Geometry &geometry);
+    ~Grid();
+    Grid(const Grid &) = delete;
+    Grid &operator=(const Grid &) = delete;
 
     const Geometry &geometry() const { return geometry_; }
 
@@ -57,15 +64,24 @@ public:
     double mobility() const { return mobility_; }
     void set_mobility(double nu) { mobility_ = nu; }
     double rest_tolerance() const { return rest_tolerance_; }
-    void set_rest_tolerance(double tol) { rest_tolerance_ = tol; }
+    void set_rest_tolerance(double tol) {
+        rest_tolerance_ = tol;
+        touched_everywhere();
+    }
     std::int64_t max_substeps() const { return max_substeps_; }
     void set_max_substeps(std::int64_t n) { max_substeps_ = n; }
     int threads() const { return threads_; }  // 0: OpenMP's default
     void set_threads(int n) { threads_ = n; }
     Scheme scheme() const { return scheme_; }
-    void set_scheme(Scheme scheme) { scheme_ = scheme; }
+    void set_scheme(Scheme scheme) {
+        scheme_ = scheme;
+        touched_everywhere();
+    }
     bool side_open(int side) const { return side_open_[side]; }
-    void set_side_open(int side, bool open) { side_open_[side] = open; }
+    void set_side_open(int side, bool open) {
+        side_open_[side] = open;
+        touched_everywhere();
+    }
 
     // Cell data, x fastest.
     const std::vector<double> &heights() const { return heights_; }
@@ -73,7 +89,12 @@ public:
     // What each cell's last updates lost to rounding, carried into its next
     // update (a per-cell TwoSum), so that a surface at steady state under a
     // source does not leak mass one half-ulp at a time.
-    std::vector<double> &height_residuals() { return residuals_; }
+    const std::vector<float> &residuals() const { return residuals_; }
+    std::vector<float> &residuals_for_stepping() { return residuals_; }
+    void swap_heights(std::vector<double> &heights, std::vector<float> &residuals) {
+        heights_.swap(heights);
+        residuals_.swap(residuals);
+    }
     const std::vector<std::uint8_t> &kinds() const { return kinds_; }
     const std::vector<double> &source() const { return source_; }  // empty: none
     bool has_obstacles() const { return wall_cells_ > 0 || open_cells_ > 0; }
@@ -102,15 +123,19 @@ public:
 
     // Scratch space the kernels use; sized once.
     std::vector<double> &rate_workspace() { return rate_; }
-    // Transverse slopes per cell for the isotropic scheme (2D only).
-    std::vector<double> &transverse_x_workspace() { return transverse_x_; }
-    std::vector<double> &transverse_y_workspace() { return transverse_y_; }
+    // The 2D sweep's active set and scratch (2D grids only).
+    ActiveSet &active_set() { return *active_; }
+    TiledWorkspace &tiled_workspace();
 
     StepInfo &last_step() { return last_step_; }
     const StepInfo &last_step() const { return last_step_; }
 
 private:
     void update_source_summary();
+    // Something that may make any face steep changed: every tile is looked at again.
+    void touched_everywhere() {
+        if (active_) active_->mark_all();
+    }
 
     Geometry geometry_;
     double repose_angle_;
@@ -121,11 +146,12 @@ private:
     std::array<bool, 4> side_open_{};
 
     std::vector<double> heights_;
-    std::vector<double> residuals_;
+    std::vector<float> residuals_;
     std::vector<std::uint8_t> kinds_;
     std::vector<double> source_;
     std::vector<double> rate_;
-    std::vector<double> transverse_x_, transverse_y_;
+    std::unique_ptr<ActiveSet> active_;
+    std::unique_ptr<TiledWorkspace> tiled_;
     Scheme scheme_;
     int threads_ = 0;
     std::int64_t wall_cells_ = 0;

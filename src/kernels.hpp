@@ -1,13 +1,9 @@
-// One explicit sweep of the slide fluxes. Every face between two cells carries
-// one flux by the law in closure.hpp, which one cell loses and the other gains,
-// so mass is conserved face by face. Two schemes share the sweep:
-//  - pairwise (the paper's Eq. 12): the slope of a face is the difference of
-//    its two cells over their distance; it limits the slope along each grid
-//    axis, so in 2D it builds pyramids;
-//  - isotropic: the face also sees the transverse slope (the average of its
-//    two cells' central differences across it), so the law acts on the full
-//    |grad h| and piles converge to cones under refinement.
-// In 1D and on the axisymmetric grid the two are the same.
+// One explicit sweep of the slide fluxes on a 1D or axisymmetric grid (2D
+// grids use tiled_sweep.hpp). Every face between two cells carries one flux
+// by the law in closure.hpp, which one cell loses and the other gains, so mass
+// is conserved face by face: the paper's pairwise exchange (its Eq. 12).
+// Faces no steeper than the rest threshold tan(theta) (1 + tol) carry nothing,
+// as in the 2D kernel, so a surface at rest is exactly at rest.
 // Kernels read the grid and write rates; they never call back up.
 #pragma once
 
@@ -18,13 +14,14 @@
 namespace dpsm {
 
 struct SweepResult {
-    double max_excess_slope = 0.0;  // max over open faces of |grad h| - tan(theta), at least 0
+    bool moved = false;             // some face carried sand
+    double max_excess_slope = 0.0;  // max over faces that carried sand of |slope| - tan(theta)
     double outflow_rate = 0.0;      // mass per unit time leaving through open sides and cells
 };
 
 // Fills the grid's rate workspace with dh/dt from the slide fluxes (sources
 // not included) for every sand cell, 0 for wall and open cells.
-SweepResult slide_rates(Grid &grid);
+SweepResult slide_rates_1d(Grid &grid);
 
 // h += dt * (rate + q) on sand cells.
 void apply_rates(Grid &grid, double dt);

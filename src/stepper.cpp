@@ -8,6 +8,7 @@
 #include "dpsm/dpsm.h"
 #include "error.hpp"
 #include "kernels.hpp"
+#include "tiled_sweep.hpp"
 
 namespace dpsm {
 
@@ -55,7 +56,10 @@ bool can_flow_forever(const Grid &grid) {
 void step(Grid &grid, double dt) {
     const double dt_max = stable_dt(grid);
     const double needed = std::ceil(dt / dt_max);
-    if (can_flow_forever(grid) && needed > static_cast<double>(grid.max_substeps())) {
+    // A count beyond 2^53 cannot be stepped exactly; a scene that comes to rest
+    // never gets there, and one that may flow forever is refused.
+    const bool bounded = needed <= 9007199254740992.0;
+    if (can_flow_forever(grid) && (!bounded || needed > static_cast<double>(grid.max_substeps()))) {
         std::ostringstream msg;
         msg << "dpsm_step: dt = " << dt << " needs " << needed << " sub-steps of at most " << dt_max
             << " in a scene that may never come to rest (an active source or open cells at different"
@@ -63,27 +67,50 @@ void step(Grid &grid, double dt) {
             << grid.max_substeps() << "; take shorter steps or raise the limit with dpsm_set_max_substeps";
         throw Error(DPSM_ERR_WORK_LIMIT, msg.str());
     }
-    // A count beyond 2^53 cannot be reached before rest anyway: step at dt_max
-    // until the surface rests (it must, or the check above would have refused).
-    const bool bounded = needed <= 9007199254740992.0;
+    const bool two_d = grid.geometry().dim == 2;
+    if (two_d) prepare_tiled_sweep(grid, grid.threads());  // allocates before anything changes
+
+    // Without a bound, step at dt_max until the surface rests (it must, or the
+    // check above would have refused).
     const std::int64_t substeps = bounded ? std::max<std::int64_t>(1, static_cast<std::int64_t>(needed)) : INT64_MAX;
     const double sub_dt = bounded ? dt / static_cast<double>(substeps) : dt_max;
-    const double rest_excess = grid.rest_tolerance() * grid.tan_repose();
     const bool source_active = grid.source_active();
     MassLedger &ledger = grid.ledger();
 
+    // Books one sub-step; false once the surface is found at rest (nothing
+    // moved and no source acts: no later sub-step can change anything).
     StepInfo info;
-    for (std::int64_t k = 0; k < substeps; ++k) {
-        const SweepResult sweep = slide_rates(grid);
-        info.max_excess_slope = std::max(0.0, sweep.max_excess_slope);
-        if (!source_active && sweep.max_excess_slope <= rest_excess) {
+    auto book = [&](bool moved, double outflow_rate, double max_excess) {
+        info.max_excess_slope = max_excess;
+        if (!moved && !source_active) {
             info.at_rest = true;
-            break;
+            return false;
         }
-        apply_rates(grid, sub_dt);
-        ledger.outflow.add(sweep.outflow_rate * sub_dt);
+        ledger.outflow.add(outflow_rate * sub_dt);
         if (source_active) ledger.sourced.add(grid.source_mass_rate() * sub_dt);
         ++info.substeps;
+        return true;
+    };
+
+    if (two_d) {
+        // Idle: no tile can move and no source acts.
+        if (!source_active && !grid.active_set().may_move()) {
+            info.at_rest = true;
+        } else {
+            std::vector<LevelSummary> levels;
+            for (std::int64_t k = 0; k < substeps && !info.at_rest; k += ActiveSet::kMaxLevels) {
+                const int count = static_cast<int>(std::min<std::int64_t>(ActiveSet::kMaxLevels, substeps - k));
+                tiled_sweep(grid, count, sub_dt, levels);
+                for (const LevelSummary &level : levels)
+                    if (!book(level.moved, level.outflow_rate, level.max_excess)) break;
+            }
+        }
+    } else {
+        for (std::int64_t k = 0; k < substeps; ++k) {
+            const SweepResult sweep = slide_rates_1d(grid);
+            if (!book(sweep.moved, sweep.outflow_rate, sweep.max_excess_slope)) break;
+            apply_rates(grid, sub_dt);
+        }
     }
     info.time_integrated = info.at_rest ? static_cast<double>(info.substeps) * sub_dt : dt;
     grid.last_step() = info;

@@ -139,7 +139,9 @@ typedef struct dpsm_grid dpsm_grid;
 /** The simulated time it integrated before the surface came to rest (equal to
  *  the requested `dt` when it did not come to rest). */
 #define DPSM_INFO_TIME_INTEGRATED 1
-/** 1 if the surface is at rest at its end, 0 otherwise. */
+/** 1 if it stopped because it found the surface at rest (or had nothing to
+ *  do), 0 if it integrated all of `dt`; a surface that came to rest in the last
+ *  sub-step reads 0 here, and the next step returns at once with 1. */
 #define DPSM_INFO_AT_REST 2
 /** The largest slope excess `|grad h| - tan(theta)` over all faces, measured
  *  at the start of its last sub-step, or when it found rest (0 when no face is

@@ -1,0 +1,115 @@
+#include "active_set.hpp"
+
+#include <algorithm>
+
+#include "grid.hpp"
+
+namespace dpsm {
+
+namespace {
+// How far a sweep reads beyond its tile: its levels plus one ring of ghosts.
+constexpr std::int64_t kReach = ActiveSet::kMaxLevels + 1;
+}  // namespace
+
+ActiveSet::ActiveSet(std::int64_t nx, std::int64_t ny)
+    : nx_(nx),
+      ny_(ny),
+      tiles_x_((nx + kTile - 1) / kTile),
+      tiles_y_((ny + kTile - 1) / kTile),
+      hot_(static_cast<std::size_t>(tiles_x_ * tiles_y_)),
+      source_(hot_.size()),
+      masked_(hot_.size(), 0),
+      has_source_(hot_.size(), 0) {
+    mark_all();
+}
+
+CellBox ActiveSet::tile_cells(std::int64_t t) const {
+    const std::int64_t ti = t % tiles_x_, tj = t / tiles_x_;
+    CellBox box;
+    box.add(ti * kTile, std::min(nx_, (ti + 1) * kTile), tj * kTile, std::min(ny_, (tj + 1) * kTile));
+    return box;
+}
+
+void ActiveSet::mark_all() {
+    for (std::int64_t t = 0; t < tiles(); ++t) hot_[t] = tile_cells(t);
+}
+
+void ActiveSet::mark_block(std::int64_t i0, std::int64_t j0, std::int64_t ni, std::int64_t nj) {
+    CellBox changed;
+    changed.add(i0, i0 + ni, j0, j0 + nj);
+    const std::int64_t t0 = std::max<std::int64_t>(0, (i0 - 1) / kTile), t1 = std::min(tiles_x_ - 1, (i0 + ni) / kTile);
+    const std::int64_t s0 = std::max<std::int64_t>(0, (j0 - 1) / kTile), s1 = std::min(tiles_y_ - 1, (j0 + nj) / kTile);
+    for (std::int64_t tj = s0; tj <= s1; ++tj)
+        for (std::int64_t ti = t0; ti <= t1; ++ti) {
+            const std::int64_t t = ti + tiles_x_ * tj;
+            if (changed.reaches(tile_cells(t), 1)) hot_[t].add(changed);
+        }
+}
+
+void ActiveSet::refresh_masks(const Grid &grid) {
+    const std::vector<std::uint8_t> &kind = grid.kinds();
+    for (std::int64_t t = 0; t < tiles(); ++t) {
+        const CellBox c = tile_cells(t);
+        // Ghost cells beyond the domain's edge are sinks or walls.
+        masked_[t] = c.i0 - kReach < 0 || c.j0 - kReach < 0 || c.i1 + kReach > nx_ || c.j1 + kReach > ny_;
+    }
+    for (std::int64_t j = 0; j < ny_; ++j)
+        for (std::int64_t i = 0; i < nx_; ++i) {
+            if (kind[i + nx_ * j] == kSand) continue;
+            const std::int64_t t0 = std::max<std::int64_t>(0, (i - kReach) / kTile);
+            const std::int64_t t1 = std::min(tiles_x_ - 1, (i + kReach) / kTile);
+            const std::int64_t s0 = std::max<std::int64_t>(0, (j - kReach) / kTile);
+            const std::int64_t s1 = std::min(tiles_y_ - 1, (j + kReach) / kTile);
+            for (std::int64_t tj = s0; tj <= s1; ++tj)
+                for (std::int64_t ti = t0; ti <= t1; ++ti) masked_[ti + tiles_x_ * tj] = 1;
+        }
+}
+
+void ActiveSet::refresh_source(const Grid &grid) {
+    std::fill(has_source_.begin(), has_source_.end(), 0);
+    std::fill(source_.begin(), source_.end(), CellBox{});
+    const std::vector<double> &q = grid.source();
+    if (q.empty()) return;
+    const std::vector<std::uint8_t> &kind = grid.kinds();
+    for (std::int64_t j = 0; j < ny_; ++j)
+        for (std::int64_t i = 0; i < nx_; ++i) {
+            const std::int64_t c = i + nx_ * j;
+            if (q[c] == 0.0 || kind[c] != kSand) continue;
+            source_[(i / kTile) + tiles_x_ * (j / kTile)].add(i, i + 1, j, j + 1);
+            const std::int64_t t0 = std::max<std::int64_t>(0, (i - kReach) / kTile);
+            const std::int64_t t1 = std::min(tiles_x_ - 1, (i + kReach) / kTile);
+            const std::int64_t s0 = std::max<std::int64_t>(0, (j - kReach) / kTile);
+            const std::int64_t s1 = std::min(tiles_y_ - 1, (j + kReach) / kTile);
+            for (std::int64_t tj = s0; tj <= s1; ++tj)
+                for (std::int64_t ti = t0; ti <= t1; ++ti) has_source_[ti + tiles_x_ * tj] = 1;
+        }
+}
+
+bool ActiveSet::may_move() const {
+    for (std::int64_t t = 0; t < tiles(); ++t)
+        if (!hot_[t].empty() || !source_[t].empty()) return true;
+    return false;
+}
+
+void ActiveSet::tiles_to_visit(int levels, std::vector<std::int64_t> &out) const {
+    // Within `levels` sub-steps motion spreads `levels` cells, and a face
+    // reads one cell beyond its own two: a hot box reaches levels + 2 cells.
+    const std::int64_t reach = levels + 2;
+    out.clear();
+    for (std::int64_t tj = 0; tj < tiles_y_; ++tj)
+        for (std::int64_t ti = 0; ti < tiles_x_; ++ti) {
+            const std::int64_t t = ti + tiles_x_ * tj;
+            const CellBox cells = tile_cells(t);
+            bool visit = false;
+            for (std::int64_t dj = -1; dj <= 1 && !visit; ++dj)
+                for (std::int64_t di = -1; di <= 1 && !visit; ++di) {
+                    const std::int64_t ui = ti + di, uj = tj + dj;
+                    if (ui < 0 || uj < 0 || ui >= tiles_x_ || uj >= tiles_y_) continue;
+                    const std::int64_t u = ui + tiles_x_ * uj;
+                    visit = hot_[u].reaches(cells, reach) || source_[u].reaches(cells, reach);
+                }
+            if (visit) out.push_back(t);
+        }
+}
+
+}  // namespace dpsm

@@ -1,0 +1,71 @@
+// The active set of a 2D grid: which tiles of 64 x 64 cells can move. A
+// tile's hot box holds the cells that carried sand in its last sweep (or that
+// the host changed since); a sweep visits a tile when a hot box, or a source,
+// lies near enough to reach it within the sweep. Everything else is exactly at
+// rest under the dead-zone flux law, so skipping it changes no result.
+#pragma once
+
+#include <climits>
+#include <cstdint>
+#include <vector>
+
+namespace dpsm {
+
+class Grid;
+
+// A box of cells [i0, i1) x [j0, j1) in grid coordinates; empty when i0 >= i1.
+struct CellBox {
+    std::int64_t i0 = INT64_MAX, i1 = INT64_MIN, j0 = INT64_MAX, j1 = INT64_MIN;
+
+    bool empty() const { return i0 >= i1 || j0 >= j1; }
+    void add(std::int64_t a0, std::int64_t a1, std::int64_t b0, std::int64_t b1) {
+        if (a0 >= a1 || b0 >= b1) return;
+        i0 = a0 < i0 ? a0 : i0;
+        i1 = a1 > i1 ? a1 : i1;
+        j0 = b0 < j0 ? b0 : j0;
+        j1 = b1 > j1 ? b1 : j1;
+    }
+    void add(const CellBox &o) { add(o.i0, o.i1, o.j0, o.j1); }
+    // Whether this box grown by d cells meets the other.
+    bool reaches(const CellBox &o, std::int64_t d) const {
+        return !empty() && !o.empty() && i0 - d < o.i1 && o.i0 < i1 + d && j0 - d < o.j1 && o.j0 < j1 + d;
+    }
+};
+
+class ActiveSet {
+public:
+    static constexpr int kTile = 64;       // cells along each side of a tile
+    static constexpr int kMaxLevels = 4;   // sub-steps per sweep over a tile
+
+    ActiveSet(std::int64_t nx, std::int64_t ny);
+
+    std::int64_t tiles_x() const { return tiles_x_; }
+    std::int64_t tiles_y() const { return tiles_y_; }
+    std::int64_t tiles() const { return tiles_x_ * tiles_y_; }
+    CellBox tile_cells(std::int64_t t) const;
+
+    // The host changed something everywhere (heights, parameters, masks).
+    void mark_all();
+    // The host changed the cells of a block: they and their neighbours may move.
+    void mark_block(std::int64_t i0, std::int64_t j0, std::int64_t ni, std::int64_t nj);
+    // Recomputes which tiles see walls, sinks or the domain's edge, and which a source.
+    void refresh_masks(const Grid &grid);
+    void refresh_source(const Grid &grid);
+
+    bool may_move() const;  // some tile is hot or has a source
+    // The tiles a sweep of `levels` sub-steps must visit, in order.
+    void tiles_to_visit(int levels, std::vector<std::int64_t> &out) const;
+
+    CellBox &hot(std::int64_t t) { return hot_[t]; }
+    bool masked(std::int64_t t) const { return masked_[t] != 0; }
+    bool has_source(std::int64_t t) const { return has_source_[t] != 0; }
+
+private:
+    std::int64_t nx_, ny_, tiles_x_, tiles_y_;
+    std::vector<CellBox> hot_;
+    std::vector<CellBox> source_;          // cells with a source, per tile
+    std::vector<std::uint8_t> masked_;     // walls, sinks or the edge within a tile's reach
+    std::vector<std::uint8_t> has_source_; // a source within a tile's reach
+};
+
+}  // namespace dpsm

@@ -1,0 +1,100 @@
+// The two lane types the tile kernel is written for: Lanes1 (one double, any
+// CPU) and Lanes8 (eight doubles in an AVX-512 register). The kernel is one
+// template over them, so both compute every face by the same formula; a run
+// uses one of them throughout, which keeps its results independent of how the
+// grid is cut into tiles and shared among threads.
+//
+// rsqrt is the one place they differ in arithmetic: Lanes1 divides by sqrt,
+// Lanes8 refines the hardware's 14-bit estimate by two Newton steps (to within
+// a few ulp), which avoids the divider, the bottleneck of this kernel.
+#pragma once
+
+#include <cmath>
+#include <cstdint>
+
+#if defined(__AVX512F__)
+#include <immintrin.h>
+#endif
+
+namespace dpsm::simd {
+
+struct Lanes1 {
+    static constexpr int width = 1;
+    using Mask = bool;
+    double v;
+
+    static Lanes1 broadcast(double x) { return {x}; }
+    static Lanes1 load(const double *p) { return {*p}; }
+    static Lanes1 load_partial(const double *p, int) { return {*p}; }
+    void store(double *p) const { *p = v; }
+    void store_partial(double *p, int) const { *p = v; }
+    static Mask first_lanes(int n) { return n > 0; }
+    static Mask kind_is(const std::uint8_t *p, std::uint8_t k) { return *p == k; }
+
+    friend Lanes1 operator+(Lanes1 a, Lanes1 b) { return {a.v + b.v}; }
+    friend Lanes1 operator-(Lanes1 a, Lanes1 b) { return {a.v - b.v}; }
+    friend Lanes1 operator*(Lanes1 a, Lanes1 b) { return {a.v * b.v}; }
+    friend Mask operator>(Lanes1 a, Lanes1 b) { return a.v > b.v; }
+    friend Mask operator!=(Lanes1 a, Lanes1 b) { return a.v != b.v; }
+    friend Lanes1 max(Lanes1 a, Lanes1 b) { return {a.v > b.v ? a.v : b.v}; }
+    friend Lanes1 select(Mask m, Lanes1 a, Lanes1 b) { return m ? a : b; }
+    friend Lanes1 rsqrt(Lanes1 a) { return {1.0 / std::sqrt(a.v)}; }
+    static Mask both(Mask a, Mask b) { return a && b; }
+    static Mask either(Mask a, Mask b) { return a || b; }
+    static Mask but_not(Mask a, Mask b) { return a && !b; }
+    static bool any(Mask m) { return m; }
+    static int first(Mask) { return 0; }
+    static int last(Mask) { return 0; }
+    static double sum(Lanes1 a) { return a.v; }
+    static double hmax(Lanes1 a) { return a.v; }
+};
+
+#if defined(__AVX512F__)
+struct Lanes8 {
+    static constexpr int width = 8;
+    using Mask = __mmask8;
+    __m512d v;
+
+    static Lanes8 broadcast(double x) { return {_mm512_set1_pd(x)}; }
+    static Lanes8 load(const double *p) { return {_mm512_loadu_pd(p)}; }
+    static Lanes8 load_partial(const double *p, int n) { return {_mm512_maskz_loadu_pd(first_lanes(n), p)}; }
+    void store(double *p) const { _mm512_storeu_pd(p, v); }
+    void store_partial(double *p, int n) const { _mm512_mask_storeu_pd(p, first_lanes(n), v); }
+    static Mask first_lanes(int n) { return static_cast<Mask>(n >= 8 ? 0xFF : n <= 0 ? 0 : (1u << n) - 1u); }
+    static Mask kind_is(const std::uint8_t *p, std::uint8_t k) {
+        const __m128i bytes = _mm_loadl_epi64(reinterpret_cast<const __m128i *>(p));
+        return static_cast<Mask>(_mm_cmpeq_epi8_mask(bytes, _mm_set1_epi8(static_cast<char>(k))) & 0xFF);
+    }
+
+    friend Lanes8 operator+(Lanes8 a, Lanes8 b) { return {_mm512_add_pd(a.v, b.v)}; }
+    friend Lanes8 operator-(Lanes8 a, Lanes8 b) { return {_mm512_sub_pd(a.v, b.v)}; }
+    friend Lanes8 operator*(Lanes8 a, Lanes8 b) { return {_mm512_mul_pd(a.v, b.v)}; }
+    friend Mask operator>(Lanes8 a, Lanes8 b) { return _mm512_cmp_pd_mask(a.v, b.v, _CMP_GT_OQ); }
+    friend Mask operator!=(Lanes8 a, Lanes8 b) { return _mm512_cmp_pd_mask(a.v, b.v, _CMP_NEQ_UQ); }
+    friend Lanes8 max(Lanes8 a, Lanes8 b) { return {_mm512_max_pd(a.v, b.v)}; }
+    friend Lanes8 select(Mask m, Lanes8 a, Lanes8 b) { return {_mm512_mask_blend_pd(m, b.v, a.v)}; }
+    friend Lanes8 rsqrt(Lanes8 a) {
+        const __m512d half_a = _mm512_mul_pd(_mm512_set1_pd(0.5), a.v);
+        const __m512d three_halves = _mm512_set1_pd(1.5);
+        __m512d y = _mm512_rsqrt14_pd(a.v);
+        y = _mm512_mul_pd(y, _mm512_fnmadd_pd(half_a, _mm512_mul_pd(y, y), three_halves));
+        y = _mm512_mul_pd(y, _mm512_fnmadd_pd(half_a, _mm512_mul_pd(y, y), three_halves));
+        return {y};
+    }
+    static Mask both(Mask a, Mask b) { return static_cast<Mask>(a & b); }
+    static Mask either(Mask a, Mask b) { return static_cast<Mask>(a | b); }
+    static Mask but_not(Mask a, Mask b) { return static_cast<Mask>(a & ~b); }
+    static bool any(Mask m) { return m != 0; }
+    static int first(Mask m) { return __builtin_ctz(m); }
+    static int last(Mask m) { return 31 - __builtin_clz(m); }
+    static double sum(Lanes8 a) {
+        // A fixed order, so that a sum does not depend on the compiler's choice.
+        alignas(64) double x[8];
+        _mm512_store_pd(x, a.v);
+        return ((x[0] + x[1]) + (x[2] + x[3])) + ((x[4] + x[5]) + (x[6] + x[7]));
+    }
+    static double hmax(Lanes8 a) { return _mm512_reduce_max_pd(a.v); }
+};
+#endif
+
+}  // namespace dpsm::simd

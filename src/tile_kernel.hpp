@@ -1,0 +1,56 @@
+// The 2D sweep on one tile: a private copy of the tile and a halo of `levels`
+// cells (plus one ring of ghosts) is advanced `levels` sub-steps in cache,
+// shrinking by one cell a level, and only the tile itself is kept. Faces are
+// computed once per level; the flux law is the dead-zone form of closure.hpp
+// (no flux up to the rest threshold tan(theta) (1 + tol)), so a tile whose
+// faces are all below it is exactly at rest and may be skipped.
+//
+// Ghost and non-sand cells carry kinds: an open cell (or the outside of an
+// open side) is a sink held at its height, a wall cell (or a wall side) closes
+// its faces and mirrors the asking cell in transverse slopes.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+namespace dpsm {
+
+struct TileRect {
+    int r0, r1, c0, c1;  // rows [r0, r1), columns [c0, c1), in buffer coordinates
+};
+
+struct TileLevelParams {
+    double nu, tan_theta, threshold2;  // threshold2: (tan(theta) (1 + tol))^2
+    double inv_dx, inv_dy, half_inv_dx, half_inv_dy;
+    double dt;
+    double x_face_length, y_face_length;  // dy and dx: flux per unit length to mass per unit time
+};
+
+// What one level did, over the tile itself (moved and max_excess also over
+// its valid halo, which holds true values of the global state).
+struct TileLevelStats {
+    bool moved = false;         // some face carried sand
+    double max_excess = 0.0;    // largest |grad h| - tan(theta) over faces that carried sand
+    double outflow_rate = 0.0;  // mass per unit time into sinks from the tile's sand cells
+    int hot_r0 = 1 << 30, hot_r1 = -1, hot_c0 = 1 << 30, hot_c1 = -1;  // cells of the tile touching moving faces
+};
+
+// A thread's private buffers, sized for the largest tile with its halo.
+struct TileBuffers {
+    int width = 0, height = 0;  // of the buffer, cells
+    std::vector<double> h[2], residual[2], source;
+    std::vector<std::uint8_t> kind;
+    std::vector<double> rows;  // scratch rows for faces and transverse slopes
+    void resize(int w, int h_);
+};
+
+// Advances the cells of `region` by one level, from slot `in` to slot 1 - in.
+// `tile` is the part of the region whose statistics count.
+using TileLevelFunction = void (*)(TileBuffers &buffers, int in, const TileRect &region, const TileRect &tile,
+                                   const TileLevelParams &params, TileLevelStats &stats);
+
+// The kernel for a tile: masked (walls, sinks or ghosts in reach), isotropic
+// or pairwise, with or without a source. The widest lanes this CPU has.
+TileLevelFunction select_tile_kernel(bool masked, bool isotropic, bool source);
+
+}  // namespace dpsm

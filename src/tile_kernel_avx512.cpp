@@ -1,0 +1,11 @@
+// The tile kernel for CPUs with AVX-512: built with -mavx512f and friends,
+// called only after select_tile_kernel has checked the CPU.
+#include "tile_kernel_impl.hpp"
+
+namespace dpsm {
+
+TileLevelFunction tile_kernel_avx512(bool masked, bool isotropic, bool source) {
+    return tile_kernel_for<simd::Lanes8>(masked, isotropic, source);
+}
+
+}  // namespace dpsm

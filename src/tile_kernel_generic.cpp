@@ -1,0 +1,48 @@
+// The tile kernel for any CPU, and the choice of kernel at run time.
+#include <cstdlib>
+
+#include "tile_kernel_impl.hpp"
+
+namespace dpsm {
+
+#if defined(DPSM_HAVE_AVX512_KERNEL)
+TileLevelFunction tile_kernel_avx512(bool masked, bool isotropic, bool source);
+#endif
+
+void TileBuffers::resize(int w, int h_) {
+    width = w;
+    height = h_;
+    // Lanes may read up to a vector past the end of a row or a buffer.
+    const std::size_t cells = static_cast<std::size_t>(w) * h_ + 64;
+    for (int s = 0; s < 2; ++s) {
+        h[s].assign(cells, 0.0);
+        residual[s].assign(cells, 0.0);
+    }
+    source.assign(cells, 0.0);
+    kind.assign(cells, kSand);
+    rows.assign(static_cast<std::size_t>(9) * (w + 32), 0.0);
+}
+
+static bool use_avx512() {
+#if defined(DPSM_HAVE_AVX512_KERNEL)
+    // DPSM_NO_AVX512=1 forces the generic kernel (to compare the two).
+    const char *off = std::getenv("DPSM_NO_AVX512");
+    if (off && *off && *off != '0') return false;
+    __builtin_cpu_init();
+    return __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512bw") &&
+           __builtin_cpu_supports("avx512vl") && __builtin_cpu_supports("avx512dq");
+#else
+    return false;
+#endif
+}
+
+TileLevelFunction select_tile_kernel(bool masked, bool isotropic, bool source) {
+    static const bool avx512 = use_avx512();
+#if defined(DPSM_HAVE_AVX512_KERNEL)
+    if (avx512) return tile_kernel_avx512(masked, isotropic, source);
+#endif
+    (void)avx512;
+    return tile_kernel_for<simd::Lanes1>(masked, isotropic, source);
+}
+
+}  // namespace dpsm

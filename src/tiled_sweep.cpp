@@ -1,0 +1,183 @@
+#include "tiled_sweep.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+
+#if defined(_OPENMP)
+#include <omp.h>
+#endif
+
+#include "active_set.hpp"
+#include "grid.hpp"
+
+namespace dpsm {
+
+namespace {
+
+constexpr int kBufferSide = ActiveSet::kTile + 2 * (ActiveSet::kMaxLevels + 1);
+
+int thread_count(int requested) {
+#if defined(_OPENMP)
+    return requested > 0 ? requested : omp_get_max_threads();
+#else
+    (void)requested;
+    return 1;
+#endif
+}
+
+// The kind of a ghost cell beyond the domain: a sink at 0 beyond an open
+// side, a wall beyond a wall side; a corner is a sink only if both sides are.
+std::uint8_t ghost_kind(const Grid &grid, std::int64_t i, std::int64_t j) {
+    const Geometry &geo = grid.geometry();
+    bool open = true;
+    if (i < 0) open = open && grid.side_open(kXMin);
+    if (i >= geo.nx) open = open && grid.side_open(kXMax);
+    if (j < 0) open = open && grid.side_open(kYMin);
+    if (j >= geo.ny) open = open && grid.side_open(kYMax);
+    return open ? kOpen : kWall;
+}
+
+// Copies a tile and its halo into the buffers, ghosts beyond the edge.
+void gather(const Grid &grid, TileBuffers &b, std::int64_t gi0, std::int64_t gj0, bool masked, bool source) {
+    const Geometry &geo = grid.geometry();
+    const double *h = grid.heights().data();
+    const float *res = grid.residuals().data();
+    const std::uint8_t *kind = grid.kinds().data();
+    const double *q = source ? grid.source().data() : nullptr;
+    for (int r = 0; r < b.height; ++r) {
+        const std::int64_t j = gj0 + r;
+        double *hb = b.h[0].data() + static_cast<std::size_t>(r) * b.width;
+        double *rb = b.residual[0].data() + static_cast<std::size_t>(r) * b.width;
+        std::uint8_t *kb = b.kind.data() + static_cast<std::size_t>(r) * b.width;
+        double *qb = b.source.data() + static_cast<std::size_t>(r) * b.width;
+        for (int c = 0; c < b.width; ++c) {
+            const std::int64_t i = gi0 + c;
+            const bool inside = i >= 0 && j >= 0 && i < geo.nx && j < geo.ny;
+            const std::int64_t cell = inside ? i + geo.nx * j : 0;
+            hb[c] = inside ? h[cell] : 0.0;
+            rb[c] = inside ? static_cast<double>(res[cell]) : 0.0;
+            if (masked) kb[c] = inside ? kind[cell] : ghost_kind(grid, i, j);
+            if (source) qb[c] = inside && kind[cell] == kSand ? q[cell] : 0.0;
+        }
+    }
+}
+
+}  // namespace
+
+void prepare_tiled_sweep(Grid &grid, int threads) {
+    TiledWorkspace &ws = grid.tiled_workspace();
+    const std::size_t cells = static_cast<std::size_t>(grid.geometry().cells());
+    if (ws.heights.size() != cells) {
+        ws.heights.assign(cells, 0.0);
+        ws.residuals.assign(cells, 0.0f);
+    }
+    const std::size_t want = static_cast<std::size_t>(thread_count(threads));
+    while (ws.buffers.size() < want) {
+        ws.buffers.emplace_back();
+        ws.buffers.back().resize(kBufferSide, kBufferSide);
+    }
+    const std::size_t tiles = static_cast<std::size_t>(grid.active_set().tiles());
+    ws.visit.reserve(tiles);
+    ws.stats.reserve(tiles * ActiveSet::kMaxLevels);
+    ws.origin.reserve(2 * tiles);
+}
+
+void tiled_sweep(Grid &grid, int levels, double dt, std::vector<LevelSummary> &summaries) {
+    const Geometry &geo = grid.geometry();
+    ActiveSet &active = grid.active_set();
+    TiledWorkspace &ws = grid.tiled_workspace();
+    active.tiles_to_visit(levels, ws.visit);
+    const std::int64_t visits = static_cast<std::int64_t>(ws.visit.size());
+    ws.stats.assign(static_cast<std::size_t>(visits) * levels, TileLevelStats{});
+    ws.origin.assign(static_cast<std::size_t>(2 * visits), 0);
+
+    const double tan_theta = grid.tan_repose();
+    const double threshold = tan_theta * (1.0 + grid.rest_tolerance());
+    const TileLevelParams params{grid.mobility(), tan_theta,       threshold * threshold, 1.0 / geo.dx,
+                                 1.0 / geo.dy,    0.5 / geo.dx,    0.5 / geo.dy,          dt,
+                                 geo.dy,          geo.dx};
+    const bool isotropic = grid.scheme() == kIsotropic;
+    const int threads = thread_count(grid.threads());
+    const int halo = levels + 1;
+
+    auto visit_tile = [&](std::int64_t k, TileBuffers &b) {
+        const std::int64_t t = ws.visit[k];
+        const CellBox cells = active.tile_cells(t);
+        const bool masked = active.masked(t), source = active.has_source(t);
+        const std::int64_t gi0 = cells.i0 - halo, gj0 = cells.j0 - halo;
+        b.width = static_cast<int>(cells.i1 - cells.i0) + 2 * halo;
+        b.height = static_cast<int>(cells.j1 - cells.j0) + 2 * halo;
+        gather(grid, b, gi0, gj0, masked, source);
+        const TileLevelFunction kernel = select_tile_kernel(masked, isotropic, source);
+        const TileRect tile{halo, b.height - halo, halo, b.width - halo};
+        int in = 0;
+        for (int s = 1; s <= levels; ++s) {
+            const int grow = levels - s;
+            const TileRect region{tile.r0 - grow, tile.r1 + grow, tile.c0 - grow, tile.c1 + grow};
+            kernel(b, in, region, tile, params, ws.stats[static_cast<std::size_t>(k) * levels + (s - 1)]);
+            in = 1 - in;
+        }
+        for (int r = tile.r0; r < tile.r1; ++r) {
+            const std::size_t from = static_cast<std::size_t>(r) * b.width + tile.c0;
+            const std::size_t to = static_cast<std::size_t>((gj0 + r) * geo.nx + gi0 + tile.c0);
+            const int count = tile.c1 - tile.c0;
+            std::memcpy(ws.heights.data() + to, b.h[in].data() + from, sizeof(double) * count);
+            for (int c = 0; c < count; ++c) ws.residuals[to + c] = static_cast<float>(b.residual[in][from + c]);
+        }
+        ws.origin[2 * k] = gi0;
+        ws.origin[2 * k + 1] = gj0;
+    };
+
+#if defined(_OPENMP)
+#pragma omp parallel num_threads(threads) if (visits > 1)
+    {
+        TileBuffers &b = ws.buffers[static_cast<std::size_t>(omp_get_thread_num())];
+#pragma omp for schedule(dynamic, 1)
+        for (std::int64_t k = 0; k < visits; ++k) visit_tile(k, b);
+    }
+#else
+    (void)threads;
+    for (std::int64_t k = 0; k < visits; ++k) visit_tile(k, ws.buffers[0]);
+#endif
+
+    // Write back; when every tile was visited the output is the whole grid.
+    if (visits == active.tiles()) {
+        grid.swap_heights(ws.heights, ws.residuals);
+    } else {
+        std::vector<double> &h = grid.heights_for_stepping();
+        std::vector<float> &res = grid.residuals_for_stepping();
+#if defined(_OPENMP)
+#pragma omp parallel for num_threads(threads) schedule(static) if (visits > 1)
+#endif
+        for (std::int64_t k = 0; k < visits; ++k) {
+            const CellBox cells = active.tile_cells(ws.visit[k]);
+            for (std::int64_t j = cells.j0; j < cells.j1; ++j) {
+                const std::size_t at = static_cast<std::size_t>(j * geo.nx + cells.i0);
+                const std::size_t count = static_cast<std::size_t>(cells.i1 - cells.i0);
+                std::memcpy(h.data() + at, ws.heights.data() + at, sizeof(double) * count);
+                std::memcpy(res.data() + at, ws.residuals.data() + at, sizeof(float) * count);
+            }
+        }
+    }
+
+    // New hot boxes: where sand moved in any level, grown by the two cells a
+    // last move can make steep. Sums in tile order, whatever the threads.
+    summaries.assign(static_cast<std::size_t>(levels), LevelSummary{});
+    for (std::int64_t k = 0; k < visits; ++k) {
+        CellBox moved;
+        for (int s = 0; s < levels; ++s) {
+            const TileLevelStats &st = ws.stats[static_cast<std::size_t>(k) * levels + s];
+            LevelSummary &sum = summaries[static_cast<std::size_t>(s)];
+            sum.moved = sum.moved || st.moved;
+            sum.outflow_rate += st.outflow_rate;
+            sum.max_excess = std::max(sum.max_excess, st.max_excess);
+            if (st.hot_r0 < st.hot_r1)
+                moved.add(ws.origin[2 * k] + st.hot_c0 - 2, ws.origin[2 * k] + st.hot_c1 + 2,
+                          ws.origin[2 * k + 1] + st.hot_r0 - 2, ws.origin[2 * k + 1] + st.hot_r1 + 2);
+        }
+        active.hot(ws.visit[k]) = moved;
+    }
+}
+
+}  // namespace dpsm

@@ -1,0 +1,1 @@
+#include <dpsm/dpsm.h>
