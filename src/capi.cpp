@@ -343,10 +343,11 @@ int dpsm_get_step_info(const dpsm_grid *g, int item, double *value) {
             case DPSM_INFO_TIME_INTEGRATED: *value = info.time_integrated; break;
             case DPSM_INFO_AT_REST: *value = info.at_rest ? 1.0 : 0.0; break;
             case DPSM_INFO_MAX_EXCESS_SLOPE: *value = info.max_excess_slope; break;
+            case DPSM_INFO_CELL_UPDATES: *value = info.cell_updates; break;
             default:
                 fail(DPSM_ERR_UNKNOWN_ENUM, fn, "item = ", item,
-                     " is not DPSM_INFO_SUBSTEPS, DPSM_INFO_TIME_INTEGRATED, DPSM_INFO_AT_REST or"
-                     " DPSM_INFO_MAX_EXCESS_SLOPE");
+                     " is not DPSM_INFO_SUBSTEPS, DPSM_INFO_TIME_INTEGRATED, DPSM_INFO_AT_REST,"
+                     " DPSM_INFO_MAX_EXCESS_SLOPE or DPSM_INFO_CELL_UPDATES");
         }
     });
 }

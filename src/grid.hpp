@@ -46,6 +46,7 @@ struct StepInfo {
     double time_integrated = 0.0;
     bool at_rest = false;
     double max_excess_slope = 0.0;
+    double cell_updates = 0.0;
 };
 
 class Grid {

@@ -93,7 +93,13 @@ struct Lanes8 {
         _mm512_store_pd(x, a.v);
         return ((x[0] + x[1]) + (x[2] + x[3])) + ((x[4] + x[5]) + (x[6] + x[7]));
     }
-    static double hmax(Lanes8 a) { return _mm512_reduce_max_pd(a.v); }
+    static double hmax(Lanes8 a) {
+        alignas(64) double x[8];
+        _mm512_store_pd(x, a.v);
+        double m = x[0];
+        for (int i = 1; i < 8; ++i) m = x[i] > m ? x[i] : m;
+        return m;
+    }
 };
 #endif
 

@@ -100,9 +100,11 @@ void step(Grid &grid, double dt) {
             std::vector<LevelSummary> levels;
             for (std::int64_t k = 0; k < substeps && !info.at_rest; k += ActiveSet::kMaxLevels) {
                 const int count = static_cast<int>(std::min<std::int64_t>(ActiveSet::kMaxLevels, substeps - k));
-                tiled_sweep(grid, count, sub_dt, levels);
-                for (const LevelSummary &level : levels)
+                const double visited = static_cast<double>(tiled_sweep(grid, count, sub_dt, levels));
+                for (const LevelSummary &level : levels) {
                     if (!book(level.moved, level.outflow_rate, level.max_excess)) break;
+                    info.cell_updates += visited;
+                }
             }
         }
     } else {
@@ -110,6 +112,7 @@ void step(Grid &grid, double dt) {
             const SweepResult sweep = slide_rates_1d(grid);
             if (!book(sweep.moved, sweep.outflow_rate, sweep.max_excess_slope)) break;
             apply_rates(grid, sub_dt);
+            info.cell_updates += static_cast<double>(grid.geometry().cells());
         }
     }
     info.time_integrated = info.at_rest ? static_cast<double>(info.substeps) * sub_dt : dt;

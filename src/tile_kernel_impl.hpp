@@ -26,11 +26,10 @@ void advance_tile_level(TileBuffers &b, int in, const TileRect &reg, const TileR
     const double *q = b.source.data();
     const int n = reg.c1 - reg.c0;
     const int stride = ((n + 2) / w + 2) * w;
-    double *ty = b.rows.data();
-    double *fx = ty + stride, *hot_x = fx + stride;
-    double *fy_below = hot_x + stride, *hot_below = fy_below + stride;
-    double *fy_above = hot_below + stride, *hot_above = fy_above + stride;
-    double *tx_lo = hot_above + stride, *tx_hi = tx_lo + stride;
+    double *__restrict ty = b.rows.data();
+    double *__restrict fx = ty + stride;
+    double *fy_below = fx + stride, *fy_above = fy_below + stride;
+    double *tx_lo = fy_above + stride, *tx_hi = tx_lo + stride;
 
     const V zero = V::broadcast(0.0), one = V::broadcast(1.0), half = V::broadcast(0.5);
     const V nu = V::broadcast(p.nu), tan_theta = V::broadcast(p.tan_theta), threshold2 = V::broadcast(p.threshold2);
@@ -41,6 +40,9 @@ void advance_tile_level(TileBuffers &b, int in, const TileRect &reg, const TileR
     const M all = V::first_lanes(w);
     V excess_max = zero, outflow = zero;
     M moved = V::first_lanes(0);
+    // The tile's cells that moved: rows, and columns as bits from tile.c0.
+    int moved_r0 = st.hot_r0, moved_r1 = st.hot_r1;
+    std::uint64_t moved_columns = 0;
 
     auto load = [](const double *ptr, int m) { return m == w ? V::load(ptr) : V::load_partial(ptr, m); };
     auto store = [](double *ptr, V v, int m) {
@@ -63,16 +65,14 @@ void advance_tile_level(TileBuffers &b, int in, const TileRect &reg, const TileR
     };
     // The flux law on the full slope (gn along the face normal, gt across),
     // positive from the first cell to the second; zero up to the threshold.
-    auto face_flux = [&](V gn, V gt, M open, double *flux_out, double *hot_out, int m) {
+    auto face_flux = [&](V gn, V gt, M open, double *flux_out, int m) {
         const V u = gn * gn + gt * gt;
         const M hot = V::both(u > threshold2, open);
         const V r1 = rsqrt(max(u, threshold2));
         const V r2 = rsqrt(one + u);
         const V flux = select(hot, nu * gn * (one - tan_theta * r1) * r2, zero);
         excess_max = max(excess_max, select(hot, u * r1 - tan_theta, zero));
-        moved = V::either(moved, hot);
         store(flux_out, flux, m);
-        store(hot_out, select(hot, one, zero), m);
     };
     // Central differences along x of row r, for the faces across it.
     auto slopes_along_x = [&](int r, double *out) {
@@ -85,12 +85,12 @@ void advance_tile_level(TileBuffers &b, int in, const TileRect &reg, const TileR
         }
     };
     // Faces between rows r and r + 1.
-    auto faces_along_y = [&](int r, const double *tx_r, const double *tx_r1, double *flux_out, double *hot_out) {
+    auto faces_along_y = [&](int r, const double *tx_r, const double *tx_r1, double *flux_out) {
         for (int k = 0; k < n; k += w) {
             const int m = std::min(w, n - k), c = r * W + reg.c0 + k;
             const V gn = (load(h + c, m) - load(h + c + W, m)) * inv_dy;
             const V gt = Isotropic ? half * (load(tx_r + k, m) + load(tx_r1 + k, m)) : zero;
-            face_flux(gn, gt, open_face(kind + c, kind + c + W), flux_out + k, hot_out + k, m);
+            face_flux(gn, gt, open_face(kind + c, kind + c + W), flux_out + k, m);
         }
     };
 
@@ -98,7 +98,7 @@ void advance_tile_level(TileBuffers &b, int in, const TileRect &reg, const TileR
         slopes_along_x(reg.r0 - 1, tx_lo);
         slopes_along_x(reg.r0, tx_hi);
     }
-    faces_along_y(reg.r0 - 1, tx_lo, tx_hi, fy_below, hot_below);
+    faces_along_y(reg.r0 - 1, tx_lo, tx_hi, fy_below);
 
     for (int r = reg.r0; r < reg.r1; ++r) {
         const int row = r * W;
@@ -106,7 +106,7 @@ void advance_tile_level(TileBuffers &b, int in, const TileRect &reg, const TileR
             std::swap(tx_lo, tx_hi);
             slopes_along_x(r + 1, tx_hi);
         }
-        faces_along_y(r, tx_lo, tx_hi, fy_above, hot_above);
+        faces_along_y(r, tx_lo, tx_hi, fy_above);
 
         // Faces between columns c - 1 and c of row r, c = c0 .. c1.
         if constexpr (Isotropic) {
@@ -122,7 +122,7 @@ void advance_tile_level(TileBuffers &b, int in, const TileRect &reg, const TileR
             const int m = std::min(w, n + 1 - k), c = row + reg.c0 - 1 + k;
             const V gn = (load(h + c, m) - load(h + c + 1, m)) * inv_dx;
             const V gt = Isotropic ? half * (load(ty + k, m) + load(ty + k + 1, m)) : zero;
-            face_flux(gn, gt, open_face(kind + c, kind + c + 1), fx + k, hot_x + k, m);
+            face_flux(gn, gt, open_face(kind + c, kind + c + 1), fx + k, m);
         }
 
         const bool row_in_tile = r >= tile.r0 && r < tile.r1;
@@ -148,18 +148,17 @@ void advance_tile_level(TileBuffers &b, int in, const TileRect &reg, const TileR
             store(h_out + c, sum, m);
             store(res_out + c, err, m);
 
+            moved = V::either(moved, changes);
             if (!row_in_tile) continue;
             const M in_tile =
                 V::both(V::but_not(V::first_lanes(tile.c1 - col), V::first_lanes(tile.c0 - col)), V::first_lanes(m));
-            if (!V::any(in_tile)) continue;
-            M hot = (load(hot_x + k, m) + load(hot_x + k + 1, m) + load(hot_below + k, m) + load(hot_above + k, m)) > zero;
-            if constexpr (Source) hot = V::either(hot, load(q + c, m) != zero);
-            hot = V::both(hot, in_tile);
+            const M hot = V::both(changes, in_tile);
             if (V::any(hot)) {
-                st.hot_r0 = std::min(st.hot_r0, r);
-                st.hot_r1 = std::max(st.hot_r1, r + 1);
-                st.hot_c0 = std::min(st.hot_c0, col + V::first(hot));
-                st.hot_c1 = std::max(st.hot_c1, col + V::last(hot) + 1);
+                moved_r0 = std::min(moved_r0, r);
+                moved_r1 = std::max(moved_r1, r + 1);
+                const int shift = col - tile.c0;
+                const std::uint64_t bits = static_cast<std::uint64_t>(hot);
+                moved_columns |= shift >= 0 ? bits << shift : bits >> -shift;
             }
             if constexpr (Masked) {
                 // Sand that this tile's cells send into sinks (open cells and
@@ -173,7 +172,12 @@ void advance_tile_level(TileBuffers &b, int in, const TileRect &reg, const TileR
             }
         }
         std::swap(fy_below, fy_above);
-        std::swap(hot_below, hot_above);
+    }
+    if (moved_columns) {
+        st.hot_r0 = moved_r0;
+        st.hot_r1 = moved_r1;
+        st.hot_c0 = std::min(st.hot_c0, tile.c0 + __builtin_ctzll(moved_columns));
+        st.hot_c1 = std::max(st.hot_c1, tile.c0 + 64 - __builtin_clzll(moved_columns));
     }
     st.moved = st.moved || V::any(moved);
     st.max_excess = std::max(st.max_excess, V::hmax(excess_max));

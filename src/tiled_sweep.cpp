@@ -45,20 +45,31 @@ void gather(const Grid &grid, TileBuffers &b, std::int64_t gi0, std::int64_t gj0
     const float *res = grid.residuals().data();
     const std::uint8_t *kind = grid.kinds().data();
     const double *q = source ? grid.source().data() : nullptr;
+    const bool inside = gi0 >= 0 && gj0 >= 0 && gi0 + b.width <= geo.nx && gj0 + b.height <= geo.ny;
     for (int r = 0; r < b.height; ++r) {
         const std::int64_t j = gj0 + r;
-        double *hb = b.h[0].data() + static_cast<std::size_t>(r) * b.width;
-        double *rb = b.residual[0].data() + static_cast<std::size_t>(r) * b.width;
-        std::uint8_t *kb = b.kind.data() + static_cast<std::size_t>(r) * b.width;
-        double *qb = b.source.data() + static_cast<std::size_t>(r) * b.width;
+        const std::size_t row = static_cast<std::size_t>(r) * b.width;
+        double *hb = b.h[0].data() + row;
+        double *rb = b.residual[0].data() + row;
+        std::uint8_t *kb = b.kind.data() + row;
+        double *qb = b.source.data() + row;
+        if (inside) {  // the common case: one copy per row
+            const std::size_t at = static_cast<std::size_t>(j * geo.nx + gi0);
+            std::memcpy(hb, h + at, sizeof(double) * b.width);
+            for (int c = 0; c < b.width; ++c) rb[c] = static_cast<double>(res[at + c]);
+            if (masked) std::memcpy(kb, kind + at, b.width);
+            if (source)
+                for (int c = 0; c < b.width; ++c) qb[c] = kind[at + c] == kSand ? q[at + c] : 0.0;
+            continue;
+        }
         for (int c = 0; c < b.width; ++c) {
             const std::int64_t i = gi0 + c;
-            const bool inside = i >= 0 && j >= 0 && i < geo.nx && j < geo.ny;
-            const std::int64_t cell = inside ? i + geo.nx * j : 0;
-            hb[c] = inside ? h[cell] : 0.0;
-            rb[c] = inside ? static_cast<double>(res[cell]) : 0.0;
-            if (masked) kb[c] = inside ? kind[cell] : ghost_kind(grid, i, j);
-            if (source) qb[c] = inside && kind[cell] == kSand ? q[cell] : 0.0;
+            const bool in = i >= 0 && j >= 0 && i < geo.nx && j < geo.ny;
+            const std::int64_t cell = in ? i + geo.nx * j : 0;
+            hb[c] = in ? h[cell] : 0.0;
+            rb[c] = in ? static_cast<double>(res[cell]) : 0.0;
+            if (masked) kb[c] = in ? kind[cell] : ghost_kind(grid, i, j);
+            if (source) qb[c] = in && kind[cell] == kSand ? q[cell] : 0.0;
         }
     }
 }
@@ -83,7 +94,7 @@ void prepare_tiled_sweep(Grid &grid, int threads) {
     ws.origin.reserve(2 * tiles);
 }
 
-void tiled_sweep(Grid &grid, int levels, double dt, std::vector<LevelSummary> &summaries) {
+std::int64_t tiled_sweep(Grid &grid, int levels, double dt, std::vector<LevelSummary> &summaries) {
     const Geometry &geo = grid.geometry();
     ActiveSet &active = grid.active_set();
     TiledWorkspace &ws = grid.tiled_workspace();
@@ -164,7 +175,10 @@ void tiled_sweep(Grid &grid, int levels, double dt, std::vector<LevelSummary> &s
     // New hot boxes: where sand moved in any level, grown by the two cells a
     // last move can make steep. Sums in tile order, whatever the threads.
     summaries.assign(static_cast<std::size_t>(levels), LevelSummary{});
+    std::int64_t visited_cells = 0;
     for (std::int64_t k = 0; k < visits; ++k) {
+        const CellBox cells = active.tile_cells(ws.visit[k]);
+        visited_cells += (cells.i1 - cells.i0) * (cells.j1 - cells.j0);
         CellBox moved;
         for (int s = 0; s < levels; ++s) {
             const TileLevelStats &st = ws.stats[static_cast<std::size_t>(k) * levels + s];
@@ -178,6 +192,7 @@ void tiled_sweep(Grid &grid, int levels, double dt, std::vector<LevelSummary> &s
         }
         active.hot(ws.visit[k]) = moved;
     }
+    return visited_cells;
 }
 
 }  // namespace dpsm

@@ -35,7 +35,7 @@ struct TiledWorkspace {
 void prepare_tiled_sweep(Grid &grid, int threads);
 
 // Advances a 2D grid `levels` (1 .. ActiveSet::kMaxLevels) sub-steps of dt and
-// fills one summary per level.
-void tiled_sweep(Grid &grid, int levels, double dt, std::vector<LevelSummary> &summaries);
+// fills one summary per level; returns the number of cells it visited.
+std::int64_t tiled_sweep(Grid &grid, int levels, double dt, std::vector<LevelSummary> &summaries);
 
 }  // namespace dpsm

@@ -96,7 +96,7 @@ typedef struct {
     size_t n;
     double h[MAX_CELLS];
     double mass[4];  /* DPSM_MASS_TOTAL .. DPSM_MASS_OUTFLOW */
-    double info[4];  /* DPSM_INFO_SUBSTEPS .. DPSM_INFO_MAX_EXCESS_SLOPE */
+    double info[5];  /* DPSM_INFO_SUBSTEPS .. DPSM_INFO_CELL_UPDATES */
     double stable_dt;
 } snapshot_t;
 
@@ -107,7 +107,7 @@ static void snapshot_at(const dpsm_grid *g, snapshot_t *s, const char *file, int
     require_at(s->n <= MAX_CELLS, file, line, "snapshot of a grid of %zu cells, at most %d", s->n, MAX_CELLS);
     check_ok_(g, dpsm_get_heights(g, s->h), "dpsm_get_heights", file, line);
     for (int q = 0; q < 4; ++q) check_ok_(g, dpsm_get_mass(g, q, &s->mass[q]), "dpsm_get_mass", file, line);
-    for (int i = 0; i < 4; ++i) check_ok_(g, dpsm_get_step_info(g, i, &s->info[i]), "dpsm_get_step_info", file, line);
+    for (int i = 0; i < 5; ++i) check_ok_(g, dpsm_get_step_info(g, i, &s->info[i]), "dpsm_get_step_info", file, line);
     check_ok_(g, dpsm_stable_dt(g, &s->stable_dt), "dpsm_stable_dt", file, line);
 }
 #define SNAPSHOT(g, s) snapshot_at((g), (s), __FILE__, __LINE__)
@@ -125,8 +125,9 @@ static void compare_snapshots_at(const snapshot_t *a, const snapshot_t *b, const
     for (int q = 0; q < 4; ++q)
         require_at(memcmp(&a->mass[q], &b->mass[q], sizeof(double)) == 0, file, line, "%s: mass %s %.17g vs %.17g",
                    what, mass_names[q], a->mass[q], b->mass[q]);
-    static const char *const info_names[4] = {"SUBSTEPS", "TIME_INTEGRATED", "AT_REST", "MAX_EXCESS_SLOPE"};
-    for (int i = 0; i < 4; ++i)
+    static const char *const info_names[5] = {"SUBSTEPS", "TIME_INTEGRATED", "AT_REST", "MAX_EXCESS_SLOPE",
+                                              "CELL_UPDATES"};
+    for (int i = 0; i < 5; ++i)
         require_at(memcmp(&a->info[i], &b->info[i], sizeof(double)) == 0, file, line, "%s: info %s %.17g vs %.17g",
                    what, info_names[i], a->info[i], b->info[i]);
     require_at(memcmp(&a->stable_dt, &b->stable_dt, sizeof(double)) == 0, file, line,
@@ -430,7 +431,7 @@ static void expect_fresh_grid(const dpsm_grid *g, int64_t nx, int64_t ny) {
     const ledger_t l = read_ledger(g);
     REQUIRE(l.total == 0.0 && l.sourced == 0.0 && l.external == 0.0 && l.outflow == 0.0,
             "fresh ledger %g %g %g %g", l.total, l.sourced, l.external, l.outflow);
-    for (int i = DPSM_INFO_SUBSTEPS; i <= DPSM_INFO_MAX_EXCESS_SLOPE; ++i) {
+    for (int i = DPSM_INFO_SUBSTEPS; i <= DPSM_INFO_CELL_UPDATES; ++i) {
         double v = 42.0;
         CHECK_OK(g, dpsm_get_step_info(g, i, &v));
         REQUIRE(v == 0.0, "step info %d before the first step = %g, expected 0", i, v);
@@ -1083,7 +1084,7 @@ static void test_step_info(void **state) {
     dpsm_grid *g = NULL;
     CHECK_OK(NULL, dpsm_create_1d(NX, dx, &g));
     double v = -1.0;
-    for (int i = DPSM_INFO_SUBSTEPS; i <= DPSM_INFO_MAX_EXCESS_SLOPE; ++i) {
+    for (int i = DPSM_INFO_SUBSTEPS; i <= DPSM_INFO_CELL_UPDATES; ++i) {
         CHECK_OK(g, dpsm_get_step_info(g, i, &v));
         REQUIRE(v == 0.0, "info %d before any step: %g", i, v);
     }
@@ -1107,6 +1108,10 @@ static void test_step_info(void **state) {
             time, substeps);
     REQUIRE(excess >= 0.0 && excess <= DPSM_DEFAULT_REST_TOLERANCE * tan_theta, "max excess slope %g at rest",
             excess);
+    double updates;
+    CHECK_OK(g, dpsm_get_step_info(g, DPSM_INFO_CELL_UPDATES, &updates));
+    REQUIRE(updates == substeps * NX, "a 1D step updates every cell each sub-step: %g for %g sub-steps", updates,
+            substeps);
     /* The heights agree: nothing steeper than the rest criterion. */
     CHECK_OK(g, dpsm_get_heights(g, h));
     const double s = max_face_slope(h, NULL, NX, 1, dx, 1.0);
@@ -1116,8 +1121,9 @@ static void test_step_info(void **state) {
     CHECK_OK(g, dpsm_get_step_info(g, DPSM_INFO_SUBSTEPS, &substeps));
     CHECK_OK(g, dpsm_get_step_info(g, DPSM_INFO_TIME_INTEGRATED, &time));
     CHECK_OK(g, dpsm_get_step_info(g, DPSM_INFO_AT_REST, &rest));
-    REQUIRE(substeps == 0.0 && time == 0.0 && rest == 1.0, "resting step: %g sub-steps, time %g, rest %g", substeps,
-            time, rest);
+    CHECK_OK(g, dpsm_get_step_info(g, DPSM_INFO_CELL_UPDATES, &updates));
+    REQUIRE(substeps == 0.0 && time == 0.0 && rest == 1.0 && updates == 0.0,
+            "resting step: %g sub-steps, time %g, rest %g, %g cell updates", substeps, time, rest, updates);
     /* A driven step: every sub-step taken, time exactly dt, not at rest. */
     double q[NX];
     for (int i = 0; i < NX; ++i) q[i] = 0.01;
@@ -1868,10 +1874,10 @@ static void test_bad_get_mass(void **state) {
 static void test_bad_get_step_info(void **state) {
     fixture_t *fx = *state;
     double v = 0.0;
-    const int bad[] = {-1, 4, 5, 255, INT_MAX, INT_MIN};
+    const int bad[] = {-1, 5, 6, 255, INT_MAX, INT_MIN};
     for (size_t k = 0; k < sizeof bad / sizeof *bad; ++k)
         EXPECT_FAIL(fx, dpsm_get_step_info(fx->g, bad[k], &v), DPSM_ERR_UNKNOWN_ENUM, "dpsm_get_step_info", "item");
-    for (int i = DPSM_INFO_SUBSTEPS; i <= DPSM_INFO_MAX_EXCESS_SLOPE; ++i)
+    for (int i = DPSM_INFO_SUBSTEPS; i <= DPSM_INFO_CELL_UPDATES; ++i)
         EXPECT_FAIL(fx, dpsm_get_step_info(fx->g, i, NULL), DPSM_ERR_NULL_POINTER, "dpsm_get_step_info", "value");
 }
 

@@ -147,6 +147,10 @@ typedef struct dpsm_grid dpsm_grid;
  *  at the start of its last sub-step, or when it found rest (0 when no face is
  *  steeper than the angle of repose). */
 #define DPSM_INFO_MAX_EXCESS_SLOPE 3
+/** The cell updates it computed: cells visited times sub-steps. On 2D grids
+ *  only the tiles of 64 x 64 cells near moving sand or a source are visited, so
+ *  this measures what the step cost (a step at rest computes none). */
+#define DPSM_INFO_CELL_UPDATES 4
 /** @} */
 
 /** The default angle of repose: 30 degrees, in radians. */
@@ -407,7 +411,8 @@ DPSM_API int dpsm_get_mass(const dpsm_grid *g, int quantity, double *value);
  * @brief Reads what the last successful dpsm_step() did.
  * @param g      the grid.
  * @param item   ::DPSM_INFO_SUBSTEPS, ::DPSM_INFO_TIME_INTEGRATED,
- *               ::DPSM_INFO_AT_REST or ::DPSM_INFO_MAX_EXCESS_SLOPE.
+ *               ::DPSM_INFO_AT_REST, ::DPSM_INFO_MAX_EXCESS_SLOPE or
+ *               ::DPSM_INFO_CELL_UPDATES.
  * @param value  receives the figure (0 for every item before the first step).
  * @return ::DPSM_OK, ::DPSM_ERR_NULL_POINTER or ::DPSM_ERR_UNKNOWN_ENUM.
  */

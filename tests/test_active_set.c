@@ -1,0 +1,167 @@
+/* The speed machinery changes no result: the active set (tiles skipped when
+ * nothing near them can move), the number of threads, and region updates give
+ * the same heights and ledger, bit for bit, as visiting every tile on one
+ * thread. Work is measured with DPSM_INFO_CELL_UPDATES, never with a clock. */
+#define _POSIX_C_SOURCE 200809L
+#include <math.h>
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <cmocka.h>
+
+#include "test_support.h"
+
+enum { NX = 260, NY = 140 };
+
+/* A scene that uses everything: a resting rough bed, three steep patches far
+ * apart, a source patch, an obstacle, an open cell and two open sides. */
+static dpsm_grid *make_scene(int scheme, int threads) {
+    dpsm_grid *g = NULL;
+    CHECK_OK(NULL, dpsm_create_2d(NX, NY, 0.5, 0.5, &g));
+    CHECK_OK(g, dpsm_set_scheme(g, scheme));
+    CHECK_OK(g, dpsm_set_threads(g, threads));
+    CHECK_OK(g, dpsm_set_boundary(g, DPSM_XMIN, DPSM_OPEN));
+    CHECK_OK(g, dpsm_set_boundary(g, DPSM_YMAX, DPSM_OPEN));
+    double *h = malloc(sizeof(double) * NX * NY), *q = calloc(NX * NY, sizeof(double));
+    uint8_t *kinds = calloc(NX * NY, 1);
+    for (int j = 0; j < NY; ++j)
+        for (int i = 0; i < NX; ++i) {
+            double v = 0.1 + 0.1 * sin(0.05 * i) * cos(0.07 * j); /* gentle: at rest */
+            if (abs(i - 40) < 4 && abs(j - 50) < 4) v += 3.0;     /* steep patches */
+            if (abs(i - 200) < 3 && abs(j - 110) < 5) v += 2.0;
+            if (abs(i - 240) < 2 && abs(j - 30) < 2) v += 4.0;
+            h[i + NX * j] = v;
+            if (abs(i - 120) < 4 && abs(j - 100) < 4) q[i + NX * j] = 0.3;
+            if (i >= 150 && i < 160 && j >= 40 && j < 100) kinds[i + NX * j] = DPSM_CELL_WALL;
+        }
+    kinds[203 + NX * 110] = DPSM_CELL_OPEN;
+    h[203 + NX * 110] = 0.0; /* a sink at the open sides' level: the scene comes to rest */
+    CHECK_OK(g, dpsm_set_heights(g, h));
+    CHECK_OK(g, dpsm_set_cell_kinds(g, kinds));
+    CHECK_OK(g, dpsm_set_source(g, q));
+    free(h);
+    free(q);
+    free(kinds);
+    return g;
+}
+
+/* Runs the scene: steps, then the source off and a region edit, then rest.
+ * Returns the heights (caller frees) and the ledger and the work done. */
+static double *run_scene(int scheme, int threads, int visit_all, ledger_t *ledger, double *updates) {
+    if (visit_all)
+        setenv("DPSM_VISIT_ALL_TILES", "1", 1);
+    else
+        unsetenv("DPSM_VISIT_ALL_TILES");
+    dpsm_grid *g = make_scene(scheme, threads);
+    double u, dt;
+    *updates = 0.0;
+    CHECK_OK(g, dpsm_stable_dt(g, &dt));
+    for (int k = 0; k < 10; ++k) {
+        CHECK_OK(g, dpsm_step(g, 7.3 * dt));
+        CHECK_OK(g, dpsm_get_step_info(g, DPSM_INFO_CELL_UPDATES, &u));
+        *updates += u;
+    }
+    CHECK_OK(g, dpsm_set_source(g, NULL));
+    const double bump[6] = {3.0, 4.0, 3.5, 2.0, 5.0, 1.0};
+    CHECK_OK(g, dpsm_add_heights_region(g, 250, 136, 3, 2, bump));
+    CHECK_OK(g, dpsm_step(g, 1e6));
+    CHECK_OK(g, dpsm_get_step_info(g, DPSM_INFO_CELL_UPDATES, &u));
+    *updates += u;
+    double *h = malloc(sizeof(double) * NX * NY);
+    CHECK_OK(g, dpsm_get_heights(g, h));
+    *ledger = read_ledger(g);
+    assert_true(ledger_residual(g) < 1e-13);
+    dpsm_destroy(g);
+    unsetenv("DPSM_VISIT_ALL_TILES");
+    return h;
+}
+
+static void assert_same_run(const double *a, const double *b, const ledger_t *la, const ledger_t *lb) {
+    size_t differ = 0;
+    for (size_t c = 0; c < (size_t)NX * NY; ++c) differ += memcmp(&a[c], &b[c], sizeof(double)) != 0;
+    assert_int_equal(differ, 0);
+    assert_memory_equal(la, lb, sizeof *la);
+}
+
+static void test_active_set_changes_no_result(void **state) {
+    (void)state;
+    for (int scheme = DPSM_SCHEME_PAIRWISE; scheme <= DPSM_SCHEME_ISOTROPIC; ++scheme) {
+        ledger_t skip, all;
+        double work_skip, work_all;
+        double *a = run_scene(scheme, 1, 0, &skip, &work_skip);
+        double *b = run_scene(scheme, 1, 1, &all, &work_all);
+        print_message("%s: cell updates %.3g with the active set, %.3g visiting every tile (%.1f%%); outflow %.6f\n",
+                      scheme ? "isotropic" : "pairwise", work_skip, work_all, 100.0 * work_skip / work_all,
+                      skip.outflow);
+        assert_same_run(a, b, &skip, &all);
+        assert_true(work_skip < 0.5 * work_all); /* it did skip */
+        assert_true(skip.outflow > 0.0);         /* the open side and cell took sand */
+        free(a);
+        free(b);
+    }
+}
+
+static void test_results_do_not_depend_on_threads(void **state) {
+    (void)state;
+    ledger_t l1, l2, l3;
+    double w1, w2, w3;
+    double *a = run_scene(DPSM_SCHEME_ISOTROPIC, 1, 0, &l1, &w1);
+    double *b = run_scene(DPSM_SCHEME_ISOTROPIC, 2, 0, &l2, &w2);
+    double *c = run_scene(DPSM_SCHEME_ISOTROPIC, 3, 0, &l3, &w3);
+    assert_same_run(a, b, &l1, &l2);
+    assert_same_run(a, c, &l1, &l3);
+    assert_true(w1 == w2 && w1 == w3);
+    free(a);
+    free(b);
+    free(c);
+}
+
+/* A surface at rest costs no cell update, however large; a few cells changed
+ * by the host wake only the tiles around them. */
+static void test_idle_and_local_updates(void **state) {
+    (void)state;
+    const int64_t n = 1024;
+    dpsm_grid *g = NULL;
+    CHECK_OK(NULL, dpsm_create_2d(n, n, 1.0, 1.0, &g));
+    double *h = malloc(sizeof(double) * n * n);
+    for (int64_t c = 0; c < n * n; ++c) h[c] = 0.3 * sin(0.01 * (double)(c % n)) + 0.2 * cos(0.013 * (double)(c / n));
+    CHECK_OK(g, dpsm_set_heights(g, h));
+    double updates, substeps;
+    CHECK_OK(g, dpsm_step(g, 10.0)); /* looks at every tile once: all at rest */
+    CHECK_OK(g, dpsm_get_step_info(g, DPSM_INFO_SUBSTEPS, &substeps));
+    assert_true(substeps == 0.0);
+    CHECK_OK(g, dpsm_step(g, 10.0));
+    CHECK_OK(g, dpsm_get_step_info(g, DPSM_INFO_CELL_UPDATES, &updates));
+    assert_true(updates == 0.0);
+
+    const double pile[4] = {5.0, 6.0, 5.5, 7.0};
+    CHECK_OK(g, dpsm_add_heights_region(g, 500, 600, 2, 2, pile));
+    CHECK_OK(g, dpsm_step(g, 1e6));
+    CHECK_OK(g, dpsm_get_step_info(g, DPSM_INFO_CELL_UPDATES, &updates));
+    CHECK_OK(g, dpsm_get_step_info(g, DPSM_INFO_SUBSTEPS, &substeps));
+    print_message("a 2x2 pile dropped on a %lldx%lld surface at rest: %.0f sub-steps, %.3g cell updates (%.2f cells "
+                  "per sub-step, grid %lld)\n",
+                  (long long)n, (long long)n, substeps, updates, updates / substeps, (long long)(n * n));
+    assert_true(substeps > 0.0);
+    assert_true(updates / substeps <= 9.0 * 64 * 64); /* at most the 3x3 tiles around it */
+    CHECK_OK(g, dpsm_step(g, 1e6));
+    CHECK_OK(g, dpsm_get_step_info(g, DPSM_INFO_CELL_UPDATES, &updates));
+    assert_true(updates == 0.0);
+    assert_true(ledger_residual(g) < 1e-13);
+    free(h);
+    dpsm_destroy(g);
+}
+
+int main(void) {
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_active_set_changes_no_result),
+        cmocka_unit_test(test_results_do_not_depend_on_threads),
+        cmocka_unit_test(test_idle_and_local_updates),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
