@@ -14,6 +14,10 @@ DPSM_APT_PACKAGES=(
     doxygen       # docs and the `docs` test
     pkg-config    # tests: finding cmocka, the install/consume test
     ninja-build   # the build
+    gfortran           # the Fortran binding, its tests and example
+    python3            # the Python binding's tests, the binding coverage checks
+    python3-numpy      # the Python tests with numpy (Debian's /usr/bin/python3)
+    python3-matplotlib # the Python example's plot
 )
 
 DPSM_ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)

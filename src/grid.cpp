@@ -17,7 +17,7 @@ Grid::Grid(const Geometry &geometry)
       heights_(static_cast<std::size_t>(geometry.cells()), 0.0),
       residuals_(static_cast<std::size_t>(geometry.cells()), 0.0f),
       kinds_(static_cast<std::size_t>(geometry.cells()), kSand),
-      rate_(static_cast<std::size_t>(geometry.cells()), 0.0),
+      rate_(geometry.dim == 1 ? static_cast<std::size_t>(geometry.cells()) : 0, 0.0),
       scheme_(geometry.dim == 2 ? kIsotropic : kPairwise) {
     if (geometry.dim == 2) {
         active_ = std::make_unique<ActiveSet>(geometry.nx, geometry.ny);

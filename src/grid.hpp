@@ -122,7 +122,7 @@ public:
     MassLedger &ledger() { return ledger_; }
     const MassLedger &ledger() const { return ledger_; }
 
-    // Scratch space the kernels use; sized once.
+    // Scratch space of the 1D sweep (1D and axisymmetric grids only).
     std::vector<double> &rate_workspace() { return rate_; }
     // The 2D sweep's active set and scratch (2D grids only).
     ActiveSet &active_set() { return *active_; }

@@ -12,6 +12,15 @@
 #     versions 1.0 and 0.99 must be refused.
 #  4. Relocation: the prefix is moved elsewhere; no installed file may name the
 #     old prefix, and the pkg-config and CMake builds must work from the new place.
+#  5. Fortran (when the Fortran binding was built, i.e. dpsm-fortran.pc is
+#     installed): $FC prog.f90 $(pkg-config --cflags --libs dpsm-fortran), run
+#     through LD_LIBRARY_PATH and through an rpath; before and after the move.
+#  6. Python: prog.py imports the installed package with PYTHONPATH=<its dir>
+#     and no DPSM_LIBRARY; it must load the library installed next to it, with
+#     numpy and with DPSM_NO_NUMPY=1; before and after the move.
+#
+# Environment: CC, CXX; DPSM_FC (default $FC or gfortran), DPSM_PYTHON (default
+# /usr/bin/python3 when it exists, else python3).
 set -euo pipefail
 
 if [[ $# -ne 2 ]]; then
@@ -23,6 +32,14 @@ src=$(cd "$2" && pwd)
 here=$src/tests/consume
 CC=${CC:-cc}
 CXX=${CXX:-c++}
+FC=${DPSM_FC:-${FC:-gfortran}}
+if [[ -n ${DPSM_PYTHON:-} ]]; then
+    PYTHON=$DPSM_PYTHON
+elif [[ -x /usr/bin/python3 ]]; then
+    PYTHON=/usr/bin/python3
+else
+    PYTHON=python3
+fi
 
 work=$(mktemp -d "${TMPDIR:-/tmp}/dpsm-consume.XXXXXX")
 trap 'rm -rf "$work"' EXIT
@@ -130,8 +147,68 @@ cmake_build() {
         fail "the package version check failed"
 }
 
+# ---- 5. Fortran: dpsm-fortran.pc --------------------------------------------
+# Builds and runs prog.f90 against the prefix $1 with pkg-config, into directory $2.
+# shellcheck disable=SC2086
+fortran_build() {
+    local prefix=$1 out=$2 pc pcdir libdir cflags libs
+    pc=$(find "$prefix" -name dpsm-fortran.pc -print -quit)
+    if [[ -z $pc ]]; then
+        say "Fortran: no dpsm-fortran.pc under $prefix (dpsm was built without Fortran): skipped"
+        return 0
+    fi
+    need "$FC"
+    installed "$prefix" dpsm.mod >/dev/null
+    installed "$prefix" "libdpsm_fortran.so.$soversion" >/dev/null
+    mkdir -p "$out"
+    pcdir=$(dirname "$pc")
+    export PKG_CONFIG_PATH=$pcdir
+    say "Fortran: $FC prog.f90 \$(pkg-config --cflags --libs dpsm-fortran) against $prefix"
+    [[ $(pkg-config --modversion dpsm-fortran) == "$version" ]] ||
+        fail "pkg-config --modversion dpsm-fortran gives '$(pkg-config --modversion dpsm-fortran)', expected $version"
+    libdir=$(realpath "$(pkg-config --variable=libdir dpsm-fortran)")
+    [[ -e $libdir/libdpsm_fortran.so ]] || fail "pkg-config libdir $libdir holds no libdpsm_fortran.so"
+    cflags=$(pkg-config --cflags dpsm-fortran)
+    libs=$(pkg-config --libs dpsm-fortran)
+    echo "   cflags: $cflags"
+    echo "   libs:   $libs"
+
+    # Shared, run through LD_LIBRARY_PATH.
+    (cd "$out" && set -x && $FC -Wall -Werror "$here/prog.f90" -o prog_f $cflags $libs) 2>&1 ||
+        fail "Fortran build with pkg-config failed"
+    local deps
+    deps=$(LD_LIBRARY_PATH=$libdir ldd "$out/prog_f")
+    [[ $deps == *"libdpsm_fortran.so.$soversion => $libdir/"* && $deps == *"libdpsm.so.$soversion => $libdir/"* ]] ||
+        fail "prog_f does not load libdpsm_fortran.so.$soversion and libdpsm.so.$soversion from $libdir: $deps"
+    LD_LIBRARY_PATH=$libdir "$out/prog_f" || fail "prog_f (Fortran, pkg-config) failed"
+
+    # Through an rpath only: libdpsm_fortran must find libdpsm next to itself.
+    (cd "$out" && set -x && $FC "$here/prog.f90" -o prog_f_rpath $cflags $libs -Wl,-rpath,"$libdir") 2>&1 ||
+        fail "Fortran build with an rpath failed"
+    env -u LD_LIBRARY_PATH "$out/prog_f_rpath" || fail "prog_f_rpath (Fortran, rpath) failed"
+    unset PKG_CONFIG_PATH
+}
+
+# ---- 6. Python: the installed package ---------------------------------------
+# Imports the package installed under prefix $1 with PYTHONPATH alone and runs prog.py.
+python_import() {
+    local prefix=$1 pkgdir pydir libdir
+    need "$PYTHON"
+    pkgdir=$(dirname "$(installed "$prefix" _libpath.py)")
+    [[ -f $pkgdir/__init__.py ]] || fail "$pkgdir has _libpath.py but no __init__.py"
+    pydir=$(dirname "$pkgdir")
+    libdir=$(dirname "$(installed "$prefix" "libdpsm.so.$soversion")")
+    say "Python: PYTHONPATH=$pydir $PYTHON prog.py (no DPSM_LIBRARY)"
+    env -u DPSM_LIBRARY -u DPSM_NO_NUMPY PYTHONPATH="$pydir" PYTHONDONTWRITEBYTECODE=1 \
+        "$PYTHON" "$here/prog.py" "$libdir" || fail "the installed Python package failed"
+    env -u DPSM_LIBRARY PYTHONPATH="$pydir" PYTHONDONTWRITEBYTECODE=1 DPSM_NO_NUMPY=1 \
+        "$PYTHON" "$here/prog.py" "$libdir" || fail "the installed Python package failed without numpy"
+}
+
 pkgconfig_build "$work/prefix" "$work/pc"
 cmake_build "$work/prefix" "$work/cm"
+fortran_build "$work/prefix" "$work/f"
+python_import "$work/prefix"
 
 # ---- 4. relocation ----------------------------------------------------------
 say "relocation: no installed file names the prefix"
@@ -143,5 +220,7 @@ mv "$work/prefix" "$work/elsewhere/deeper/moved"
 [[ ! -e $work/prefix ]] || fail "the old prefix is still there"
 pkgconfig_build "$work/elsewhere/deeper/moved" "$work/pc-moved"
 cmake_build "$work/elsewhere/deeper/moved" "$work/cm-moved"
+fortran_build "$work/elsewhere/deeper/moved" "$work/f-moved"
+python_import "$work/elsewhere/deeper/moved"
 
 say "install/consume checks passed"

@@ -1,0 +1,968 @@
+!> dpsm: the Fortran binding of the C API in include/dpsm/dpsm.h.
+!>
+!> One hand-written module over iso_c_binding:
+!>
+!>  - type(dpsm_grid) holds the C handle (a private type(c_ptr)); a grid is made
+!>    by dpsm_create_1d / dpsm_create_2d / dpsm_create_axisymmetric and released
+!>    by dpsm_destroy, explicitly (there is no finalizer: copies of a
+!>    type(dpsm_grid) share one handle, as copies of a C pointer do).
+!>  - Every C function has a subroutine of the same name taking the C arguments
+!>    in order (the grid first, outputs as arguments) and an optional
+!>    `integer, intent(out) :: ierr` last. With ierr present it receives the
+!>    status (DPSM_OK or a DPSM_ERR_* code); with ierr absent a failure stops the
+!>    program (error stop) with the library's message.
+!>  - dpsm_last_error, dpsm_status_string and dpsm_version_string are functions
+!>    returning allocatable strings; dpsm_version_number returns an integer.
+!>  - Sizes are integer(c_int64_t) as in C; every routine taking sizes also
+!>    accepts integer(c_int32_t) (default integers). Block offsets i0, j0 are
+!>    0-based, as in C.
+!>  - Arrays are assumed-shape: heights h(nx, ny) (or h(nx*ny); h(nx) on 1D and
+!>    axisymmetric grids), real(c_double); cell kinds integer(c_int8_t). Their
+!>    shape is checked against the grid (dpsm_get_shape) before C is called; a
+!>    mismatch fails with DPSM_ERR_INVALID_SIZE and a message naming both shapes.
+!>  - Every #define constant of dpsm.h is a parameter of the same name.
+!>
+!> tests/fortran/check_module.py fails the test suite when a function declared
+!> with DPSM_API or a constant of dpsm.h has no counterpart here.
+module dpsm
+  use, intrinsic :: iso_c_binding, only: c_ptr, c_null_ptr, c_associated, c_f_pointer, c_int, c_int8_t, &
+                                         c_int32_t, c_int64_t, c_double, c_char, c_size_t
+  implicit none
+  private
+
+  ! ---- constants: every #define of dpsm.h ----------------------------------
+  ! Status codes.
+  integer(c_int), parameter, public :: DPSM_OK = 0
+  integer(c_int), parameter, public :: DPSM_ERR_NULL_POINTER = 1
+  integer(c_int), parameter, public :: DPSM_ERR_INVALID_VALUE = 2
+  integer(c_int), parameter, public :: DPSM_ERR_INVALID_SIZE = 3
+  integer(c_int), parameter, public :: DPSM_ERR_UNKNOWN_ENUM = 4
+  integer(c_int), parameter, public :: DPSM_ERR_NOT_APPLICABLE = 5
+  integer(c_int), parameter, public :: DPSM_ERR_WORK_LIMIT = 6
+  integer(c_int), parameter, public :: DPSM_ERR_OUT_OF_MEMORY = 7
+  integer(c_int), parameter, public :: DPSM_ERR_INTERNAL = 8
+  ! Sides of the domain.
+  integer(c_int), parameter, public :: DPSM_XMIN = 0
+  integer(c_int), parameter, public :: DPSM_XMAX = 1
+  integer(c_int), parameter, public :: DPSM_YMIN = 2
+  integer(c_int), parameter, public :: DPSM_YMAX = 3
+  ! Boundary kinds.
+  integer(c_int), parameter, public :: DPSM_OPEN = 0
+  integer(c_int), parameter, public :: DPSM_WALL = 1
+  ! Schemes.
+  integer(c_int), parameter, public :: DPSM_SCHEME_PAIRWISE = 0
+  integer(c_int), parameter, public :: DPSM_SCHEME_ISOTROPIC = 1
+  ! Cell kinds (the values of an integer(c_int8_t) kinds array).
+  integer(c_int8_t), parameter, public :: DPSM_CELL_SAND = 0_c_int8_t
+  integer(c_int8_t), parameter, public :: DPSM_CELL_WALL = 1_c_int8_t
+  integer(c_int8_t), parameter, public :: DPSM_CELL_OPEN = 2_c_int8_t
+  ! Mass quantities.
+  integer(c_int), parameter, public :: DPSM_MASS_TOTAL = 0
+  integer(c_int), parameter, public :: DPSM_MASS_SOURCED = 1
+  integer(c_int), parameter, public :: DPSM_MASS_EXTERNAL = 2
+  integer(c_int), parameter, public :: DPSM_MASS_OUTFLOW = 3
+  ! Step information.
+  integer(c_int), parameter, public :: DPSM_INFO_SUBSTEPS = 0
+  integer(c_int), parameter, public :: DPSM_INFO_TIME_INTEGRATED = 1
+  integer(c_int), parameter, public :: DPSM_INFO_AT_REST = 2
+  integer(c_int), parameter, public :: DPSM_INFO_MAX_EXCESS_SLOPE = 3
+  integer(c_int), parameter, public :: DPSM_INFO_CELL_UPDATES = 4
+  ! Defaults.
+  real(c_double), parameter, public :: DPSM_DEFAULT_REPOSE_ANGLE = 0.52359877559829887_c_double
+  real(c_double), parameter, public :: DPSM_DEFAULT_MOBILITY = 1.0_c_double
+  real(c_double), parameter, public :: DPSM_DEFAULT_REST_TOLERANCE = 1e-6_c_double
+  integer(c_int64_t), parameter, public :: DPSM_DEFAULT_MAX_SUBSTEPS = 10000000_c_int64_t
+
+  ! The version of the headers this module was built against (dpsm_version.h).
+  ! DPSM_VERSION_NUMBER and DPSM_VERSION_STRING are DPSM_HEADER_VERSION_NUMBER
+  ! and DPSM_HEADER_VERSION_STRING here: Fortran names ignore case, and the
+  ! functions dpsm_version_number() and dpsm_version_string() take the C names.
+  include 'dpsm_version.inc'
+
+  ! ---- the grid ------------------------------------------------------------
+  !> Messages of failures found on the Fortran side (a wrong array shape),
+  !> kept with the handle so that dpsm_last_error(g) reports them.
+  type :: grid_state
+    character(len=:), allocatable :: message
+  end type grid_state
+
+  !> A dpsm grid: the C handle. Default-initialized to no grid (C's NULL).
+  type, public :: dpsm_grid
+    private
+    type(c_ptr) :: ptr = c_null_ptr
+    type(grid_state), pointer :: state => null()
+  end type dpsm_grid
+
+  ! ---- the public procedures: one per C function ---------------------------
+  public :: dpsm_create_1d, dpsm_create_2d, dpsm_create_axisymmetric, dpsm_destroy
+  public :: dpsm_set_repose_angle, dpsm_set_mobility, dpsm_set_scheme, dpsm_set_boundary
+  public :: dpsm_set_cell_kinds, dpsm_set_heights, dpsm_get_heights
+  public :: dpsm_set_heights_region, dpsm_add_heights_region, dpsm_get_heights_region
+  public :: dpsm_set_source, dpsm_stable_dt, dpsm_step, dpsm_get_mass, dpsm_get_step_info
+  public :: dpsm_get_shape, dpsm_set_rest_tolerance, dpsm_set_max_substeps, dpsm_set_threads
+  public :: dpsm_last_error, dpsm_status_string, dpsm_version_string, dpsm_version_number
+  ! Not in C: .true. when g holds a grid (its handle is not NULL).
+  public :: dpsm_associated
+
+  interface dpsm_create_1d
+    module procedure create_1d_i64, create_1d_i32
+  end interface dpsm_create_1d
+  interface dpsm_create_2d
+    module procedure create_2d_i64, create_2d_i32
+  end interface dpsm_create_2d
+  interface dpsm_create_axisymmetric
+    module procedure create_axisymmetric_i64, create_axisymmetric_i32
+  end interface dpsm_create_axisymmetric
+  interface dpsm_set_cell_kinds
+    module procedure set_cell_kinds_r1, set_cell_kinds_r2, set_cell_kinds_none
+  end interface dpsm_set_cell_kinds
+  interface dpsm_set_heights
+    module procedure set_heights_r1, set_heights_r2
+  end interface dpsm_set_heights
+  interface dpsm_get_heights
+    module procedure get_heights_r1, get_heights_r2
+  end interface dpsm_get_heights
+  interface dpsm_set_heights_region
+    module procedure set_heights_region_i64_r1, set_heights_region_i64_r2, &
+                     set_heights_region_i32_r1, set_heights_region_i32_r2
+  end interface dpsm_set_heights_region
+  interface dpsm_add_heights_region
+    module procedure add_heights_region_i64_r1, add_heights_region_i64_r2, &
+                     add_heights_region_i32_r1, add_heights_region_i32_r2
+  end interface dpsm_add_heights_region
+  interface dpsm_get_heights_region
+    module procedure get_heights_region_i64_r1, get_heights_region_i64_r2, &
+                     get_heights_region_i32_r1, get_heights_region_i32_r2
+  end interface dpsm_get_heights_region
+  interface dpsm_set_source
+    module procedure set_source_r1, set_source_r2, set_source_none
+  end interface dpsm_set_source
+  interface dpsm_get_shape
+    module procedure get_shape_i64, get_shape_i32
+  end interface dpsm_get_shape
+  interface dpsm_set_max_substeps
+    module procedure set_max_substeps_i64, set_max_substeps_i32
+  end interface dpsm_set_max_substeps
+
+  ! ---- the C functions -----------------------------------------------------
+  interface
+    integer(c_int) function c_dpsm_create_1d(nx, dx, out) bind(C, name='dpsm_create_1d')
+      import :: c_int, c_int64_t, c_double, c_ptr
+      integer(c_int64_t), value :: nx
+      real(c_double), value :: dx
+      type(c_ptr), intent(out) :: out
+    end function c_dpsm_create_1d
+
+    integer(c_int) function c_dpsm_create_2d(nx, ny, dx, dy, out) bind(C, name='dpsm_create_2d')
+      import :: c_int, c_int64_t, c_double, c_ptr
+      integer(c_int64_t), value :: nx, ny
+      real(c_double), value :: dx, dy
+      type(c_ptr), intent(out) :: out
+    end function c_dpsm_create_2d
+
+    integer(c_int) function c_dpsm_create_axisymmetric(nr, dr, out) bind(C, name='dpsm_create_axisymmetric')
+      import :: c_int, c_int64_t, c_double, c_ptr
+      integer(c_int64_t), value :: nr
+      real(c_double), value :: dr
+      type(c_ptr), intent(out) :: out
+    end function c_dpsm_create_axisymmetric
+
+    subroutine c_dpsm_destroy(g) bind(C, name='dpsm_destroy')
+      import :: c_ptr
+      type(c_ptr), value :: g
+    end subroutine c_dpsm_destroy
+
+    integer(c_int) function c_dpsm_set_repose_angle(g, theta_radians) bind(C, name='dpsm_set_repose_angle')
+      import :: c_int, c_double, c_ptr
+      type(c_ptr), value :: g
+      real(c_double), value :: theta_radians
+    end function c_dpsm_set_repose_angle
+
+    integer(c_int) function c_dpsm_set_mobility(g, nu) bind(C, name='dpsm_set_mobility')
+      import :: c_int, c_double, c_ptr
+      type(c_ptr), value :: g
+      real(c_double), value :: nu
+    end function c_dpsm_set_mobility
+
+    integer(c_int) function c_dpsm_set_scheme(g, scheme) bind(C, name='dpsm_set_scheme')
+      import :: c_int, c_ptr
+      type(c_ptr), value :: g
+      integer(c_int), value :: scheme
+    end function c_dpsm_set_scheme
+
+    integer(c_int) function c_dpsm_set_boundary(g, side, kind) bind(C, name='dpsm_set_boundary')
+      import :: c_int, c_ptr
+      type(c_ptr), value :: g
+      integer(c_int), value :: side, kind
+    end function c_dpsm_set_boundary
+
+    integer(c_int) function c_dpsm_set_cell_kinds(g, kinds) bind(C, name='dpsm_set_cell_kinds')
+      import :: c_int, c_int8_t, c_ptr
+      type(c_ptr), value :: g
+      integer(c_int8_t), intent(in), optional :: kinds(*) ! absent: NULL
+    end function c_dpsm_set_cell_kinds
+
+    integer(c_int) function c_dpsm_set_heights(g, h) bind(C, name='dpsm_set_heights')
+      import :: c_int, c_double, c_ptr
+      type(c_ptr), value :: g
+      real(c_double), intent(in) :: h(*)
+    end function c_dpsm_set_heights
+
+    integer(c_int) function c_dpsm_get_heights(g, h) bind(C, name='dpsm_get_heights')
+      import :: c_int, c_double, c_ptr
+      type(c_ptr), value :: g
+      real(c_double), intent(inout) :: h(*)
+    end function c_dpsm_get_heights
+
+    integer(c_int) function c_dpsm_set_heights_region(g, i0, j0, ni, nj, h) bind(C, name='dpsm_set_heights_region')
+      import :: c_int, c_int64_t, c_double, c_ptr
+      type(c_ptr), value :: g
+      integer(c_int64_t), value :: i0, j0, ni, nj
+      real(c_double), intent(in) :: h(*)
+    end function c_dpsm_set_heights_region
+
+    integer(c_int) function c_dpsm_add_heights_region(g, i0, j0, ni, nj, dh) bind(C, name='dpsm_add_heights_region')
+      import :: c_int, c_int64_t, c_double, c_ptr
+      type(c_ptr), value :: g
+      integer(c_int64_t), value :: i0, j0, ni, nj
+      real(c_double), intent(in) :: dh(*)
+    end function c_dpsm_add_heights_region
+
+    integer(c_int) function c_dpsm_get_heights_region(g, i0, j0, ni, nj, h) bind(C, name='dpsm_get_heights_region')
+      import :: c_int, c_int64_t, c_double, c_ptr
+      type(c_ptr), value :: g
+      integer(c_int64_t), value :: i0, j0, ni, nj
+      real(c_double), intent(inout) :: h(*)
+    end function c_dpsm_get_heights_region
+
+    integer(c_int) function c_dpsm_set_source(g, q) bind(C, name='dpsm_set_source')
+      import :: c_int, c_double, c_ptr
+      type(c_ptr), value :: g
+      real(c_double), intent(in), optional :: q(*) ! absent: NULL
+    end function c_dpsm_set_source
+
+    integer(c_int) function c_dpsm_stable_dt(g, dt) bind(C, name='dpsm_stable_dt')
+      import :: c_int, c_double, c_ptr
+      type(c_ptr), value :: g
+      real(c_double), intent(out) :: dt
+    end function c_dpsm_stable_dt
+
+    integer(c_int) function c_dpsm_step(g, dt) bind(C, name='dpsm_step')
+      import :: c_int, c_double, c_ptr
+      type(c_ptr), value :: g
+      real(c_double), value :: dt
+    end function c_dpsm_step
+
+    integer(c_int) function c_dpsm_get_mass(g, quantity, value) bind(C, name='dpsm_get_mass')
+      import :: c_int, c_double, c_ptr
+      type(c_ptr), value :: g
+      integer(c_int), value :: quantity
+      real(c_double), intent(out) :: value
+    end function c_dpsm_get_mass
+
+    integer(c_int) function c_dpsm_get_step_info(g, item, value) bind(C, name='dpsm_get_step_info')
+      import :: c_int, c_double, c_ptr
+      type(c_ptr), value :: g
+      integer(c_int), value :: item
+      real(c_double), intent(out) :: value
+    end function c_dpsm_get_step_info
+
+    integer(c_int) function c_dpsm_get_shape(g, nx, ny) bind(C, name='dpsm_get_shape')
+      import :: c_int, c_int64_t, c_ptr
+      type(c_ptr), value :: g
+      integer(c_int64_t), intent(out) :: nx, ny
+    end function c_dpsm_get_shape
+
+    integer(c_int) function c_dpsm_set_rest_tolerance(g, tol) bind(C, name='dpsm_set_rest_tolerance')
+      import :: c_int, c_double, c_ptr
+      type(c_ptr), value :: g
+      real(c_double), value :: tol
+    end function c_dpsm_set_rest_tolerance
+
+    integer(c_int) function c_dpsm_set_max_substeps(g, n) bind(C, name='dpsm_set_max_substeps')
+      import :: c_int, c_int64_t, c_ptr
+      type(c_ptr), value :: g
+      integer(c_int64_t), value :: n
+    end function c_dpsm_set_max_substeps
+
+    integer(c_int) function c_dpsm_set_threads(g, n) bind(C, name='dpsm_set_threads')
+      import :: c_int, c_ptr
+      type(c_ptr), value :: g
+      integer(c_int), value :: n
+    end function c_dpsm_set_threads
+
+    type(c_ptr) function c_dpsm_last_error(g) bind(C, name='dpsm_last_error')
+      import :: c_ptr
+      type(c_ptr), value :: g
+    end function c_dpsm_last_error
+
+    type(c_ptr) function c_dpsm_status_string(status) bind(C, name='dpsm_status_string')
+      import :: c_ptr, c_int
+      integer(c_int), value :: status
+    end function c_dpsm_status_string
+
+    type(c_ptr) function c_dpsm_version_string() bind(C, name='dpsm_version_string')
+      import :: c_ptr
+    end function c_dpsm_version_string
+
+    integer(c_int) function c_dpsm_version_number() bind(C, name='dpsm_version_number')
+      import :: c_int
+    end function c_dpsm_version_number
+
+    integer(c_size_t) function c_strlen(s) bind(C, name='strlen')
+      import :: c_size_t, c_ptr
+      type(c_ptr), value :: s
+    end function c_strlen
+  end interface
+
+contains
+
+  ! ==== helpers ==============================================================
+
+  !> A NUL-terminated C string as a Fortran string ('' for NULL).
+  function from_c_string(p) result(s)
+    type(c_ptr), intent(in) :: p
+    character(len=:), allocatable :: s
+    character(kind=c_char), pointer :: chars(:)
+    integer :: i, n
+    if (.not. c_associated(p)) then
+      s = ''
+      return
+    end if
+    n = int(c_strlen(p))
+    call c_f_pointer(p, chars, [n])
+    allocate (character(len=n) :: s)
+    do i = 1, n
+      s(i:i) = chars(i)
+    end do
+  end function from_c_string
+
+  function itoa(i) result(s)
+    integer(c_int64_t), intent(in) :: i
+    character(len=:), allocatable :: s
+    character(len=24) :: buffer
+    write (buffer, '(i0)') i
+    s = trim(buffer)
+  end function itoa
+
+  function shape_string(s) result(r)
+    integer, intent(in) :: s(:)
+    character(len=:), allocatable :: r
+    integer :: k
+    r = '('
+    do k = 1, size(s)
+      if (k > 1) r = r//', '
+      r = r//itoa(int(s(k), c_int64_t))
+    end do
+    r = r//')'
+  end function shape_string
+
+  !> Forgets a message of the Fortran side: called as every call on g begins.
+  subroutine clear_message(g)
+    type(dpsm_grid), intent(in) :: g
+    if (associated(g%state)) then
+      if (allocated(g%state%message)) deallocate (g%state%message)
+    end if
+  end subroutine clear_message
+
+  !> Records a failure found on the Fortran side, for dpsm_last_error(g).
+  subroutine set_message(g, message)
+    type(dpsm_grid), intent(in) :: g
+    character(len=*), intent(in) :: message
+    if (associated(g%state)) g%state%message = message
+  end subroutine set_message
+
+  !> Hands a status to the caller: into ierr when present; otherwise a failure
+  !> stops the program with the message of the failed call.
+  subroutine finish(status, ierr, where, g)
+    integer(c_int), intent(in) :: status
+    integer, intent(out), optional :: ierr
+    character(len=*), intent(in) :: where
+    type(dpsm_grid), intent(in), optional :: g
+    character(len=:), allocatable :: message
+    if (present(ierr)) then
+      ierr = int(status)
+      return
+    end if
+    if (status == DPSM_OK) return
+    message = where//' failed: '//dpsm_status_string(status)//': '//dpsm_last_error(g)
+    error stop message
+  end subroutine finish
+
+  !> Reads the grid's shape and compares it with an array's: DPSM_OK, the
+  !> status of a failed dpsm_get_shape, or DPSM_ERR_INVALID_SIZE with a message.
+  function check_grid_shape(g, where, name, array_shape) result(status)
+    type(dpsm_grid), intent(in) :: g
+    character(len=*), intent(in) :: where, name
+    integer, intent(in) :: array_shape(:)
+    integer(c_int) :: status
+    integer(c_int64_t) :: nx, ny
+    logical :: ok
+    status = c_dpsm_get_shape(g%ptr, nx, ny)
+    if (status /= DPSM_OK) return
+    if (size(array_shape) == 1) then
+      ok = int(array_shape(1), c_int64_t) == nx*ny
+    else
+      ok = int(array_shape(1), c_int64_t) == nx .and. int(array_shape(2), c_int64_t) == ny
+    end if
+    if (ok) return
+    status = DPSM_ERR_INVALID_SIZE
+    call set_message(g, where//': '//name//' has shape '//shape_string(array_shape)// &
+                     ' but the grid has nx = '//itoa(nx)//', ny = '//itoa(ny)// &
+                     ': pass '//name//'(nx, ny) or '//name//'(nx*ny)')
+  end function check_grid_shape
+
+  !> As check_grid_shape, for a block of ni by nj cells.
+  function check_block_shape(g, where, name, ni, nj, array_shape) result(status)
+    type(dpsm_grid), intent(in) :: g
+    character(len=*), intent(in) :: where, name
+    integer(c_int64_t), intent(in) :: ni, nj
+    integer, intent(in) :: array_shape(:)
+    integer(c_int) :: status
+    integer(c_int64_t) :: nx, ny
+    logical :: ok
+    ! A NULL handle fails here first, with the library's message.
+    status = c_dpsm_get_shape(g%ptr, nx, ny)
+    if (status /= DPSM_OK) return
+    if (size(array_shape) == 1) then
+      ok = int(array_shape(1), c_int64_t) == ni*nj
+    else
+      ok = int(array_shape(1), c_int64_t) == ni .and. int(array_shape(2), c_int64_t) == nj
+    end if
+    if (ok) return
+    status = DPSM_ERR_INVALID_SIZE
+    call set_message(g, where//': '//name//' has shape '//shape_string(array_shape)// &
+                     ' but the block has ni = '//itoa(ni)//', nj = '//itoa(nj)// &
+                     ': pass '//name//'(ni, nj) or '//name//'(ni*nj)')
+  end function check_block_shape
+
+  !> A size of default kind as c_int64_t, for the integer(c_int32_t) variants.
+  elemental function i64(i) result(r)
+    integer(c_int32_t), intent(in) :: i
+    integer(c_int64_t) :: r
+    r = int(i, c_int64_t)
+  end function i64
+
+  ! ==== not in C =============================================================
+
+  !> .true. when g holds a grid (made by a create call and not destroyed).
+  logical function dpsm_associated(g)
+    type(dpsm_grid), intent(in) :: g
+    dpsm_associated = c_associated(g%ptr)
+  end function dpsm_associated
+
+  ! ==== creating and destroying ==============================================
+
+  !> Stores a newly created handle (or none) in g.
+  subroutine adopt(g, ptr, status)
+    type(dpsm_grid), intent(out) :: g
+    type(c_ptr), intent(in) :: ptr
+    integer(c_int), intent(in) :: status
+    if (status == DPSM_OK) then
+      g%ptr = ptr
+      allocate (g%state)
+    end if
+  end subroutine adopt
+
+  !> dpsm_create_1d(g, nx, dx[, ierr]): a 1D grid of nx cells of width dx.
+  subroutine create_1d_i64(g, nx, dx, ierr)
+    type(dpsm_grid), intent(out) :: g
+    integer(c_int64_t), intent(in) :: nx
+    real(c_double), intent(in) :: dx
+    integer, intent(out), optional :: ierr
+    type(c_ptr) :: ptr
+    integer(c_int) :: status
+    status = c_dpsm_create_1d(nx, dx, ptr)
+    call adopt(g, ptr, status)
+    call finish(status, ierr, 'dpsm_create_1d')
+  end subroutine create_1d_i64
+
+  subroutine create_1d_i32(g, nx, dx, ierr)
+    type(dpsm_grid), intent(out) :: g
+    integer(c_int32_t), intent(in) :: nx
+    real(c_double), intent(in) :: dx
+    integer, intent(out), optional :: ierr
+    call create_1d_i64(g, i64(nx), dx, ierr)
+  end subroutine create_1d_i32
+
+  !> dpsm_create_2d(g, nx, ny, dx, dy[, ierr]): a 2D grid of nx by ny cells.
+  subroutine create_2d_i64(g, nx, ny, dx, dy, ierr)
+    type(dpsm_grid), intent(out) :: g
+    integer(c_int64_t), intent(in) :: nx, ny
+    real(c_double), intent(in) :: dx, dy
+    integer, intent(out), optional :: ierr
+    type(c_ptr) :: ptr
+    integer(c_int) :: status
+    status = c_dpsm_create_2d(nx, ny, dx, dy, ptr)
+    call adopt(g, ptr, status)
+    call finish(status, ierr, 'dpsm_create_2d')
+  end subroutine create_2d_i64
+
+  subroutine create_2d_i32(g, nx, ny, dx, dy, ierr)
+    type(dpsm_grid), intent(out) :: g
+    integer(c_int32_t), intent(in) :: nx, ny
+    real(c_double), intent(in) :: dx, dy
+    integer, intent(out), optional :: ierr
+    call create_2d_i64(g, i64(nx), i64(ny), dx, dy, ierr)
+  end subroutine create_2d_i32
+
+  !> dpsm_create_axisymmetric(g, nr, dr[, ierr]): nr rings of width dr.
+  subroutine create_axisymmetric_i64(g, nr, dr, ierr)
+    type(dpsm_grid), intent(out) :: g
+    integer(c_int64_t), intent(in) :: nr
+    real(c_double), intent(in) :: dr
+    integer, intent(out), optional :: ierr
+    type(c_ptr) :: ptr
+    integer(c_int) :: status
+    status = c_dpsm_create_axisymmetric(nr, dr, ptr)
+    call adopt(g, ptr, status)
+    call finish(status, ierr, 'dpsm_create_axisymmetric')
+  end subroutine create_axisymmetric_i64
+
+  subroutine create_axisymmetric_i32(g, nr, dr, ierr)
+    type(dpsm_grid), intent(out) :: g
+    integer(c_int32_t), intent(in) :: nr
+    real(c_double), intent(in) :: dr
+    integer, intent(out), optional :: ierr
+    call create_axisymmetric_i64(g, i64(nr), dr, ierr)
+  end subroutine create_axisymmetric_i32
+
+  !> dpsm_destroy(g[, ierr]): releases the grid and leaves g empty. An empty g
+  !> is allowed and does nothing; ierr is always DPSM_OK.
+  subroutine dpsm_destroy(g, ierr)
+    type(dpsm_grid), intent(inout) :: g
+    integer, intent(out), optional :: ierr
+    call c_dpsm_destroy(g%ptr)
+    g%ptr = c_null_ptr
+    if (associated(g%state)) then
+      call clear_message(g)
+      deallocate (g%state)
+    end if
+    if (present(ierr)) ierr = int(DPSM_OK)
+  end subroutine dpsm_destroy
+
+  ! ==== parameters ===========================================================
+
+  !> dpsm_set_repose_angle(g, theta_radians[, ierr])
+  subroutine dpsm_set_repose_angle(g, theta_radians, ierr)
+    type(dpsm_grid), intent(in) :: g
+    real(c_double), intent(in) :: theta_radians
+    integer, intent(out), optional :: ierr
+    call clear_message(g)
+    call finish(c_dpsm_set_repose_angle(g%ptr, theta_radians), ierr, 'dpsm_set_repose_angle', g)
+  end subroutine dpsm_set_repose_angle
+
+  !> dpsm_set_mobility(g, nu[, ierr])
+  subroutine dpsm_set_mobility(g, nu, ierr)
+    type(dpsm_grid), intent(in) :: g
+    real(c_double), intent(in) :: nu
+    integer, intent(out), optional :: ierr
+    call clear_message(g)
+    call finish(c_dpsm_set_mobility(g%ptr, nu), ierr, 'dpsm_set_mobility', g)
+  end subroutine dpsm_set_mobility
+
+  !> dpsm_set_scheme(g, scheme[, ierr]): DPSM_SCHEME_ISOTROPIC or DPSM_SCHEME_PAIRWISE.
+  subroutine dpsm_set_scheme(g, scheme, ierr)
+    type(dpsm_grid), intent(in) :: g
+    integer(c_int), intent(in) :: scheme
+    integer, intent(out), optional :: ierr
+    call clear_message(g)
+    call finish(c_dpsm_set_scheme(g%ptr, scheme), ierr, 'dpsm_set_scheme', g)
+  end subroutine dpsm_set_scheme
+
+  !> dpsm_set_boundary(g, side, kind[, ierr]): side DPSM_XMIN..DPSM_YMAX, kind DPSM_OPEN or DPSM_WALL.
+  subroutine dpsm_set_boundary(g, side, kind, ierr)
+    type(dpsm_grid), intent(in) :: g
+    integer(c_int), intent(in) :: side, kind
+    integer, intent(out), optional :: ierr
+    call clear_message(g)
+    call finish(c_dpsm_set_boundary(g%ptr, side, kind), ierr, 'dpsm_set_boundary', g)
+  end subroutine dpsm_set_boundary
+
+  !> dpsm_set_rest_tolerance(g, tol[, ierr])
+  subroutine dpsm_set_rest_tolerance(g, tol, ierr)
+    type(dpsm_grid), intent(in) :: g
+    real(c_double), intent(in) :: tol
+    integer, intent(out), optional :: ierr
+    call clear_message(g)
+    call finish(c_dpsm_set_rest_tolerance(g%ptr, tol), ierr, 'dpsm_set_rest_tolerance', g)
+  end subroutine dpsm_set_rest_tolerance
+
+  !> dpsm_set_max_substeps(g, n[, ierr])
+  subroutine set_max_substeps_i64(g, n, ierr)
+    type(dpsm_grid), intent(in) :: g
+    integer(c_int64_t), intent(in) :: n
+    integer, intent(out), optional :: ierr
+    call clear_message(g)
+    call finish(c_dpsm_set_max_substeps(g%ptr, n), ierr, 'dpsm_set_max_substeps', g)
+  end subroutine set_max_substeps_i64
+
+  subroutine set_max_substeps_i32(g, n, ierr)
+    type(dpsm_grid), intent(in) :: g
+    integer(c_int32_t), intent(in) :: n
+    integer, intent(out), optional :: ierr
+    call set_max_substeps_i64(g, i64(n), ierr)
+  end subroutine set_max_substeps_i32
+
+  !> dpsm_set_threads(g, n[, ierr]): 0 means OpenMP's default.
+  subroutine dpsm_set_threads(g, n, ierr)
+    type(dpsm_grid), intent(in) :: g
+    integer(c_int), intent(in) :: n
+    integer, intent(out), optional :: ierr
+    call clear_message(g)
+    call finish(c_dpsm_set_threads(g%ptr, n), ierr, 'dpsm_set_threads', g)
+  end subroutine dpsm_set_threads
+
+  ! ==== cell kinds ===========================================================
+
+  !> dpsm_set_cell_kinds(g, kinds[, ierr]): kinds(nx, ny) or kinds(nx*ny) of
+  !> DPSM_CELL_SAND, DPSM_CELL_WALL, DPSM_CELL_OPEN; without kinds every cell is sand.
+  subroutine set_cell_kinds_r1(g, kinds, ierr)
+    type(dpsm_grid), intent(in) :: g
+    integer(c_int8_t), intent(in), contiguous :: kinds(:)
+    integer, intent(out), optional :: ierr
+    integer(c_int) :: status
+    call clear_message(g)
+    status = check_grid_shape(g, 'dpsm_set_cell_kinds', 'kinds', shape(kinds))
+    if (status == DPSM_OK) status = c_dpsm_set_cell_kinds(g%ptr, kinds)
+    call finish(status, ierr, 'dpsm_set_cell_kinds', g)
+  end subroutine set_cell_kinds_r1
+
+  subroutine set_cell_kinds_r2(g, kinds, ierr)
+    type(dpsm_grid), intent(in) :: g
+    integer(c_int8_t), intent(in), contiguous :: kinds(:, :)
+    integer, intent(out), optional :: ierr
+    integer(c_int) :: status
+    call clear_message(g)
+    status = check_grid_shape(g, 'dpsm_set_cell_kinds', 'kinds', shape(kinds))
+    if (status == DPSM_OK) status = c_dpsm_set_cell_kinds(g%ptr, kinds)
+    call finish(status, ierr, 'dpsm_set_cell_kinds', g)
+  end subroutine set_cell_kinds_r2
+
+  subroutine set_cell_kinds_none(g, ierr)
+    type(dpsm_grid), intent(in) :: g
+    integer, intent(out), optional :: ierr
+    call clear_message(g)
+    call finish(c_dpsm_set_cell_kinds(g%ptr), ierr, 'dpsm_set_cell_kinds', g)
+  end subroutine set_cell_kinds_none
+
+  ! ==== heights ==============================================================
+
+  !> dpsm_set_heights(g, h[, ierr]): h(nx, ny) or h(nx*ny).
+  subroutine set_heights_r1(g, h, ierr)
+    type(dpsm_grid), intent(in) :: g
+    real(c_double), intent(in), contiguous :: h(:)
+    integer, intent(out), optional :: ierr
+    integer(c_int) :: status
+    call clear_message(g)
+    status = check_grid_shape(g, 'dpsm_set_heights', 'h', shape(h))
+    if (status == DPSM_OK) status = c_dpsm_set_heights(g%ptr, h)
+    call finish(status, ierr, 'dpsm_set_heights', g)
+  end subroutine set_heights_r1
+
+  subroutine set_heights_r2(g, h, ierr)
+    type(dpsm_grid), intent(in) :: g
+    real(c_double), intent(in), contiguous :: h(:, :)
+    integer, intent(out), optional :: ierr
+    integer(c_int) :: status
+    call clear_message(g)
+    status = check_grid_shape(g, 'dpsm_set_heights', 'h', shape(h))
+    if (status == DPSM_OK) status = c_dpsm_set_heights(g%ptr, h)
+    call finish(status, ierr, 'dpsm_set_heights', g)
+  end subroutine set_heights_r2
+
+  !> dpsm_get_heights(g, h[, ierr]): h(nx, ny) or h(nx*ny).
+  subroutine get_heights_r1(g, h, ierr)
+    type(dpsm_grid), intent(in) :: g
+    real(c_double), intent(inout), contiguous :: h(:)
+    integer, intent(out), optional :: ierr
+    integer(c_int) :: status
+    call clear_message(g)
+    status = check_grid_shape(g, 'dpsm_get_heights', 'h', shape(h))
+    if (status == DPSM_OK) status = c_dpsm_get_heights(g%ptr, h)
+    call finish(status, ierr, 'dpsm_get_heights', g)
+  end subroutine get_heights_r1
+
+  subroutine get_heights_r2(g, h, ierr)
+    type(dpsm_grid), intent(in) :: g
+    real(c_double), intent(inout), contiguous :: h(:, :)
+    integer, intent(out), optional :: ierr
+    integer(c_int) :: status
+    call clear_message(g)
+    status = check_grid_shape(g, 'dpsm_get_heights', 'h', shape(h))
+    if (status == DPSM_OK) status = c_dpsm_get_heights(g%ptr, h)
+    call finish(status, ierr, 'dpsm_get_heights', g)
+  end subroutine get_heights_r2
+
+  ! ==== blocks of heights (i0, j0 are 0-based, as in C) ======================
+
+  !> dpsm_set_heights_region(g, i0, j0, ni, nj, h[, ierr]): h(ni, nj) or h(ni*nj).
+  subroutine set_heights_region_i64_r1(g, i0, j0, ni, nj, h, ierr)
+    type(dpsm_grid), intent(in) :: g
+    integer(c_int64_t), intent(in) :: i0, j0, ni, nj
+    real(c_double), intent(in), contiguous :: h(:)
+    integer, intent(out), optional :: ierr
+    integer(c_int) :: status
+    call clear_message(g)
+    status = check_block_shape(g, 'dpsm_set_heights_region', 'h', ni, nj, shape(h))
+    if (status == DPSM_OK) status = c_dpsm_set_heights_region(g%ptr, i0, j0, ni, nj, h)
+    call finish(status, ierr, 'dpsm_set_heights_region', g)
+  end subroutine set_heights_region_i64_r1
+
+  subroutine set_heights_region_i64_r2(g, i0, j0, ni, nj, h, ierr)
+    type(dpsm_grid), intent(in) :: g
+    integer(c_int64_t), intent(in) :: i0, j0, ni, nj
+    real(c_double), intent(in), contiguous :: h(:, :)
+    integer, intent(out), optional :: ierr
+    integer(c_int) :: status
+    call clear_message(g)
+    status = check_block_shape(g, 'dpsm_set_heights_region', 'h', ni, nj, shape(h))
+    if (status == DPSM_OK) status = c_dpsm_set_heights_region(g%ptr, i0, j0, ni, nj, h)
+    call finish(status, ierr, 'dpsm_set_heights_region', g)
+  end subroutine set_heights_region_i64_r2
+
+  subroutine set_heights_region_i32_r1(g, i0, j0, ni, nj, h, ierr)
+    type(dpsm_grid), intent(in) :: g
+    integer(c_int32_t), intent(in) :: i0, j0, ni, nj
+    real(c_double), intent(in), contiguous :: h(:)
+    integer, intent(out), optional :: ierr
+    call set_heights_region_i64_r1(g, i64(i0), i64(j0), i64(ni), i64(nj), h, ierr)
+  end subroutine set_heights_region_i32_r1
+
+  subroutine set_heights_region_i32_r2(g, i0, j0, ni, nj, h, ierr)
+    type(dpsm_grid), intent(in) :: g
+    integer(c_int32_t), intent(in) :: i0, j0, ni, nj
+    real(c_double), intent(in), contiguous :: h(:, :)
+    integer, intent(out), optional :: ierr
+    call set_heights_region_i64_r2(g, i64(i0), i64(j0), i64(ni), i64(nj), h, ierr)
+  end subroutine set_heights_region_i32_r2
+
+  !> dpsm_add_heights_region(g, i0, j0, ni, nj, dh[, ierr]): dh(ni, nj) or dh(ni*nj).
+  subroutine add_heights_region_i64_r1(g, i0, j0, ni, nj, dh, ierr)
+    type(dpsm_grid), intent(in) :: g
+    integer(c_int64_t), intent(in) :: i0, j0, ni, nj
+    real(c_double), intent(in), contiguous :: dh(:)
+    integer, intent(out), optional :: ierr
+    integer(c_int) :: status
+    call clear_message(g)
+    status = check_block_shape(g, 'dpsm_add_heights_region', 'dh', ni, nj, shape(dh))
+    if (status == DPSM_OK) status = c_dpsm_add_heights_region(g%ptr, i0, j0, ni, nj, dh)
+    call finish(status, ierr, 'dpsm_add_heights_region', g)
+  end subroutine add_heights_region_i64_r1
+
+  subroutine add_heights_region_i64_r2(g, i0, j0, ni, nj, dh, ierr)
+    type(dpsm_grid), intent(in) :: g
+    integer(c_int64_t), intent(in) :: i0, j0, ni, nj
+    real(c_double), intent(in), contiguous :: dh(:, :)
+    integer, intent(out), optional :: ierr
+    integer(c_int) :: status
+    call clear_message(g)
+    status = check_block_shape(g, 'dpsm_add_heights_region', 'dh', ni, nj, shape(dh))
+    if (status == DPSM_OK) status = c_dpsm_add_heights_region(g%ptr, i0, j0, ni, nj, dh)
+    call finish(status, ierr, 'dpsm_add_heights_region', g)
+  end subroutine add_heights_region_i64_r2
+
+  subroutine add_heights_region_i32_r1(g, i0, j0, ni, nj, dh, ierr)
+    type(dpsm_grid), intent(in) :: g
+    integer(c_int32_t), intent(in) :: i0, j0, ni, nj
+    real(c_double), intent(in), contiguous :: dh(:)
+    integer, intent(out), optional :: ierr
+    call add_heights_region_i64_r1(g, i64(i0), i64(j0), i64(ni), i64(nj), dh, ierr)
+  end subroutine add_heights_region_i32_r1
+
+  subroutine add_heights_region_i32_r2(g, i0, j0, ni, nj, dh, ierr)
+    type(dpsm_grid), intent(in) :: g
+    integer(c_int32_t), intent(in) :: i0, j0, ni, nj
+    real(c_double), intent(in), contiguous :: dh(:, :)
+    integer, intent(out), optional :: ierr
+    call add_heights_region_i64_r2(g, i64(i0), i64(j0), i64(ni), i64(nj), dh, ierr)
+  end subroutine add_heights_region_i32_r2
+
+  !> dpsm_get_heights_region(g, i0, j0, ni, nj, h[, ierr]): h(ni, nj) or h(ni*nj).
+  subroutine get_heights_region_i64_r1(g, i0, j0, ni, nj, h, ierr)
+    type(dpsm_grid), intent(in) :: g
+    integer(c_int64_t), intent(in) :: i0, j0, ni, nj
+    real(c_double), intent(inout), contiguous :: h(:)
+    integer, intent(out), optional :: ierr
+    integer(c_int) :: status
+    call clear_message(g)
+    status = check_block_shape(g, 'dpsm_get_heights_region', 'h', ni, nj, shape(h))
+    if (status == DPSM_OK) status = c_dpsm_get_heights_region(g%ptr, i0, j0, ni, nj, h)
+    call finish(status, ierr, 'dpsm_get_heights_region', g)
+  end subroutine get_heights_region_i64_r1
+
+  subroutine get_heights_region_i64_r2(g, i0, j0, ni, nj, h, ierr)
+    type(dpsm_grid), intent(in) :: g
+    integer(c_int64_t), intent(in) :: i0, j0, ni, nj
+    real(c_double), intent(inout), contiguous :: h(:, :)
+    integer, intent(out), optional :: ierr
+    integer(c_int) :: status
+    call clear_message(g)
+    status = check_block_shape(g, 'dpsm_get_heights_region', 'h', ni, nj, shape(h))
+    if (status == DPSM_OK) status = c_dpsm_get_heights_region(g%ptr, i0, j0, ni, nj, h)
+    call finish(status, ierr, 'dpsm_get_heights_region', g)
+  end subroutine get_heights_region_i64_r2
+
+  subroutine get_heights_region_i32_r1(g, i0, j0, ni, nj, h, ierr)
+    type(dpsm_grid), intent(in) :: g
+    integer(c_int32_t), intent(in) :: i0, j0, ni, nj
+    real(c_double), intent(inout), contiguous :: h(:)
+    integer, intent(out), optional :: ierr
+    call get_heights_region_i64_r1(g, i64(i0), i64(j0), i64(ni), i64(nj), h, ierr)
+  end subroutine get_heights_region_i32_r1
+
+  subroutine get_heights_region_i32_r2(g, i0, j0, ni, nj, h, ierr)
+    type(dpsm_grid), intent(in) :: g
+    integer(c_int32_t), intent(in) :: i0, j0, ni, nj
+    real(c_double), intent(inout), contiguous :: h(:, :)
+    integer, intent(out), optional :: ierr
+    call get_heights_region_i64_r2(g, i64(i0), i64(j0), i64(ni), i64(nj), h, ierr)
+  end subroutine get_heights_region_i32_r2
+
+  ! ==== sources ==============================================================
+
+  !> dpsm_set_source(g, q[, ierr]): q(nx, ny) or q(nx*ny), height per unit
+  !> time (deposition > 0, erosion < 0); without q no source acts.
+  subroutine set_source_r1(g, q, ierr)
+    type(dpsm_grid), intent(in) :: g
+    real(c_double), intent(in), contiguous :: q(:)
+    integer, intent(out), optional :: ierr
+    integer(c_int) :: status
+    call clear_message(g)
+    status = check_grid_shape(g, 'dpsm_set_source', 'q', shape(q))
+    if (status == DPSM_OK) status = c_dpsm_set_source(g%ptr, q)
+    call finish(status, ierr, 'dpsm_set_source', g)
+  end subroutine set_source_r1
+
+  subroutine set_source_r2(g, q, ierr)
+    type(dpsm_grid), intent(in) :: g
+    real(c_double), intent(in), contiguous :: q(:, :)
+    integer, intent(out), optional :: ierr
+    integer(c_int) :: status
+    call clear_message(g)
+    status = check_grid_shape(g, 'dpsm_set_source', 'q', shape(q))
+    if (status == DPSM_OK) status = c_dpsm_set_source(g%ptr, q)
+    call finish(status, ierr, 'dpsm_set_source', g)
+  end subroutine set_source_r2
+
+  subroutine set_source_none(g, ierr)
+    type(dpsm_grid), intent(in) :: g
+    integer, intent(out), optional :: ierr
+    call clear_message(g)
+    call finish(c_dpsm_set_source(g%ptr), ierr, 'dpsm_set_source', g)
+  end subroutine set_source_none
+
+  ! ==== stepping =============================================================
+
+  !> dpsm_stable_dt(g, dt[, ierr]): the largest stable explicit sub-step.
+  subroutine dpsm_stable_dt(g, dt, ierr)
+    type(dpsm_grid), intent(in) :: g
+    real(c_double), intent(out) :: dt
+    integer, intent(out), optional :: ierr
+    call clear_message(g)
+    call finish(c_dpsm_stable_dt(g%ptr, dt), ierr, 'dpsm_stable_dt', g)
+  end subroutine dpsm_stable_dt
+
+  !> dpsm_step(g, dt[, ierr]): advances the surface by exactly dt.
+  subroutine dpsm_step(g, dt, ierr)
+    type(dpsm_grid), intent(in) :: g
+    real(c_double), intent(in) :: dt
+    integer, intent(out), optional :: ierr
+    call clear_message(g)
+    call finish(c_dpsm_step(g%ptr, dt), ierr, 'dpsm_step', g)
+  end subroutine dpsm_step
+
+  ! ==== reading back =========================================================
+
+  !> dpsm_get_mass(g, quantity, value[, ierr]): DPSM_MASS_TOTAL, _SOURCED, _EXTERNAL or _OUTFLOW.
+  subroutine dpsm_get_mass(g, quantity, value, ierr)
+    type(dpsm_grid), intent(in) :: g
+    integer(c_int), intent(in) :: quantity
+    real(c_double), intent(out) :: value
+    integer, intent(out), optional :: ierr
+    call clear_message(g)
+    call finish(c_dpsm_get_mass(g%ptr, quantity, value), ierr, 'dpsm_get_mass', g)
+  end subroutine dpsm_get_mass
+
+  !> dpsm_get_step_info(g, item, value[, ierr]): DPSM_INFO_* of the last step.
+  subroutine dpsm_get_step_info(g, item, value, ierr)
+    type(dpsm_grid), intent(in) :: g
+    integer(c_int), intent(in) :: item
+    real(c_double), intent(out) :: value
+    integer, intent(out), optional :: ierr
+    call clear_message(g)
+    call finish(c_dpsm_get_step_info(g%ptr, item, value), ierr, 'dpsm_get_step_info', g)
+  end subroutine dpsm_get_step_info
+
+  !> dpsm_get_shape(g, nx, ny[, ierr]): ny is 1 on 1D and axisymmetric grids.
+  subroutine get_shape_i64(g, nx, ny, ierr)
+    type(dpsm_grid), intent(in) :: g
+    integer(c_int64_t), intent(out) :: nx, ny
+    integer, intent(out), optional :: ierr
+    call clear_message(g)
+    call finish(c_dpsm_get_shape(g%ptr, nx, ny), ierr, 'dpsm_get_shape', g)
+  end subroutine get_shape_i64
+
+  subroutine get_shape_i32(g, nx, ny, ierr)
+    type(dpsm_grid), intent(in) :: g
+    integer(c_int32_t), intent(out) :: nx, ny
+    integer, intent(out), optional :: ierr
+    integer(c_int64_t) :: nx64, ny64
+    integer(c_int) :: status
+    call clear_message(g)
+    nx = 0
+    ny = 0
+    status = c_dpsm_get_shape(g%ptr, nx64, ny64)
+    if (status == DPSM_OK) then
+      if (nx64 > huge(nx) .or. ny64 > huge(ny)) then
+        status = DPSM_ERR_INVALID_SIZE
+        call set_message(g, 'dpsm_get_shape: the grid has nx = '//itoa(nx64)//', ny = '//itoa(ny64)// &
+                         ', too large for integer(c_int32_t): pass integer(c_int64_t) variables')
+      else
+        nx = int(nx64, c_int32_t)
+        ny = int(ny64, c_int32_t)
+      end if
+    end if
+    call finish(status, ierr, 'dpsm_get_shape', g)
+  end subroutine get_shape_i32
+
+  ! ==== messages and versions ================================================
+
+  !> The message of the last failed call on g, or '' if it succeeded. Without
+  !> g (or with an empty g): the last failure in this thread that had no grid
+  !> to keep it (a failed create), as dpsm_last_error(NULL) in C.
+  function dpsm_last_error(g) result(message)
+    type(dpsm_grid), intent(in), optional :: g
+    character(len=:), allocatable :: message
+    if (.not. present(g)) then
+      message = from_c_string(c_dpsm_last_error(c_null_ptr))
+      return
+    end if
+    if (associated(g%state)) then
+      if (allocated(g%state%message)) then
+        message = g%state%message
+        return
+      end if
+    end if
+    message = from_c_string(c_dpsm_last_error(g%ptr))
+  end function dpsm_last_error
+
+  !> A short name for a status code, e.g. 'DPSM_ERR_INVALID_VALUE'.
+  function dpsm_status_string(status) result(name)
+    integer(c_int), intent(in) :: status
+    character(len=:), allocatable :: name
+    name = from_c_string(c_dpsm_status_string(status))
+  end function dpsm_status_string
+
+  !> The version of the library actually linked, e.g. '0.1.0'.
+  function dpsm_version_string() result(version)
+    character(len=:), allocatable :: version
+    version = from_c_string(c_dpsm_version_string())
+  end function dpsm_version_string
+
+  !> The version of the library actually linked as MAJOR*10000 + MINOR*100 + PATCH.
+  integer(c_int) function dpsm_version_number()
+    dpsm_version_number = c_dpsm_version_number()
+  end function dpsm_version_number
+
+end module dpsm

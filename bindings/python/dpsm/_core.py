@@ -1,0 +1,425 @@
+"""The Grid class, dpsm.Error and the module-level functions."""
+
+import ctypes
+import operator
+import os
+
+from . import _constants as C
+from ._lib import LIBRARY, GridPtr, lib
+
+
+def _import_numpy():
+    if os.environ.get("DPSM_NO_NUMPY", "") not in ("", "0"):
+        return None
+    try:
+        import numpy
+    except ImportError:
+        return None
+    return numpy
+
+
+np = _import_numpy()
+HAVE_NUMPY = np is not None
+
+_INT_RANGE = (-(2**31), 2**31 - 1)
+_INT64_RANGE = (-(2**63), 2**63 - 1)
+_P_DOUBLE = ctypes.POINTER(ctypes.c_double)
+_P_UINT8 = ctypes.POINTER(ctypes.c_uint8)
+
+
+def _text(raw):
+    return raw.decode("utf-8", "replace") if raw is not None else ""
+
+
+def status_string(status):
+    """A short name for a status code, e.g. ``"DPSM_ERR_INVALID_VALUE"``."""
+    status = operator.index(status)
+    if not _INT_RANGE[0] <= status <= _INT_RANGE[1]:
+        return "unknown status"
+    return _text(lib.dpsm_status_string(status))
+
+
+def version_string():
+    """The version of the library actually loaded, e.g. ``"0.1.0"``."""
+    return _text(lib.dpsm_version_string())
+
+
+def version_number():
+    """The version of the library actually loaded as ``MAJOR*10000 + MINOR*100 + PATCH``."""
+    return lib.dpsm_version_number()
+
+
+def last_error(grid=None):
+    """``dpsm_last_error``: the message of the last failed call on ``grid``
+    (``""`` if it succeeded); without a grid, the last failure in this thread
+    that had no grid to keep it (a failed create)."""
+    if grid is None:
+        return _text(lib.dpsm_last_error(None))
+    return grid.last_error()
+
+
+class Error(Exception):
+    """A failed dpsm call.
+
+    ``status`` is the ``DPSM_ERR_*`` code, ``status_name`` its name,
+    ``message`` the library's message and ``function`` the C function that
+    failed.
+    """
+
+    def __init__(self, status, message, function=None):
+        self.status = status
+        self.message = message
+        self.function = function
+        self.status_name = status_string(status)
+        where = function + ": " if function else ""
+        super().__init__("%s%s: %s" % (where, self.status_name, message))
+
+
+def _check(status, function, handle=None, created=False):
+    if status != C.DPSM_OK:
+        message = _text(lib.dpsm_last_error(None if created else handle))
+        raise Error(status, message, function)
+
+
+def _c_int(value, name, function, status, range_=_INT_RANGE, ctype="int"):
+    """``value`` as a Python int that fits the C type (ctypes would wrap it)."""
+    value = operator.index(value)
+    if not range_[0] <= value <= range_[1]:
+        raise Error(status, "%s = %d does not fit in a C %s" % (name, value, ctype), function)
+    return value
+
+
+def _c_int64(value, name, function, status=C.DPSM_ERR_INVALID_SIZE):
+    return _c_int(value, name, function, status, _INT64_RANGE, "int64_t")
+
+
+def _flatten(values, shape, name, function):
+    """A flat list of the values of a nested or flat sequence holding
+    ``shape = (rows, columns)`` values (rows may be None for 1D)."""
+    rows, columns = shape
+    count = columns * (rows or 1)
+    items = list(values)
+    if rows is not None and len(items) == rows and all(_is_sequence(row) for row in items):
+        flat = []
+        for row in items:
+            row = list(row)
+            if len(row) != columns:
+                raise _shape_error(function, name, "a row of %d values" % len(row), shape)
+            flat.extend(row)
+        return flat
+    if len(items) == count and not any(_is_sequence(item) for item in items):
+        return items
+    return _raise_shape(function, name, "%d items" % len(items), shape)
+
+
+def _is_sequence(item):
+    return hasattr(item, "__len__") and hasattr(item, "__iter__") and not isinstance(item, (str, bytes))
+
+
+def _shape_error(function, name, got, shape):
+    rows, columns = shape
+    if rows is None:
+        want = "(%d,)" % columns
+    else:
+        want = "(%d, %d) or (%d,)" % (rows, columns, rows * columns)
+    return Error(C.DPSM_ERR_INVALID_SIZE, "%s has %s; expected shape %s" % (name, got, want), function)
+
+
+def _raise_shape(function, name, got, shape):
+    raise _shape_error(function, name, got, shape)
+
+
+class Grid:
+    """A dpsm grid (``dpsm_grid *``): create one with ``Grid.create_1d``,
+    ``Grid.create_2d`` or ``Grid.create_axisymmetric``.
+
+    Arrays of heights, sources and cell kinds have the grid's ``shape``:
+    ``(ny, nx)`` on a 2D grid (row ``j`` holds cells ``(0..nx-1, j)``, as a C
+    ``h[ny][nx]``; a flat sequence of ``nx*ny`` values, x fastest, is also
+    accepted) and ``(nx,)`` on 1D and axisymmetric grids.
+    """
+
+    def __init__(self, _handle=None, _kind=None):
+        if not isinstance(_handle, GridPtr) or not _handle:
+            raise TypeError("make a Grid with Grid.create_1d, Grid.create_2d or Grid.create_axisymmetric")
+        self._handle = _handle
+        self.kind = _kind
+        nx, ny = ctypes.c_int64(), ctypes.c_int64()
+        _check(lib.dpsm_get_shape(_handle, ctypes.byref(nx), ctypes.byref(ny)), "dpsm_get_shape", _handle)
+        self.nx, self.ny = nx.value, ny.value
+
+    # ---- creating and releasing --------------------------------------------
+
+    @classmethod
+    def _create(cls, function, kind, *args):
+        handle = GridPtr()
+        _check(getattr(lib, function)(*args, ctypes.byref(handle)), function, created=True)
+        return cls(_handle=handle, _kind=kind)
+
+    @classmethod
+    def create_1d(cls, nx, dx):
+        """``dpsm_create_1d``: ``nx`` cells of width ``dx``."""
+        f = "dpsm_create_1d"
+        return cls._create(f, "1d", _c_int64(nx, "nx", f), float(dx))
+
+    @classmethod
+    def create_2d(cls, nx, ny, dx, dy):
+        """``dpsm_create_2d``: ``nx`` by ``ny`` cells of size ``dx`` by ``dy``."""
+        f = "dpsm_create_2d"
+        return cls._create(f, "2d", _c_int64(nx, "nx", f), _c_int64(ny, "ny", f), float(dx), float(dy))
+
+    @classmethod
+    def create_axisymmetric(cls, nr, dr):
+        """``dpsm_create_axisymmetric``: ``nr`` rings of width ``dr``."""
+        f = "dpsm_create_axisymmetric"
+        return cls._create(f, "axisymmetric", _c_int64(nr, "nr", f), float(dr))
+
+    def close(self):
+        """``dpsm_destroy``: releases the grid; later calls on it fail with
+        ``DPSM_ERR_NULL_POINTER``. Closing twice is allowed."""
+        handle, self._handle = self._handle, None
+        if handle:
+            lib.dpsm_destroy(handle)
+
+    destroy = close
+
+    @property
+    def closed(self):
+        return not self._handle
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+        return False
+
+    def __del__(self):
+        if getattr(self, "_handle", None):
+            try:
+                self.close()
+            except Exception:  # at interpreter exit the library may be gone
+                pass
+
+    def __repr__(self):
+        state = "closed" if self.closed else "nx=%d, ny=%d" % (self.nx, self.ny)
+        return "<dpsm.Grid %s %s>" % (self.kind, state)
+
+    @property
+    def shape(self):
+        """The shape of this grid's arrays: ``(ny, nx)`` in 2D, ``(nx,)`` otherwise."""
+        return (self.ny, self.nx) if self.kind == "2d" else (self.nx,)
+
+    def _call(self, function, *args):
+        _check(getattr(lib, function)(self._handle, *args), function, self._handle)
+
+    # ---- parameters ----------------------------------------------------------
+
+    def set_repose_angle(self, theta_radians):
+        """``dpsm_set_repose_angle``: the angle of repose, strictly between 0 and pi/2."""
+        self._call("dpsm_set_repose_angle", float(theta_radians))
+
+    def set_mobility(self, nu):
+        """``dpsm_set_mobility``: the mobility ``nu``, finite and positive."""
+        self._call("dpsm_set_mobility", float(nu))
+
+    def set_scheme(self, scheme):
+        """``dpsm_set_scheme``: ``SCHEME_ISOTROPIC`` (the default) or ``SCHEME_PAIRWISE``."""
+        f = "dpsm_set_scheme"
+        self._call(f, _c_int(scheme, "scheme", f, C.DPSM_ERR_UNKNOWN_ENUM))
+
+    def set_boundary(self, side, kind):
+        """``dpsm_set_boundary``: side ``XMIN``, ``XMAX``, ``YMIN`` or ``YMAX``; kind ``OPEN`` or ``WALL``."""
+        f = "dpsm_set_boundary"
+        self._call(f, _c_int(side, "side", f, C.DPSM_ERR_UNKNOWN_ENUM), _c_int(kind, "kind", f, C.DPSM_ERR_UNKNOWN_ENUM))
+
+    def set_rest_tolerance(self, tol):
+        """``dpsm_set_rest_tolerance``: finite and positive."""
+        self._call("dpsm_set_rest_tolerance", float(tol))
+
+    def set_max_substeps(self, n):
+        """``dpsm_set_max_substeps``: at least 1."""
+        f = "dpsm_set_max_substeps"
+        self._call(f, _c_int64(n, "n", f, C.DPSM_ERR_INVALID_VALUE))
+
+    def set_threads(self, n):
+        """``dpsm_set_threads``: at least 0; 0 means OpenMP's default."""
+        f = "dpsm_set_threads"
+        self._call(f, _c_int(n, "n", f, C.DPSM_ERR_INVALID_VALUE))
+
+    # ---- arrays --------------------------------------------------------------
+
+    def _block_shape(self, ni, nj):
+        """The array shape of a block, as in numpy: (nj, ni) in 2D, (ni,) otherwise."""
+        return (nj, ni) if self.kind == "2d" else (ni,)
+
+    def _doubles_in(self, values, shape, name, function):
+        """(pointer, keep-alive) for C from an array of ``shape``."""
+        count = 1
+        for n in shape:
+            count *= n
+        if np is not None:
+            array = np.ascontiguousarray(values, dtype=np.float64)
+            if array.shape != tuple(shape) and array.shape != (count,):
+                raise _shape_error(function, name, "shape %s" % (array.shape,), _rows_columns(shape))
+            return array.ctypes.data_as(_P_DOUBLE), array
+        flat = _flatten(values, _rows_columns(shape), name, function)
+        buffer = (ctypes.c_double * count)(*[float(v) for v in flat])
+        return buffer, buffer
+
+    def _doubles_out(self, shape, out, name, function):
+        """(pointer, result, finish) for C to fill an array of ``shape``."""
+        count = 1
+        for n in shape:
+            count *= n
+        if out is not None:
+            view = memoryview(out)
+            if view.readonly or not view.c_contiguous or view.format not in ("d", "<d", "=d", "@d"):
+                raise TypeError("%s: out must be a writable C-contiguous array of float64" % function)
+            if view.shape != tuple(shape) and view.shape != (count,):
+                raise _shape_error(function, "out", "shape %s" % (view.shape,), _rows_columns(shape))
+            buffer = (ctypes.c_double * count).from_buffer(out)
+            return buffer, out, None
+        if np is not None:
+            array = np.empty(shape, dtype=np.float64)
+            return array.ctypes.data_as(_P_DOUBLE), array, None
+        buffer = (ctypes.c_double * count)()
+
+        def finish():
+            flat = list(buffer)
+            if len(shape) == 1:
+                return flat
+            rows, columns = shape
+            return [flat[j * columns:(j + 1) * columns] for j in range(rows)]
+
+        return buffer, None, finish
+
+    def set_cell_kinds(self, kinds=None):
+        """``dpsm_set_cell_kinds``: one of ``CELL_SAND``, ``CELL_WALL``,
+        ``CELL_OPEN`` per cell; ``None`` makes every cell sand."""
+        f = "dpsm_set_cell_kinds"
+        if kinds is None:
+            self._call(f, None)
+            return
+        shape = self.shape
+        count = self.nx * self.ny
+        if np is not None:
+            array = np.asarray(kinds)
+            if array.shape != shape and array.shape != (count,):
+                raise _shape_error(f, "kinds", "shape %s" % (array.shape,), _rows_columns(shape))
+            if array.size and (array.min() < 0 or array.max() > 255):
+                raise Error(C.DPSM_ERR_UNKNOWN_ENUM, "kinds holds values outside 0..255", f)
+            array = np.ascontiguousarray(array, dtype=np.uint8)
+            self._call(f, array.ctypes.data_as(_P_UINT8))
+            return
+        flat = [operator.index(k) for k in _flatten(kinds, _rows_columns(shape), "kinds", f)]
+        if any(k < 0 or k > 255 for k in flat):
+            raise Error(C.DPSM_ERR_UNKNOWN_ENUM, "kinds holds values outside 0..255", f)
+        self._call(f, (ctypes.c_uint8 * count)(*flat))
+
+    def set_heights(self, h):
+        """``dpsm_set_heights``: the height of every cell, an array of ``shape``."""
+        f = "dpsm_set_heights"
+        pointer, keep = self._doubles_in(h, self.shape, "h", f)
+        self._call(f, pointer)
+        del keep
+
+    def get_heights(self, out=None):
+        """``dpsm_get_heights``: the height of every cell, as an array of
+        ``shape`` (a numpy array, or lists without numpy). ``out``, a writable
+        float64 buffer of ``shape`` or of ``nx*ny`` values (a numpy array, an
+        ``array.array('d')``), is filled and returned instead."""
+        f = "dpsm_get_heights"
+        pointer, result, finish = self._doubles_out(self.shape, out, "h", f)
+        self._call(f, pointer)
+        return finish() if finish else result
+
+    def set_source(self, q=None):
+        """``dpsm_set_source``: height per unit time added to each cell
+        (deposition > 0, erosion < 0); ``None`` removes the source."""
+        f = "dpsm_set_source"
+        if q is None:
+            self._call(f, None)
+            return
+        pointer, keep = self._doubles_in(q, self.shape, "q", f)
+        self._call(f, pointer)
+        del keep
+
+    def _block(self, function, i0, j0, ni, nj):
+        block = (
+            _c_int64(i0, "i0", function),
+            _c_int64(j0, "j0", function),
+            _c_int64(ni, "ni", function),
+            _c_int64(nj, "nj", function),
+        )
+        if block[2] < 1 or block[3] < 1:
+            # No array has that shape: let the library refuse the block, with its message.
+            self._call(function, *block, (ctypes.c_double * 1)())
+        return block
+
+    def set_heights_region(self, i0, j0, ni, nj, h):
+        """``dpsm_set_heights_region``: the heights of the block of ``ni`` by
+        ``nj`` cells from cell ``(i0, j0)`` (0-based), ``h`` of shape
+        ``(nj, ni)`` in 2D (``(ni,)`` otherwise) or ``ni*nj`` values."""
+        f = "dpsm_set_heights_region"
+        block = self._block(f, i0, j0, ni, nj)
+        pointer, keep = self._doubles_in(h, self._block_shape(block[2], block[3]), "h", f)
+        self._call(f, *block, pointer)
+        del keep
+
+    def add_heights_region(self, i0, j0, ni, nj, dh):
+        """``dpsm_add_heights_region``: adds ``dh`` to a block (deposition > 0, erosion < 0)."""
+        f = "dpsm_add_heights_region"
+        block = self._block(f, i0, j0, ni, nj)
+        pointer, keep = self._doubles_in(dh, self._block_shape(block[2], block[3]), "dh", f)
+        self._call(f, *block, pointer)
+        del keep
+
+    def get_heights_region(self, i0, j0, ni, nj, out=None):
+        """``dpsm_get_heights_region``: the heights of a block, shape ``(nj, ni)`` in 2D (``(ni,)`` otherwise)."""
+        f = "dpsm_get_heights_region"
+        block = self._block(f, i0, j0, ni, nj)
+        pointer, result, finish = self._doubles_out(self._block_shape(block[2], block[3]), out, "h", f)
+        self._call(f, *block, pointer)
+        return finish() if finish else result
+
+    # ---- stepping and reading back -------------------------------------------
+
+    def stable_dt(self):
+        """``dpsm_stable_dt``: the largest stable explicit sub-step."""
+        value = ctypes.c_double()
+        self._call("dpsm_stable_dt", ctypes.byref(value))
+        return value.value
+
+    def step(self, dt):
+        """``dpsm_step``: advances the surface by exactly ``dt``."""
+        self._call("dpsm_step", float(dt))
+
+    def get_mass(self, quantity):
+        """``dpsm_get_mass``: ``MASS_TOTAL``, ``MASS_SOURCED``, ``MASS_EXTERNAL`` or ``MASS_OUTFLOW``."""
+        f = "dpsm_get_mass"
+        value = ctypes.c_double()
+        self._call(f, _c_int(quantity, "quantity", f, C.DPSM_ERR_UNKNOWN_ENUM), ctypes.byref(value))
+        return value.value
+
+    def get_step_info(self, item):
+        """``dpsm_get_step_info``: ``INFO_SUBSTEPS``, ``INFO_TIME_INTEGRATED``,
+        ``INFO_AT_REST`` or ``INFO_MAX_EXCESS_SLOPE`` of the last step."""
+        f = "dpsm_get_step_info"
+        value = ctypes.c_double()
+        self._call(f, _c_int(item, "item", f, C.DPSM_ERR_UNKNOWN_ENUM), ctypes.byref(value))
+        return value.value
+
+    def get_shape(self):
+        """``dpsm_get_shape``: ``(nx, ny)``, as C gives them (``ny`` is 1 on 1D grids)."""
+        nx, ny = ctypes.c_int64(), ctypes.c_int64()
+        self._call("dpsm_get_shape", ctypes.byref(nx), ctypes.byref(ny))
+        return nx.value, ny.value
+
+    def last_error(self):
+        """``dpsm_last_error``: the message of the last failed call on this grid, ``""`` if it succeeded."""
+        return _text(lib.dpsm_last_error(self._handle))
+
+
+def _rows_columns(shape):
+    return (None, shape[0]) if len(shape) == 1 else (shape[0], shape[1])

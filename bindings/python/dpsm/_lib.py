@@ -1,0 +1,129 @@
+"""Loads libdpsm and declares every C function of dpsm.h to ctypes.
+
+The library is looked for, in this order:
+
+1. the file named by the environment variable ``DPSM_LIBRARY`` (and nowhere
+   else when it is set);
+2. next to this package: ``_libpath.py``, written by ``cmake --install``,
+   holds the path of the installed library relative to this directory, so an
+   installed tree may be moved;
+3. the system's search path (``ctypes.util.find_library("dpsm")``, then
+   ``libdpsm.so.<major>``).
+"""
+
+import ctypes
+import ctypes.util
+import os
+import sys
+
+# The major version (the soname) of the C API these declarations describe.
+ABI_MAJOR = 0
+
+
+class GridStruct(ctypes.Structure):
+    """The opaque ``struct dpsm_grid``; only pointers to it are used."""
+
+
+GridPtr = ctypes.POINTER(GridStruct)
+
+_int = ctypes.c_int
+_i64 = ctypes.c_int64
+_dbl = ctypes.c_double
+_P = ctypes.POINTER
+
+# Every function of dpsm.h: name -> (restype, argtypes), in the header's order.
+SIGNATURES = {
+    "dpsm_create_1d": (_int, [_i64, _dbl, _P(GridPtr)]),
+    "dpsm_create_2d": (_int, [_i64, _i64, _dbl, _dbl, _P(GridPtr)]),
+    "dpsm_create_axisymmetric": (_int, [_i64, _dbl, _P(GridPtr)]),
+    "dpsm_destroy": (None, [GridPtr]),
+    "dpsm_set_repose_angle": (_int, [GridPtr, _dbl]),
+    "dpsm_set_mobility": (_int, [GridPtr, _dbl]),
+    "dpsm_set_scheme": (_int, [GridPtr, _int]),
+    "dpsm_set_boundary": (_int, [GridPtr, _int, _int]),
+    "dpsm_set_cell_kinds": (_int, [GridPtr, _P(ctypes.c_uint8)]),
+    "dpsm_set_heights": (_int, [GridPtr, _P(_dbl)]),
+    "dpsm_get_heights": (_int, [GridPtr, _P(_dbl)]),
+    "dpsm_set_heights_region": (_int, [GridPtr, _i64, _i64, _i64, _i64, _P(_dbl)]),
+    "dpsm_add_heights_region": (_int, [GridPtr, _i64, _i64, _i64, _i64, _P(_dbl)]),
+    "dpsm_get_heights_region": (_int, [GridPtr, _i64, _i64, _i64, _i64, _P(_dbl)]),
+    "dpsm_set_source": (_int, [GridPtr, _P(_dbl)]),
+    "dpsm_stable_dt": (_int, [GridPtr, _P(_dbl)]),
+    "dpsm_step": (_int, [GridPtr, _dbl]),
+    "dpsm_get_mass": (_int, [GridPtr, _int, _P(_dbl)]),
+    "dpsm_get_step_info": (_int, [GridPtr, _int, _P(_dbl)]),
+    "dpsm_get_shape": (_int, [GridPtr, _P(_i64), _P(_i64)]),
+    "dpsm_set_rest_tolerance": (_int, [GridPtr, _dbl]),
+    "dpsm_set_max_substeps": (_int, [GridPtr, _i64]),
+    "dpsm_set_threads": (_int, [GridPtr, _int]),
+    "dpsm_last_error": (ctypes.c_char_p, [GridPtr]),
+    "dpsm_status_string": (ctypes.c_char_p, [_int]),
+    "dpsm_version_string": (ctypes.c_char_p, []),
+    "dpsm_version_number": (_int, []),
+}
+
+
+def _system_names():
+    if sys.platform == "win32":
+        return ["dpsm.dll", "libdpsm.dll"]
+    if sys.platform == "darwin":
+        return ["libdpsm.%d.dylib" % ABI_MAJOR]
+    return ["libdpsm.so.%d" % ABI_MAJOR]
+
+
+def _candidates():
+    """(path or name, how it was found) in the order they are tried."""
+    env = os.environ.get("DPSM_LIBRARY")
+    if env:
+        return [(env, "DPSM_LIBRARY")]
+    found = []
+    try:
+        from . import _libpath  # written by cmake --install
+    except ImportError:
+        _libpath = None
+    if _libpath is not None:
+        here = os.path.dirname(os.path.abspath(__file__))
+        found.append((os.path.normpath(os.path.join(here, _libpath.LIBRARY)), "next to the package"))
+    name = ctypes.util.find_library("dpsm")
+    if name:
+        found.append((name, "the system path"))
+    for name in _system_names():
+        found.append((name, "the system path"))
+    return found
+
+
+def _load():
+    tried = []
+    for path, how in _candidates():
+        try:
+            lib = ctypes.CDLL(path)
+        except OSError as e:
+            tried.append("%s (%s): %s" % (path, how, e))
+            continue
+        return lib, path
+    raise ImportError(
+        "dpsm: cannot load the dpsm C library; tried:\n  "
+        + "\n  ".join(tried)
+        + "\nSet DPSM_LIBRARY to the path of libdpsm.so, or install dpsm with cmake --install "
+        "(the package then finds the library next to itself)."
+    )
+
+
+def _declare(lib):
+    for name, (restype, argtypes) in SIGNATURES.items():
+        try:
+            function = getattr(lib, name)
+        except AttributeError:
+            raise ImportError("dpsm: %s has no function %s: the library is older than this package" % (LIBRARY, name))
+        function.restype = restype
+        function.argtypes = argtypes
+    major = lib.dpsm_version_number() // 10000
+    if major != ABI_MAJOR:
+        raise ImportError(
+            "dpsm: %s is version %s, major %d; this package needs major version %d"
+            % (LIBRARY, lib.dpsm_version_string().decode(), major, ABI_MAJOR)
+        )
+
+
+lib, LIBRARY = _load()
+_declare(lib)

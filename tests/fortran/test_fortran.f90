@@ -1,0 +1,456 @@
+! Calls every routine of the Fortran module `dpsm` (bindings/fortran/dpsm.f90)
+! with good and bad arguments and checks the results, so the module cannot
+! drift from the C API. check_module.py also fails when a function of dpsm.h
+! is not called here. Exits non-zero when any check fails.
+program test_fortran
+  use, intrinsic :: iso_c_binding, only: c_double, c_int, c_int8_t, c_int32_t, c_int64_t
+  use, intrinsic :: iso_fortran_env, only: error_unit
+  use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
+  use dpsm
+  implicit none
+
+  integer :: failures = 0
+  real(c_double), parameter :: pi = 3.14159265358979323846_c_double
+
+  call test_versions_and_status()
+  call test_create_failures()
+  call test_2d()
+  call test_regions()
+  call test_cell_kinds_and_sources()
+  call test_open_sides()
+  call test_1d()
+  call test_axisymmetric()
+  call test_destroyed()
+
+  if (failures > 0) then
+    write (error_unit, '(i0, a)') failures, ' check(s) failed'
+    error stop 1
+  end if
+  print '(a)', 'test_fortran: all checks passed'
+
+contains
+
+  subroutine expect(condition, what)
+    logical, intent(in) :: condition
+    character(len=*), intent(in) :: what
+    if (.not. condition) then
+      failures = failures + 1
+      write (error_unit, '(2a)') 'FAILED: ', what
+    end if
+  end subroutine expect
+
+  logical function close_to(a, b, rtol)
+    real(c_double), intent(in) :: a, b, rtol
+    close_to = abs(a - b) <= rtol*max(abs(a), abs(b), tiny(1.0_c_double))
+  end function close_to
+
+  !> The mass ledger closes: TOTAL == SOURCED + EXTERNAL - OUTFLOW.
+  subroutine expect_ledger(g, what)
+    type(dpsm_grid), intent(in) :: g
+    character(len=*), intent(in) :: what
+    real(c_double) :: total, sourced, external, outflow
+    integer :: ierr(4)
+    call dpsm_get_mass(g, DPSM_MASS_TOTAL, total, ierr(1))
+    call dpsm_get_mass(g, DPSM_MASS_SOURCED, sourced, ierr(2))
+    call dpsm_get_mass(g, DPSM_MASS_EXTERNAL, external, ierr(3))
+    call dpsm_get_mass(g, DPSM_MASS_OUTFLOW, outflow, ierr(4))
+    call expect(all(ierr == DPSM_OK), what//': dpsm_get_mass')
+    call expect(abs(total - (sourced + external - outflow)) <= 1e-12_c_double*max(abs(total), 1.0_c_double), &
+                what//': TOTAL == SOURCED + EXTERNAL - OUTFLOW')
+  end subroutine expect_ledger
+
+  subroutine test_versions_and_status()
+    character(len=:), allocatable :: s
+    call expect(dpsm_version_string() == DPSM_HEADER_VERSION_STRING, 'dpsm_version_string() == header version')
+    call expect(dpsm_version_number() == DPSM_HEADER_VERSION_NUMBER, 'dpsm_version_number() == header version')
+    call expect(DPSM_HEADER_VERSION_NUMBER == DPSM_VERSION_MAJOR*10000 + DPSM_VERSION_MINOR*100 + DPSM_VERSION_PATCH, &
+                'DPSM_HEADER_VERSION_NUMBER from MAJOR, MINOR, PATCH')
+    s = dpsm_status_string(DPSM_OK)
+    call expect(s == 'DPSM_OK', 'dpsm_status_string(DPSM_OK) is '//s)
+    call expect(dpsm_status_string(DPSM_ERR_NULL_POINTER) == 'DPSM_ERR_NULL_POINTER', 'status NULL_POINTER')
+    call expect(dpsm_status_string(DPSM_ERR_INVALID_VALUE) == 'DPSM_ERR_INVALID_VALUE', 'status INVALID_VALUE')
+    call expect(dpsm_status_string(DPSM_ERR_INVALID_SIZE) == 'DPSM_ERR_INVALID_SIZE', 'status INVALID_SIZE')
+    call expect(dpsm_status_string(DPSM_ERR_UNKNOWN_ENUM) == 'DPSM_ERR_UNKNOWN_ENUM', 'status UNKNOWN_ENUM')
+    call expect(dpsm_status_string(DPSM_ERR_NOT_APPLICABLE) == 'DPSM_ERR_NOT_APPLICABLE', 'status NOT_APPLICABLE')
+    call expect(dpsm_status_string(DPSM_ERR_WORK_LIMIT) == 'DPSM_ERR_WORK_LIMIT', 'status WORK_LIMIT')
+    call expect(dpsm_status_string(DPSM_ERR_OUT_OF_MEMORY) == 'DPSM_ERR_OUT_OF_MEMORY', 'status OUT_OF_MEMORY')
+    call expect(dpsm_status_string(DPSM_ERR_INTERNAL) == 'DPSM_ERR_INTERNAL', 'status INTERNAL')
+    call expect(dpsm_status_string(12345_c_int) == 'unknown status', 'dpsm_status_string(12345)')
+  end subroutine test_versions_and_status
+
+  subroutine test_create_failures()
+    type(dpsm_grid) :: g
+    integer :: ierr
+    call dpsm_create_1d(g, 0_c_int64_t, 0.1_c_double, ierr)
+    call expect(ierr == DPSM_ERR_INVALID_SIZE, 'dpsm_create_1d(nx = 0) fails with INVALID_SIZE')
+    call expect(.not. dpsm_associated(g), 'a failed create leaves no grid')
+    call expect(len(dpsm_last_error()) > 0, 'a failed create leaves a message in dpsm_last_error()')
+    call expect(len(dpsm_last_error(g)) > 0, 'dpsm_last_error(empty grid) is dpsm_last_error(NULL)')
+    call dpsm_create_2d(g, 4, 4, -1.0_c_double, 0.1_c_double, ierr)
+    call expect(ierr == DPSM_ERR_INVALID_VALUE, 'dpsm_create_2d(dx < 0) fails with INVALID_VALUE')
+    call dpsm_create_2d(g, 4_c_int64_t, -2_c_int64_t, 0.1_c_double, 0.1_c_double, ierr)
+    call expect(ierr == DPSM_ERR_INVALID_SIZE, 'dpsm_create_2d(ny < 0) fails with INVALID_SIZE')
+    call dpsm_create_axisymmetric(g, -3, 0.1_c_double, ierr)
+    call expect(ierr == DPSM_ERR_INVALID_SIZE, 'dpsm_create_axisymmetric(nr < 0) fails with INVALID_SIZE')
+    call dpsm_create_axisymmetric(g, 3_c_int64_t, 0.0_c_double, ierr)
+    call expect(ierr == DPSM_ERR_INVALID_VALUE, 'dpsm_create_axisymmetric(dr = 0) fails with INVALID_VALUE')
+    call expect(.not. dpsm_associated(g), 'still no grid')
+  end subroutine test_create_failures
+
+  subroutine test_2d()
+    integer, parameter :: nx = 24, ny = 20
+    real(c_double), parameter :: dx = 0.1_c_double, dy = 0.125_c_double, theta = 0.6_c_double, nu = 2.0_c_double
+    type(dpsm_grid) :: g
+    real(c_double) :: h(nx, ny), h2(nx, ny), flat(nx*ny), wrong(ny, nx), big(2*nx, ny)
+    real(c_double) :: dt, value, total, external, slope_excess
+    integer(c_int64_t) :: nx64, ny64
+    integer(c_int32_t) :: nx32, ny32
+    integer :: ierr, i, j
+    character(len=:), allocatable :: message
+
+    call dpsm_create_2d(g, nx, ny, dx, dy, ierr)
+    call expect(ierr == DPSM_OK .and. dpsm_associated(g), 'dpsm_create_2d (default integers)')
+    call dpsm_get_shape(g, nx64, ny64, ierr)
+    call expect(ierr == DPSM_OK .and. nx64 == nx .and. ny64 == ny, 'dpsm_get_shape (c_int64_t)')
+    call dpsm_get_shape(g, nx32, ny32)
+    call expect(nx32 == nx .and. ny32 == ny, 'dpsm_get_shape (c_int32_t)')
+
+    ! Parameters: good values pass, bad ones fail with the C status and a message.
+    call dpsm_set_repose_angle(g, 2.0_c_double, ierr)
+    call expect(ierr == DPSM_ERR_INVALID_VALUE, 'dpsm_set_repose_angle(2) fails')
+    call expect(len(dpsm_last_error(g)) > 0, 'a failed call leaves a message on its grid')
+    call dpsm_set_repose_angle(g, theta, ierr)
+    call expect(ierr == DPSM_OK, 'dpsm_set_repose_angle')
+    call expect(dpsm_last_error(g) == '', 'a successful call clears the message')
+    call dpsm_set_mobility(g, -1.0_c_double, ierr)
+    call expect(ierr == DPSM_ERR_INVALID_VALUE, 'dpsm_set_mobility(-1) fails')
+    call dpsm_set_mobility(g, nu)
+    call dpsm_set_scheme(g, 7_c_int, ierr)
+    call expect(ierr == DPSM_ERR_UNKNOWN_ENUM, 'dpsm_set_scheme(7) fails')
+    call dpsm_set_scheme(g, DPSM_SCHEME_PAIRWISE, ierr)
+    call expect(ierr == DPSM_OK, 'dpsm_set_scheme(PAIRWISE)')
+    call dpsm_set_scheme(g, DPSM_SCHEME_ISOTROPIC, ierr)
+    call expect(ierr == DPSM_OK, 'dpsm_set_scheme(ISOTROPIC)')
+    call dpsm_set_boundary(g, 9_c_int, DPSM_OPEN, ierr)
+    call expect(ierr == DPSM_ERR_UNKNOWN_ENUM, 'dpsm_set_boundary(side 9) fails')
+    call dpsm_set_boundary(g, DPSM_XMIN, 5_c_int, ierr)
+    call expect(ierr == DPSM_ERR_UNKNOWN_ENUM, 'dpsm_set_boundary(kind 5) fails')
+    call dpsm_set_boundary(g, DPSM_YMAX, DPSM_WALL, ierr)
+    call expect(ierr == DPSM_OK, 'dpsm_set_boundary(YMAX, WALL)')
+    call dpsm_set_rest_tolerance(g, 0.0_c_double, ierr)
+    call expect(ierr == DPSM_ERR_INVALID_VALUE, 'dpsm_set_rest_tolerance(0) fails')
+    call dpsm_set_rest_tolerance(g, DPSM_DEFAULT_REST_TOLERANCE, ierr)
+    call expect(ierr == DPSM_OK, 'dpsm_set_rest_tolerance')
+    call dpsm_set_max_substeps(g, 0, ierr)
+    call expect(ierr == DPSM_ERR_INVALID_VALUE, 'dpsm_set_max_substeps(0) fails')
+    call dpsm_set_max_substeps(g, DPSM_DEFAULT_MAX_SUBSTEPS, ierr)
+    call expect(ierr == DPSM_OK, 'dpsm_set_max_substeps (c_int64_t)')
+    call dpsm_set_threads(g, -1_c_int, ierr)
+    call expect(ierr == DPSM_ERR_INVALID_VALUE, 'dpsm_set_threads(-1) fails')
+    call dpsm_set_threads(g, 2_c_int, ierr)
+    call expect(ierr == DPSM_OK, 'dpsm_set_threads(2)')
+
+    call dpsm_stable_dt(g, dt, ierr)
+    call expect(ierr == DPSM_OK .and. close_to(dt, 1/(2*nu*cos(theta)*(1/dx**2 + 1/dy**2)), 1e-12_c_double), &
+                'dpsm_stable_dt is 1 / (2 nu cos(theta) (1/dx^2 + 1/dy^2))')
+
+    ! Before the first step every item of the step information is 0.
+    call dpsm_get_step_info(g, DPSM_INFO_SUBSTEPS, value, ierr)
+    call expect(ierr == DPSM_OK .and. value == 0, 'dpsm_get_step_info before a step')
+    call dpsm_get_step_info(g, 9_c_int, value, ierr)
+    call expect(ierr == DPSM_ERR_UNKNOWN_ENUM, 'dpsm_get_step_info(9) fails')
+    call dpsm_get_mass(g, 9_c_int, value, ierr)
+    call expect(ierr == DPSM_ERR_UNKNOWN_ENUM, 'dpsm_get_mass(9) fails')
+
+    ! A steep cone, h(i, j) is cell (i-1, j-1): x fastest, as in C.
+    do j = 1, ny
+      do i = 1, nx
+        h(i, j) = max(0.0_c_double, 1.5_c_double - 3*hypot((i - 12)*dx, (j - 10)*dy))
+      end do
+    end do
+    call dpsm_set_heights(g, h, ierr)
+    call expect(ierr == DPSM_OK, 'dpsm_set_heights(h(nx, ny))')
+    h2 = -1
+    call dpsm_get_heights(g, h2, ierr)
+    call expect(ierr == DPSM_OK .and. all(h2 == h), 'dpsm_get_heights(h(nx, ny)) gives back what was set')
+    call dpsm_get_heights(g, flat, ierr)
+    call expect(ierr == DPSM_OK .and. all(flat == reshape(h, [nx*ny])), 'dpsm_get_heights(h(nx*ny))')
+    big = -1
+    call dpsm_get_heights(g, big(1:2*nx:2, :), ierr)
+    call expect(ierr == DPSM_OK .and. all(big(1:2*nx:2, :) == h) .and. all(big(2:2*nx:2, :) == -1), &
+                'dpsm_get_heights into a non-contiguous section')
+    call dpsm_set_heights(g, big(1:2*nx:2, :), ierr)
+    call expect(ierr == DPSM_OK, 'dpsm_set_heights from a non-contiguous section')
+    call dpsm_set_heights(g, flat, ierr)
+    call expect(ierr == DPSM_OK, 'dpsm_set_heights(h(nx*ny))')
+
+    ! An array of the wrong shape is refused before C is called, with a clear message.
+    wrong = 7
+    call dpsm_set_heights(g, wrong, ierr)
+    call expect(ierr == DPSM_ERR_INVALID_SIZE, 'dpsm_set_heights(h(ny, nx)) fails with INVALID_SIZE')
+    message = dpsm_last_error(g)
+    call expect(index(message, 'shape (20, 24)') > 0 .and. index(message, 'nx = 24, ny = 20') > 0, &
+                'the shape message names both shapes: '//message)
+    call dpsm_get_heights(g, h2, ierr)
+    call expect(all(h2 == h), 'a refused dpsm_set_heights changes nothing')
+    call expect(dpsm_last_error(g) == '', 'the next successful call clears the shape message')
+    call dpsm_get_heights(g, flat(1:nx), ierr)
+    call expect(ierr == DPSM_ERR_INVALID_SIZE, 'dpsm_get_heights(h(nx)) on a 2D grid fails')
+    h2 = h
+    h2(3, 4) = ieee_value(h2(3, 4), ieee_quiet_nan)
+    call dpsm_set_heights(g, h2, ierr)
+    call expect(ierr == DPSM_ERR_INVALID_VALUE, 'dpsm_set_heights with a NaN fails with INVALID_VALUE')
+
+    call dpsm_get_mass(g, DPSM_MASS_TOTAL, total, ierr)
+    call expect(ierr == DPSM_OK .and. close_to(total, sum(h)*dx*dy, 1e-12_c_double), 'TOTAL is sum h dx dy')
+    call dpsm_get_mass(g, DPSM_MASS_EXTERNAL, external)
+    call expect(close_to(external, total, 1e-12_c_double), 'EXTERNAL books dpsm_set_heights')
+
+    ! To rest: walls all round, so the mass stays.
+    call dpsm_step(g, 100.0_c_double, ierr)
+    call expect(ierr == DPSM_OK, 'dpsm_step')
+    call dpsm_get_step_info(g, DPSM_INFO_AT_REST, value)
+    call expect(value == 1, 'at rest after a long step')
+    call dpsm_get_step_info(g, DPSM_INFO_SUBSTEPS, value)
+    call expect(value >= 1, 'INFO_SUBSTEPS counts the sub-steps')
+    call dpsm_get_step_info(g, DPSM_INFO_TIME_INTEGRATED, value)
+    call expect(value > 0 .and. value <= 100, 'INFO_TIME_INTEGRATED is in (0, dt]')
+    call dpsm_get_step_info(g, DPSM_INFO_CELL_UPDATES, value)
+    call expect(value >= nx*ny, 'INFO_CELL_UPDATES counts at least one sweep')
+    call dpsm_get_step_info(g, DPSM_INFO_MAX_EXCESS_SLOPE, slope_excess)
+    call expect(slope_excess <= DPSM_DEFAULT_REST_TOLERANCE*tan(theta)*(1 + 1e-9_c_double), &
+                'INFO_MAX_EXCESS_SLOPE within the rest tolerance')
+    call dpsm_get_heights(g, h2)
+    call expect(maxval(h2) < maxval(h), 'the cone slumped')
+    call dpsm_get_mass(g, DPSM_MASS_TOTAL, value)
+    call expect(close_to(value, total, 1e-12_c_double), 'walls all round: the mass stays')
+    call expect_ledger(g, 'after the slump')
+
+    call dpsm_step(g, -1.0_c_double, ierr)
+    call expect(ierr == DPSM_ERR_INVALID_VALUE, 'dpsm_step(-1) fails')
+    call dpsm_destroy(g)
+    call expect(.not. dpsm_associated(g), 'dpsm_destroy empties the grid')
+  end subroutine test_2d
+
+  subroutine test_regions()
+    integer, parameter :: nx = 10, ny = 8
+    type(dpsm_grid) :: g
+    real(c_double) :: h(nx, ny), block(4, 5), block2(4, 5), row(20), wrong(5, 4)
+    integer :: ierr, i, j
+
+    call dpsm_create_2d(g, int(nx, c_int64_t), int(ny, c_int64_t), 1.0_c_double, 1.0_c_double)
+    h = 0
+    call dpsm_set_heights(g, h)
+    do j = 1, 5
+      do i = 1, 4
+        block(i, j) = 0.01_c_double*(i + 10*j)
+      end do
+    end do
+    ! The block of 4 x 5 cells from cell (2, 3), 0-based as in C: h(3:6, 4:8) here.
+    call dpsm_set_heights_region(g, 2_c_int64_t, 3_c_int64_t, 4_c_int64_t, 5_c_int64_t, block, ierr)
+    call expect(ierr == DPSM_OK, 'dpsm_set_heights_region (c_int64_t, rank 2)')
+    call dpsm_get_heights(g, h)
+    call expect(all(h(3:6, 4:8) == block) .and. sum(h) == sum(block), 'the block lands on cells (2..5, 3..7)')
+    block2 = 0
+    call dpsm_get_heights_region(g, 2, 3, 4, 5, block2, ierr)
+    call expect(ierr == DPSM_OK .and. all(block2 == block), 'dpsm_get_heights_region (default integers, rank 2)')
+    row = 0.5_c_double
+    call dpsm_add_heights_region(g, 2, 3, 4, 5, row, ierr)
+    call expect(ierr == DPSM_OK, 'dpsm_add_heights_region (default integers, rank 1)')
+    call dpsm_add_heights_region(g, 2_c_int64_t, 3_c_int64_t, 4_c_int64_t, 5_c_int64_t, block, ierr)
+    call expect(ierr == DPSM_OK, 'dpsm_add_heights_region (c_int64_t, rank 2)')
+    row = 0
+    call dpsm_get_heights_region(g, 2_c_int64_t, 3_c_int64_t, 4_c_int64_t, 5_c_int64_t, row, ierr)
+    call expect(ierr == DPSM_OK .and. all(abs(row - reshape(2*block + 0.5_c_double, [20])) < 1e-15_c_double), &
+                'dpsm_get_heights_region (c_int64_t, rank 1) after two adds')
+    call dpsm_set_heights_region(g, 0, 0, 4, 5, row, ierr)
+    call expect(ierr == DPSM_OK, 'dpsm_set_heights_region (default integers, rank 1)')
+    call dpsm_get_heights(g, h)
+    call expect(all(h(1:4, 1:5) == reshape(row, [4, 5])), 'the block lands on cells (0..3, 0..4)')
+    call expect_ledger(g, 'after the blocks')
+
+    wrong = 1
+    call dpsm_set_heights_region(g, 2, 3, 4, 5, wrong, ierr)
+    call expect(ierr == DPSM_ERR_INVALID_SIZE, 'dpsm_set_heights_region with h(nj, ni) fails')
+    call expect(index(dpsm_last_error(g), 'ni = 4, nj = 5') > 0, 'the message names the block: '//dpsm_last_error(g))
+    call dpsm_add_heights_region(g, 2, 3, 4, 5, row(1:19), ierr)
+    call expect(ierr == DPSM_ERR_INVALID_SIZE, 'dpsm_add_heights_region with 19 values for 20 fails')
+    call dpsm_get_heights_region(g, 8, 0, 4, 5, block2, ierr)
+    call expect(ierr == DPSM_ERR_INVALID_SIZE, 'dpsm_get_heights_region off the grid fails in C')
+    call expect(len(dpsm_last_error(g)) > 0, 'with a message')
+    call dpsm_destroy(g)
+  end subroutine test_regions
+
+  subroutine test_cell_kinds_and_sources()
+    integer, parameter :: nx = 12, ny = 10
+    real(c_double), parameter :: dx = 0.5_c_double, rate = 0.01_c_double, dt = 0.5_c_double
+    type(dpsm_grid) :: g
+    integer(c_int8_t) :: kinds(nx, ny), flat_kinds(nx*ny)
+    real(c_double) :: h(nx, ny), h2(nx, ny), q(nx, ny), sourced, stable, value
+    integer :: ierr
+
+    call dpsm_create_2d(g, nx, ny, dx, dx)
+    h = 0.25_c_double
+    h(5:6, 5:6) = 3
+    call dpsm_set_heights(g, h)
+    kinds = DPSM_CELL_SAND
+    kinds(5:6, 5:6) = DPSM_CELL_WALL
+    kinds(1, 1) = DPSM_CELL_OPEN
+    call dpsm_set_cell_kinds(g, kinds, ierr)
+    call expect(ierr == DPSM_OK, 'dpsm_set_cell_kinds(kinds(nx, ny))')
+    call expect_ledger(g, 'after turning cells into walls')
+    kinds(2, 2) = 7
+    call dpsm_set_cell_kinds(g, kinds, ierr)
+    call expect(ierr == DPSM_ERR_UNKNOWN_ENUM, 'dpsm_set_cell_kinds with a kind 7 fails')
+    call dpsm_set_cell_kinds(g, flat_kinds(1:nx), ierr)
+    call expect(ierr == DPSM_ERR_INVALID_SIZE, 'dpsm_set_cell_kinds(kinds(nx)) on a 2D grid fails')
+    kinds(2, 2) = DPSM_CELL_SAND
+    kinds(1, 1) = DPSM_CELL_SAND
+    flat_kinds = reshape(kinds, [nx*ny])
+    call dpsm_set_cell_kinds(g, flat_kinds, ierr)
+    call expect(ierr == DPSM_OK, 'dpsm_set_cell_kinds(kinds(nx*ny))')
+
+    ! A uniform source: the wall cells neither gain nor move.
+    q = rate
+    call dpsm_set_source(g, q, ierr)
+    call expect(ierr == DPSM_OK, 'dpsm_set_source(q(nx, ny))')
+    call dpsm_step(g, dt, ierr)
+    call expect(ierr == DPSM_OK, 'dpsm_step with a source')
+    call dpsm_get_heights(g, h2)
+    call expect(all(h2(5:6, 5:6) == 3), 'wall cells keep their height')
+    call dpsm_get_mass(g, DPSM_MASS_SOURCED, sourced)
+    call expect(close_to(sourced, rate*dt*(nx*ny - 4)*dx*dx, 1e-12_c_double), &
+                'SOURCED is rate * dt * area of the sand cells')
+    call expect_ledger(g, 'after the source')
+    call dpsm_set_source(g, reshape(q, [nx*ny]), ierr)
+    call expect(ierr == DPSM_OK, 'dpsm_set_source(q(nx*ny))')
+    call dpsm_set_source(g, q(1:nx, 1:ny - 1), ierr)
+    call expect(ierr == DPSM_ERR_INVALID_SIZE, 'dpsm_set_source(q(nx, ny-1)) fails')
+
+    ! A driven scene is limited by dpsm_set_max_substeps.
+    call dpsm_stable_dt(g, stable)
+    call dpsm_set_max_substeps(g, 1, ierr)
+    call expect(ierr == DPSM_OK, 'dpsm_set_max_substeps (default integer)')
+    call dpsm_get_heights(g, h)
+    call dpsm_step(g, 10*stable, ierr)
+    call expect(ierr == DPSM_ERR_WORK_LIMIT, 'a driven step over the sub-step limit fails with WORK_LIMIT')
+    call expect(len(dpsm_last_error(g)) > 0, 'with a message')
+    call dpsm_get_heights(g, h2)
+    call expect(all(h2 == h), 'the refused step changes nothing')
+
+    ! No source: the step is no longer driven, and SOURCED stays.
+    call dpsm_set_source(g, ierr=ierr)
+    call expect(ierr == DPSM_OK, 'dpsm_set_source without q removes the source')
+    call dpsm_step(g, 10*stable, ierr)
+    call expect(ierr == DPSM_OK, 'the same step without a source passes')
+    call dpsm_get_mass(g, DPSM_MASS_SOURCED, value)
+    call expect(close_to(value, sourced, 1e-12_c_double), 'SOURCED unchanged without a source')
+
+    call dpsm_set_cell_kinds(g, ierr=ierr)
+    call expect(ierr == DPSM_OK, 'dpsm_set_cell_kinds without kinds makes every cell sand')
+    call dpsm_get_mass(g, DPSM_MASS_TOTAL, value)
+    call dpsm_get_heights(g, h)
+    call expect(close_to(value, sum(h)*dx*dx, 1e-12_c_double), 'every cell counts again')
+    call expect_ledger(g, 'after all sand again')
+    call dpsm_destroy(g)
+  end subroutine test_cell_kinds_and_sources
+
+  subroutine test_open_sides()
+    integer, parameter :: n = 16
+    type(dpsm_grid) :: g
+    real(c_double) :: h(n, n), outflow
+    call dpsm_create_2d(g, n, n, 0.1_c_double, 0.1_c_double)
+    call dpsm_set_boundary(g, DPSM_XMIN, DPSM_OPEN)
+    call dpsm_set_boundary(g, DPSM_XMAX, DPSM_OPEN)
+    call dpsm_set_boundary(g, DPSM_YMIN, DPSM_OPEN)
+    call dpsm_set_boundary(g, DPSM_YMAX, DPSM_OPEN)
+    h = 2
+    call dpsm_set_heights(g, h)
+    call dpsm_step(g, 1e3_c_double)
+    call dpsm_get_mass(g, DPSM_MASS_OUTFLOW, outflow)
+    call expect(outflow > 0, 'sand leaves through open sides')
+    call expect_ledger(g, 'open sides')
+    call dpsm_destroy(g)
+  end subroutine test_open_sides
+
+  subroutine test_1d()
+    integer, parameter :: nx = 30
+    real(c_double), parameter :: dx = 0.2_c_double
+    type(dpsm_grid) :: g
+    real(c_double) :: h(nx), h2(nx), dt, total
+    integer(c_int64_t) :: n1, n2
+    integer :: ierr
+    call dpsm_create_1d(g, int(nx, c_int64_t), dx, ierr)
+    call expect(ierr == DPSM_OK, 'dpsm_create_1d (c_int64_t)')
+    call dpsm_get_shape(g, n1, n2)
+    call expect(n1 == nx .and. n2 == 1, 'a 1D grid has ny = 1')
+    call dpsm_stable_dt(g, dt)
+    call expect(close_to(dt, dx**2/(2*DPSM_DEFAULT_MOBILITY*cos(DPSM_DEFAULT_REPOSE_ANGLE)), 1e-12_c_double), &
+                '1D: dpsm_stable_dt is dx^2 / (2 nu cos(theta)) with the defaults')
+    call dpsm_set_boundary(g, DPSM_YMIN, DPSM_OPEN, ierr)
+    call expect(ierr == DPSM_ERR_NOT_APPLICABLE, '1D: a y side is not applicable')
+    call dpsm_destroy(g)
+    call dpsm_create_1d(g, nx, dx) ! default integer
+    call dpsm_set_boundary(g, DPSM_XMAX, DPSM_OPEN)
+    h = 1
+    h(1:5) = 4
+    call dpsm_set_heights(g, h)
+    call dpsm_step(g, 1e3_c_double)
+    call dpsm_get_heights(g, h2)
+    call expect(h2(1) < 4 .and. all(h2 >= 0), '1D: the step moved sand')
+    call dpsm_get_mass(g, DPSM_MASS_TOTAL, total)
+    call expect(close_to(total, sum(h2)*dx, 1e-12_c_double), '1D: TOTAL is sum h dx')
+    call expect_ledger(g, '1D')
+    call dpsm_destroy(g)
+  end subroutine test_1d
+
+  subroutine test_axisymmetric()
+    integer, parameter :: nr = 20
+    real(c_double), parameter :: dr = 0.05_c_double
+    type(dpsm_grid) :: g
+    real(c_double) :: h(nr), dt, total, volume
+    integer :: ierr, i
+    call dpsm_create_axisymmetric(g, nr, dr, ierr)
+    call expect(ierr == DPSM_OK, 'dpsm_create_axisymmetric (default integers)')
+    call dpsm_destroy(g)
+    call dpsm_create_axisymmetric(g, int(nr, c_int64_t), dr, ierr)
+    call expect(ierr == DPSM_OK, 'dpsm_create_axisymmetric (c_int64_t)')
+    call dpsm_set_boundary(g, DPSM_XMIN, DPSM_OPEN, ierr)
+    call expect(ierr == DPSM_ERR_NOT_APPLICABLE, 'axisymmetric: the axis is not a boundary')
+    call dpsm_set_boundary(g, DPSM_XMAX, DPSM_OPEN, ierr)
+    call expect(ierr == DPSM_OK, 'axisymmetric: the rim may be open')
+    call dpsm_stable_dt(g, dt)
+    call expect(close_to(dt, 3*dr**2/(8*cos(DPSM_DEFAULT_REPOSE_ANGLE)), 1e-12_c_double), &
+                'axisymmetric: dpsm_stable_dt is 3 dr^2 / (8 nu cos(theta))')
+    h = 1
+    call dpsm_set_heights(g, h)
+    volume = 0
+    do i = 1, nr
+      volume = volume + h(i)*2*pi*(i - 0.5_c_double)*dr*dr
+    end do
+    call dpsm_get_mass(g, DPSM_MASS_TOTAL, total)
+    call expect(close_to(total, volume, 1e-12_c_double), 'axisymmetric: TOTAL is sum h 2 pi r dr')
+    call dpsm_step(g, 10.0_c_double)
+    call expect_ledger(g, 'axisymmetric')
+    call dpsm_destroy(g)
+  end subroutine test_axisymmetric
+
+  subroutine test_destroyed()
+    type(dpsm_grid) :: g, empty
+    real(c_double) :: value
+    integer :: ierr
+    call dpsm_create_1d(g, 4, 1.0_c_double)
+    call dpsm_destroy(g, ierr)
+    call expect(ierr == DPSM_OK .and. .not. dpsm_associated(g), 'dpsm_destroy(g, ierr)')
+    call dpsm_destroy(g, ierr)
+    call expect(ierr == DPSM_OK, 'destroying an empty grid does nothing')
+    call dpsm_step(g, 1.0_c_double, ierr)
+    call expect(ierr == DPSM_ERR_NULL_POINTER, 'a call on a destroyed grid fails with NULL_POINTER')
+    call expect(len(dpsm_last_error(g)) > 0, 'with a message')
+    call dpsm_get_mass(empty, DPSM_MASS_TOTAL, value, ierr)
+    call expect(ierr == DPSM_ERR_NULL_POINTER, 'a call on a never-created grid fails with NULL_POINTER')
+    call dpsm_set_heights(empty, [1.0_c_double], ierr)
+    call expect(ierr == DPSM_ERR_NULL_POINTER, 'the shape check of an empty grid fails with NULL_POINTER')
+  end subroutine test_destroyed
+
+end program test_fortran

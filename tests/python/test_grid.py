@@ -1,0 +1,360 @@
+"""Every function of the Python package dpsm, with good and bad arguments.
+
+Runs with numpy (arrays are numpy arrays) and without (lists); run_tests.py
+runs it both ways. test_coverage.py checks that every C function is called here.
+"""
+
+import array
+import math
+import unittest
+
+import dpsm
+
+try:
+    import numpy as np
+except ImportError:
+    np = None
+
+
+def as_list(values):
+    """numpy arrays and lists alike as (nested) lists."""
+    return values.tolist() if hasattr(values, "tolist") else values
+
+
+def flat(values):
+    values = as_list(values)
+    if values and isinstance(values[0], list):
+        return [v for row in values for v in row]
+    return list(values)
+
+
+class LedgerMixin:
+    def assertLedger(self, g):
+        total = g.get_mass(dpsm.MASS_TOTAL)
+        sourced = g.get_mass(dpsm.MASS_SOURCED)
+        external = g.get_mass(dpsm.MASS_EXTERNAL)
+        outflow = g.get_mass(dpsm.MASS_OUTFLOW)
+        self.assertAlmostEqual(total, sourced + external - outflow, delta=1e-12 * max(abs(total), 1.0))
+
+    def assertFails(self, status, call, *args, **kwargs):
+        with self.assertRaises(dpsm.Error) as caught:
+            call(*args, **kwargs)
+        self.assertEqual(caught.exception.status, status, str(caught.exception))
+        self.assertEqual(caught.exception.status_name, dpsm.status_string(status))
+        self.assertTrue(caught.exception.message, "an Error carries the library's message")
+        return caught.exception
+
+
+class TestModule(LedgerMixin, unittest.TestCase):
+    def test_versions(self):
+        self.assertEqual(dpsm.__version__, dpsm.version_string())
+        major, minor, patch = (int(p) for p in dpsm.version_string().split("."))
+        self.assertEqual(dpsm.version_number(), major * 10000 + minor * 100 + patch)
+
+    def test_status_string(self):
+        names = ["OK", "ERR_NULL_POINTER", "ERR_INVALID_VALUE", "ERR_INVALID_SIZE", "ERR_UNKNOWN_ENUM",
+                 "ERR_NOT_APPLICABLE", "ERR_WORK_LIMIT", "ERR_OUT_OF_MEMORY", "ERR_INTERNAL"]
+        for name in names:
+            self.assertEqual(dpsm.status_string(getattr(dpsm, name)), "DPSM_" + name)
+        self.assertEqual(dpsm.status_string(12345), "unknown status")
+        self.assertEqual(dpsm.status_string(2**40), "unknown status")
+
+    def test_constants_under_both_names(self):
+        self.assertEqual(dpsm.DPSM_MASS_TOTAL, dpsm.MASS_TOTAL)
+        for name in dpsm._constants.NAMES:
+            self.assertEqual(getattr(dpsm, name), getattr(dpsm, name[len("DPSM_"):]), name)
+        self.assertIsInstance(dpsm.DEFAULT_MAX_SUBSTEPS, int)
+        self.assertIsInstance(dpsm.DEFAULT_REPOSE_ANGLE, float)
+
+    def test_create_failures(self):
+        e = self.assertFails(dpsm.ERR_INVALID_SIZE, dpsm.Grid.create_1d, 0, 0.1)
+        self.assertEqual(e.function, "dpsm_create_1d")
+        self.assertIn("dpsm_create_1d", str(e))
+        self.assertIn("DPSM_ERR_INVALID_SIZE", str(e))
+        self.assertEqual(dpsm.last_error(), e.message)
+        self.assertFails(dpsm.ERR_INVALID_VALUE, dpsm.Grid.create_2d, 4, 4, -1.0, 0.1)
+        self.assertFails(dpsm.ERR_INVALID_SIZE, dpsm.Grid.create_2d, 4, -2, 0.1, 0.1)
+        self.assertFails(dpsm.ERR_INVALID_VALUE, dpsm.Grid.create_axisymmetric, 3, 0.0)
+        self.assertFails(dpsm.ERR_INVALID_SIZE, dpsm.Grid.create_axisymmetric, -3, 0.1)
+        # Too large for int64_t: refused before ctypes could wrap it.
+        self.assertFails(dpsm.ERR_INVALID_SIZE, dpsm.Grid.create_1d, 2**70, 0.1)
+        with self.assertRaises(TypeError):
+            dpsm.Grid.create_1d(4.5, 0.1)
+        with self.assertRaises(TypeError):
+            dpsm.Grid()
+
+
+class Test2D(LedgerMixin, unittest.TestCase):
+    nx, ny, dx, dy = 24, 20, 0.1, 0.125
+
+    def setUp(self):
+        self.g = dpsm.Grid.create_2d(self.nx, self.ny, self.dx, self.dy)
+        self.cone = [[max(0.0, 1.5 - 3 * math.hypot((i - 12) * self.dx, (j - 10) * self.dy))
+                      for i in range(self.nx)] for j in range(self.ny)]
+
+    def tearDown(self):
+        self.g.close()
+
+    def test_shape(self):
+        self.assertEqual(self.g.get_shape(), (self.nx, self.ny))
+        self.assertEqual(self.g.shape, (self.ny, self.nx))
+        self.assertEqual(self.g.kind, "2d")
+        self.assertIn("nx=24", repr(self.g))
+
+    def test_parameters(self):
+        g = self.g
+        self.assertFails(dpsm.ERR_INVALID_VALUE, g.set_repose_angle, 2.0)
+        self.assertTrue(g.last_error())
+        self.assertEqual(dpsm.last_error(g), g.last_error())
+        g.set_repose_angle(0.6)
+        self.assertEqual(g.last_error(), "")
+        self.assertFails(dpsm.ERR_INVALID_VALUE, g.set_mobility, -1.0)
+        g.set_mobility(2.0)
+        self.assertFails(dpsm.ERR_UNKNOWN_ENUM, g.set_scheme, 7)
+        self.assertFails(dpsm.ERR_UNKNOWN_ENUM, g.set_scheme, 2**40)  # not wrapped into a valid int
+        g.set_scheme(dpsm.SCHEME_PAIRWISE)
+        g.set_scheme(dpsm.DPSM_SCHEME_ISOTROPIC)
+        self.assertFails(dpsm.ERR_UNKNOWN_ENUM, g.set_boundary, 9, dpsm.OPEN)
+        self.assertFails(dpsm.ERR_UNKNOWN_ENUM, g.set_boundary, dpsm.XMIN, 5)
+        for side in (dpsm.XMIN, dpsm.XMAX, dpsm.YMIN, dpsm.YMAX):
+            g.set_boundary(side, dpsm.WALL)
+        self.assertFails(dpsm.ERR_INVALID_VALUE, g.set_rest_tolerance, 0.0)
+        g.set_rest_tolerance(dpsm.DEFAULT_REST_TOLERANCE)
+        self.assertFails(dpsm.ERR_INVALID_VALUE, g.set_max_substeps, 0)
+        g.set_max_substeps(dpsm.DEFAULT_MAX_SUBSTEPS)
+        self.assertFails(dpsm.ERR_INVALID_VALUE, g.set_threads, -1)
+        g.set_threads(2)
+        g.set_threads(0)
+        expected = 1 / (2 * 2.0 * math.cos(0.6) * (1 / self.dx**2 + 1 / self.dy**2))
+        self.assertAlmostEqual(g.stable_dt(), expected, delta=1e-12 * expected)
+
+    def test_heights(self):
+        g = self.g
+        g.set_heights(self.cone)
+        h = g.get_heights()
+        if np is not None:
+            self.assertIsInstance(h, np.ndarray)
+            self.assertEqual(h.shape, (self.ny, self.nx))
+            self.assertEqual(h.dtype, np.float64)
+        else:
+            self.assertIsInstance(h, list)
+            self.assertEqual(len(h), self.ny)
+            self.assertEqual(len(h[0]), self.nx)
+        self.assertEqual(as_list(h), self.cone)
+        # x fastest: row j of the array is cells (0..nx-1, j).
+        self.assertEqual(flat(h)[3 + self.nx * 7], self.cone[7][3])
+        # A flat sequence of nx*ny values, x fastest, is accepted too.
+        g.set_heights(flat(self.cone)[::-1])
+        self.assertEqual(flat(g.get_heights()), flat(self.cone)[::-1])
+        g.set_heights(self.cone)
+
+        # Wrong shapes are refused before C is called; the grid is unchanged.
+        transposed = [list(col) for col in zip(*self.cone)]
+        e = self.assertFails(dpsm.ERR_INVALID_SIZE, g.set_heights, transposed)
+        self.assertIn("(20, 24)", e.message)
+        self.assertFails(dpsm.ERR_INVALID_SIZE, g.set_heights, flat(self.cone)[:-1])
+        self.assertEqual(as_list(g.get_heights()), self.cone)
+        # A NaN is refused by the library.
+        bad = [row[:] for row in self.cone]
+        bad[3][4] = float("nan")
+        e = self.assertFails(dpsm.ERR_INVALID_VALUE, g.set_heights, bad)
+        self.assertEqual(e.function, "dpsm_set_heights")
+        self.assertEqual(as_list(g.get_heights()), self.cone)
+
+        # out: any writable float64 buffer of nx*ny values.
+        out = array.array("d", [0.0]) * (self.nx * self.ny)
+        self.assertIs(g.get_heights(out=out), out)
+        self.assertEqual(list(out), flat(self.cone))
+        with self.assertRaises(TypeError):
+            g.get_heights(out=array.array("f", [0.0]) * (self.nx * self.ny))
+        self.assertFails(dpsm.ERR_INVALID_SIZE, g.get_heights, out=array.array("d", [0.0]) * 5)
+
+        total = g.get_mass(dpsm.MASS_TOTAL)
+        self.assertAlmostEqual(total, sum(flat(self.cone)) * self.dx * self.dy, delta=1e-12 * total)
+        self.assertAlmostEqual(g.get_mass(dpsm.MASS_EXTERNAL), total, delta=1e-12 * total)
+        self.assertFails(dpsm.ERR_UNKNOWN_ENUM, g.get_mass, 9)
+
+    @unittest.skipIf(np is None, "numpy is not importable")
+    def test_numpy_arrays(self):
+        g = self.g
+        cone = np.array(self.cone)
+        g.set_heights(np.asfortranarray(cone))  # any layout is copied to C order
+        np.testing.assert_array_equal(g.get_heights(), cone)
+        g.set_heights(cone.astype(np.float32))
+        np.testing.assert_array_equal(g.get_heights(), cone.astype(np.float32).astype(np.float64))
+        g.set_heights(cone.ravel())
+        out = np.zeros((self.ny, self.nx))
+        self.assertIs(g.get_heights(out=out), out)
+        np.testing.assert_array_equal(out, cone)
+        self.assertFails(dpsm.ERR_INVALID_SIZE, g.set_heights, cone.T)
+        self.assertFails(dpsm.ERR_INVALID_SIZE, g.get_heights, out=np.zeros((self.nx, self.ny)))
+        with self.assertRaises(TypeError):
+            g.get_heights(out=np.zeros((self.ny, self.nx)).T)  # not C-contiguous
+        kinds = np.zeros((self.ny, self.nx), dtype=np.int64)
+        kinds[0, 0] = 300
+        self.assertFails(dpsm.ERR_UNKNOWN_ENUM, g.set_cell_kinds, kinds)
+        kinds[0, 0] = dpsm.CELL_WALL
+        g.set_cell_kinds(kinds)
+
+    def test_step_to_rest(self):
+        g = self.g
+        g.set_repose_angle(0.6)
+        for item in (dpsm.INFO_SUBSTEPS, dpsm.INFO_TIME_INTEGRATED, dpsm.INFO_AT_REST, dpsm.INFO_MAX_EXCESS_SLOPE,
+                     dpsm.INFO_CELL_UPDATES):
+            self.assertEqual(g.get_step_info(item), 0.0)
+        self.assertFails(dpsm.ERR_UNKNOWN_ENUM, g.get_step_info, 9)
+        g.set_heights(self.cone)
+        total = g.get_mass(dpsm.MASS_TOTAL)
+        g.step(100.0)
+        self.assertEqual(g.get_step_info(dpsm.INFO_AT_REST), 1.0)
+        self.assertGreaterEqual(g.get_step_info(dpsm.INFO_SUBSTEPS), 1.0)
+        self.assertGreaterEqual(g.get_step_info(dpsm.INFO_CELL_UPDATES), self.nx * self.ny)
+        self.assertLessEqual(g.get_step_info(dpsm.INFO_TIME_INTEGRATED), 100.0)
+        self.assertLessEqual(g.get_step_info(dpsm.INFO_MAX_EXCESS_SLOPE),
+                             dpsm.DEFAULT_REST_TOLERANCE * math.tan(0.6) * (1 + 1e-9))
+        self.assertLess(max(flat(g.get_heights())), 1.5)
+        self.assertAlmostEqual(g.get_mass(dpsm.MASS_TOTAL), total, delta=1e-12 * total)
+        self.assertLedger(g)
+        self.assertFails(dpsm.ERR_INVALID_VALUE, g.step, -1.0)
+
+    def test_regions(self):
+        g = self.g
+        block = [[0.01 * (i + 10 * j) for i in range(4)] for j in range(5)]  # nj = 5 rows of ni = 4
+        g.set_heights_region(2, 3, 4, 5, block)
+        h = as_list(g.get_heights())
+        self.assertEqual([row[2:6] for row in h[3:8]], block)
+        self.assertEqual(sum(flat(h)), sum(flat(block)))
+        got = g.get_heights_region(2, 3, 4, 5)
+        if np is not None:
+            self.assertEqual(got.shape, (5, 4))
+        self.assertEqual(as_list(got), block)
+        g.add_heights_region(2, 3, 4, 5, [0.5] * 20)
+        g.add_heights_region(2, 3, 4, 5, block)
+        expected = [[2 * v + 0.5 for v in row] for row in block]
+        for a, b in zip(flat(g.get_heights_region(2, 3, 4, 5)), flat(expected)):
+            self.assertAlmostEqual(a, b, delta=1e-15)
+        out = array.array("d", [0.0]) * 20
+        g.get_heights_region(2, 3, 4, 5, out=out)
+        self.assertEqual(list(out), flat(g.get_heights_region(2, 3, 4, 5)))
+        self.assertLedger(g)
+        self.assertFails(dpsm.ERR_INVALID_SIZE, g.set_heights_region, 2, 3, 4, 5, [[1.0] * 5] * 4)
+        self.assertFails(dpsm.ERR_INVALID_SIZE, g.add_heights_region, 2, 3, 4, 5, [1.0] * 19)
+        e = self.assertFails(dpsm.ERR_INVALID_SIZE, g.get_heights_region, 22, 0, 4, 5)
+        self.assertEqual(e.message, g.last_error())  # the library's own message
+        self.assertFails(dpsm.ERR_INVALID_SIZE, g.get_heights_region, 0, 0, 0, 5)
+        self.assertFails(dpsm.ERR_INVALID_SIZE, g.set_heights_region, 0, 0, -1, 5, [])
+        self.assertFails(dpsm.ERR_INVALID_SIZE, g.add_heights_region, 0, 0, 4, 0, [])
+
+    def test_cell_kinds_and_sources(self):
+        g = self.g
+        nx, ny = self.nx, self.ny
+        g.set_heights([[0.25] * nx for _ in range(ny)])
+        kinds = [[dpsm.CELL_SAND] * nx for _ in range(ny)]
+        kinds[5][5] = kinds[5][6] = dpsm.CELL_WALL
+        kinds[0][0] = dpsm.CELL_OPEN
+        g.set_cell_kinds(kinds)
+        self.assertLedger(g)
+        kinds[2][2] = 7
+        self.assertFails(dpsm.ERR_UNKNOWN_ENUM, g.set_cell_kinds, kinds)
+        kinds[2][2] = 256  # would wrap to CELL_SAND in a uint8_t
+        self.assertFails(dpsm.ERR_UNKNOWN_ENUM, g.set_cell_kinds, kinds)
+        kinds[2][2] = dpsm.CELL_SAND
+        kinds[0][0] = dpsm.CELL_SAND
+        self.assertFails(dpsm.ERR_INVALID_SIZE, g.set_cell_kinds, kinds[:-1])
+        g.set_cell_kinds(flat(kinds))
+
+        rate, dt = 0.01, 0.5
+        g.set_source([[rate] * nx for _ in range(ny)])
+        g.step(dt)
+        h = as_list(g.get_heights())
+        self.assertEqual(h[5][5], 0.25)  # a wall cell neither gains nor moves
+        sourced = g.get_mass(dpsm.MASS_SOURCED)
+        expected = rate * dt * (nx * ny - 2) * self.dx * self.dy
+        self.assertAlmostEqual(sourced, expected, delta=1e-12 * expected)
+        self.assertLedger(g)
+        self.assertFails(dpsm.ERR_INVALID_SIZE, g.set_source, [[rate] * nx for _ in range(ny - 1)])
+
+        # A driven scene is limited by set_max_substeps; the refused step changes nothing.
+        g.set_max_substeps(1)
+        before = as_list(g.get_heights())
+        self.assertFails(dpsm.ERR_WORK_LIMIT, g.step, 10 * g.stable_dt())
+        self.assertEqual(as_list(g.get_heights()), before)
+        g.set_source(None)
+        g.step(10 * g.stable_dt())
+        self.assertAlmostEqual(g.get_mass(dpsm.MASS_SOURCED), sourced, delta=1e-15)
+        g.set_cell_kinds(None)
+        total = g.get_mass(dpsm.MASS_TOTAL)
+        self.assertAlmostEqual(total, sum(flat(g.get_heights())) * self.dx * self.dy, delta=1e-12 * total)
+        self.assertLedger(g)
+
+    def test_open_sides(self):
+        g = self.g
+        for side in (dpsm.XMIN, dpsm.XMAX, dpsm.YMIN, dpsm.YMAX):
+            g.set_boundary(side, dpsm.OPEN)
+        g.set_heights([[2.0] * self.nx for _ in range(self.ny)])
+        g.step(1e3)
+        self.assertGreater(g.get_mass(dpsm.MASS_OUTFLOW), 0.0)
+        self.assertLedger(g)
+
+
+class TestOtherGrids(LedgerMixin, unittest.TestCase):
+    def test_1d(self):
+        nx, dx = 30, 0.2
+        with dpsm.Grid.create_1d(nx, dx) as g:
+            self.assertEqual(g.get_shape(), (nx, 1))
+            self.assertEqual(g.shape, (nx,))
+            self.assertEqual(g.kind, "1d")
+            self.assertAlmostEqual(g.stable_dt(), dx**2 / (2 * dpsm.DEFAULT_MOBILITY * math.cos(dpsm.DEFAULT_REPOSE_ANGLE)),
+                                   delta=1e-15)
+            self.assertFails(dpsm.ERR_NOT_APPLICABLE, g.set_boundary, dpsm.YMIN, dpsm.OPEN)
+            g.set_boundary(dpsm.XMAX, dpsm.OPEN)
+            h = [4.0] * 5 + [1.0] * (nx - 5)
+            g.set_heights(h)
+            self.assertFails(dpsm.ERR_INVALID_SIZE, g.set_heights, [h])  # not (1, nx)
+            g.step(1e3)
+            after = g.get_heights()
+            if np is not None:
+                self.assertEqual(after.shape, (nx,))
+            else:
+                self.assertIsInstance(after, list)
+                self.assertIsInstance(after[0], float)
+            self.assertLess(after[0], 4.0)
+            self.assertAlmostEqual(g.get_mass(dpsm.MASS_TOTAL), sum(as_list(after)) * dx, delta=1e-12)
+            self.assertEqual(as_list(g.get_heights_region(3, 0, 4, 1)), as_list(after)[3:7])
+            self.assertLedger(g)
+
+    def test_axisymmetric(self):
+        nr, dr = 20, 0.05
+        with dpsm.Grid.create_axisymmetric(nr, dr) as g:
+            self.assertEqual(g.kind, "axisymmetric")
+            self.assertFails(dpsm.ERR_NOT_APPLICABLE, g.set_boundary, dpsm.XMIN, dpsm.OPEN)
+            g.set_boundary(dpsm.XMAX, dpsm.OPEN)
+            self.assertAlmostEqual(g.stable_dt(), 3 * dr**2 / (8 * math.cos(dpsm.DEFAULT_REPOSE_ANGLE)), delta=1e-15)
+            g.set_heights([1.0] * nr)
+            volume = sum(2 * math.pi * (i + 0.5) * dr * dr for i in range(nr))
+            self.assertAlmostEqual(g.get_mass(dpsm.MASS_TOTAL), volume, delta=1e-12)
+            g.step(10.0)
+            self.assertLedger(g)
+
+    def test_close(self):
+        g = dpsm.Grid.create_1d(4, 1.0)
+        with g:
+            self.assertFalse(g.closed)
+        self.assertTrue(g.closed)
+        self.assertIn("closed", repr(g))
+        g.close()  # twice is fine
+        g.destroy()
+        e = self.assertFails(dpsm.ERR_NULL_POINTER, g.step, 1.0)
+        self.assertEqual(e.message, dpsm.last_error())
+        self.assertFails(dpsm.ERR_NULL_POINTER, g.get_mass, dpsm.MASS_TOTAL)
+
+    def test_many_grids(self):
+        # Grids are independent, and released when dropped.
+        grids = [dpsm.Grid.create_1d(8 + k, 0.1) for k in range(50)]
+        for k, g in enumerate(grids):
+            self.assertEqual(g.get_shape(), (8 + k, 1))
+        del grids
+
+
+if __name__ == "__main__":
+    unittest.main()
