@@ -92,31 +92,34 @@ bool ActiveSet::may_move() const {
     return false;
 }
 
-void ActiveSet::tiles_to_visit(int levels, std::vector<std::int64_t> &out) const {
+void ActiveSet::tiles_to_visit(int levels, std::vector<std::int64_t> &tiles,
+                               std::vector<CellBox> &boxes) const {
     // Within `levels` sub-steps motion spreads `levels` cells, and a face
     // reads one cell beyond its own two: a hot box reaches levels + 2 cells.
     const std::int64_t reach = levels + 2;
-    out.clear();
+    tiles.clear();
+    boxes.clear();
     // DPSM_VISIT_ALL_TILES=1 turns the active set off, for tests that show it
     // changes no result.
     const char *all = std::getenv("DPSM_VISIT_ALL_TILES");
-    if (all && *all && *all != '0') {
-        for (std::int64_t t = 0; t < tiles(); ++t) out.push_back(t);
-        return;
-    }
+    const bool visit_all = all && *all && *all != '0';
     for (std::int64_t tj = 0; tj < tiles_y_; ++tj)
         for (std::int64_t ti = 0; ti < tiles_x_; ++ti) {
             const std::int64_t t = ti + tiles_x_ * tj;
             const CellBox cells = tile_cells(t);
-            bool visit = false;
-            for (std::int64_t dj = -1; dj <= 1 && !visit; ++dj)
-                for (std::int64_t di = -1; di <= 1 && !visit; ++di) {
+            CellBox reached;
+            for (std::int64_t dj = -1; dj <= 1; ++dj)
+                for (std::int64_t di = -1; di <= 1; ++di) {
                     const std::int64_t ui = ti + di, uj = tj + dj;
                     if (ui < 0 || uj < 0 || ui >= tiles_x_ || uj >= tiles_y_) continue;
                     const std::int64_t u = ui + tiles_x_ * uj;
-                    visit = hot_[u].reaches(cells, reach) || source_[u].reaches(cells, reach);
+                    reached.add(hot_[u].grown_within(reach, cells));
+                    reached.add(source_[u].grown_within(reach, cells));
                 }
-            if (visit) out.push_back(t);
+            if (visit_all) reached = cells;
+            if (reached.empty()) continue;
+            tiles.push_back(t);
+            boxes.push_back(reached);
         }
 }
 

@@ -26,6 +26,14 @@ struct CellBox {
         j1 = b1 > j1 ? b1 : j1;
     }
     void add(const CellBox &o) { add(o.i0, o.i1, o.j0, o.j1); }
+    // This box grown by d cells and clipped to the other; empty if they do not meet.
+    CellBox grown_within(std::int64_t d, const CellBox &o) const {
+        CellBox b;
+        if (empty() || o.empty()) return b;
+        b.add(i0 - d > o.i0 ? i0 - d : o.i0, i1 + d < o.i1 ? i1 + d : o.i1, j0 - d > o.j0 ? j0 - d : o.j0,
+              j1 + d < o.j1 ? j1 + d : o.j1);
+        return b;
+    }
     // Whether this box grown by d cells meets the other.
     bool reaches(const CellBox &o, std::int64_t d) const {
         return !empty() && !o.empty() && i0 - d < o.i1 && o.i0 < i1 + d && j0 - d < o.j1 && o.j0 < j1 + d;
@@ -53,8 +61,9 @@ public:
     void refresh_source(const Grid &grid);
 
     bool may_move() const;  // some tile is hot or has a source
-    // The tiles a sweep of `levels` sub-steps must visit, in order.
-    void tiles_to_visit(int levels, std::vector<std::int64_t> &out) const;
+    // The tiles a sweep of `levels` sub-steps must visit, in order, and in each
+    // the box of its cells that can change (the rest of the tile stays as it is).
+    void tiles_to_visit(int levels, std::vector<std::int64_t> &tiles, std::vector<CellBox> &boxes) const;
 
     CellBox &hot(std::int64_t t) { return hot_[t]; }
     bool masked(std::int64_t t) const { return masked_[t] != 0; }

@@ -16,6 +16,7 @@ namespace dpsm {
 namespace {
 
 constexpr int kBufferSide = ActiveSet::kTile + 2 * (ActiveSet::kMaxLevels + 1);
+constexpr std::int64_t kCellsForThreads = 8 * ActiveSet::kTile * ActiveSet::kTile;
 
 int thread_count(int requested) {
 #if defined(_OPENMP)
@@ -90,6 +91,7 @@ void prepare_tiled_sweep(Grid &grid, int threads) {
     }
     const std::size_t tiles = static_cast<std::size_t>(grid.active_set().tiles());
     ws.visit.reserve(tiles);
+    ws.boxes.reserve(tiles);
     ws.stats.reserve(tiles * ActiveSet::kMaxLevels);
     ws.origin.reserve(2 * tiles);
 }
@@ -98,7 +100,7 @@ std::int64_t tiled_sweep(Grid &grid, int levels, double dt, std::vector<LevelSum
     const Geometry &geo = grid.geometry();
     ActiveSet &active = grid.active_set();
     TiledWorkspace &ws = grid.tiled_workspace();
-    active.tiles_to_visit(levels, ws.visit);
+    active.tiles_to_visit(levels, ws.visit, ws.boxes);
     const std::int64_t visits = static_cast<std::int64_t>(ws.visit.size());
     ws.stats.assign(static_cast<std::size_t>(visits) * levels, TileLevelStats{});
     ws.origin.assign(static_cast<std::size_t>(2 * visits), 0);
@@ -110,11 +112,16 @@ std::int64_t tiled_sweep(Grid &grid, int levels, double dt, std::vector<LevelSum
                                  geo.dy,          geo.dx};
     const bool isotropic = grid.scheme() == kIsotropic;
     const int threads = thread_count(grid.threads());
+    std::int64_t visited_cells = 0;
+    for (const CellBox &cells : ws.boxes) visited_cells += (cells.i1 - cells.i0) * (cells.j1 - cells.j0);
+    // Threads pay off only with enough work between their barriers; below this
+    // a sweep runs on the calling thread (results are the same either way).
+    const bool parallel = threads > 1 && visits > 1 && visited_cells >= kCellsForThreads;
     const int halo = levels + 1;
 
     auto visit_tile = [&](std::int64_t k, TileBuffers &b) {
         const std::int64_t t = ws.visit[k];
-        const CellBox cells = active.tile_cells(t);
+        const CellBox &cells = ws.boxes[k];
         const bool masked = active.masked(t), source = active.has_source(t);
         const std::int64_t gi0 = cells.i0 - halo, gj0 = cells.j0 - halo;
         b.width = static_cast<int>(cells.i1 - cells.i0) + 2 * halo;
@@ -141,7 +148,7 @@ std::int64_t tiled_sweep(Grid &grid, int levels, double dt, std::vector<LevelSum
     };
 
 #if defined(_OPENMP)
-#pragma omp parallel num_threads(threads) if (visits > 1)
+#pragma omp parallel num_threads(threads) if (parallel)
     {
         TileBuffers &b = ws.buffers[static_cast<std::size_t>(omp_get_thread_num())];
 #pragma omp for schedule(dynamic, 1)
@@ -149,20 +156,21 @@ std::int64_t tiled_sweep(Grid &grid, int levels, double dt, std::vector<LevelSum
     }
 #else
     (void)threads;
+    (void)parallel;
     for (std::int64_t k = 0; k < visits; ++k) visit_tile(k, ws.buffers[0]);
 #endif
 
-    // Write back; when every tile was visited the output is the whole grid.
-    if (visits == active.tiles()) {
+    // Write back; when every tile was visited whole the output is the whole grid.
+    if (visited_cells == geo.cells()) {
         grid.swap_heights(ws.heights, ws.residuals);
     } else {
         std::vector<double> &h = grid.heights_for_stepping();
         std::vector<float> &res = grid.residuals_for_stepping();
 #if defined(_OPENMP)
-#pragma omp parallel for num_threads(threads) schedule(static) if (visits > 1)
+#pragma omp parallel for num_threads(threads) schedule(static) if (parallel)
 #endif
         for (std::int64_t k = 0; k < visits; ++k) {
-            const CellBox cells = active.tile_cells(ws.visit[k]);
+            const CellBox &cells = ws.boxes[k];
             for (std::int64_t j = cells.j0; j < cells.j1; ++j) {
                 const std::size_t at = static_cast<std::size_t>(j * geo.nx + cells.i0);
                 const std::size_t count = static_cast<std::size_t>(cells.i1 - cells.i0);
@@ -175,10 +183,7 @@ std::int64_t tiled_sweep(Grid &grid, int levels, double dt, std::vector<LevelSum
     // New hot boxes: where sand moved in any level, grown by the two cells a
     // last move can make steep. Sums in tile order, whatever the threads.
     summaries.assign(static_cast<std::size_t>(levels), LevelSummary{});
-    std::int64_t visited_cells = 0;
     for (std::int64_t k = 0; k < visits; ++k) {
-        const CellBox cells = active.tile_cells(ws.visit[k]);
-        visited_cells += (cells.i1 - cells.i0) * (cells.j1 - cells.j0);
         CellBox moved;
         for (int s = 0; s < levels; ++s) {
             const TileLevelStats &st = ws.stats[static_cast<std::size_t>(k) * levels + s];

@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "active_set.hpp"
 #include "tile_kernel.hpp"
 
 namespace dpsm {
@@ -26,6 +27,7 @@ struct TiledWorkspace {
     std::vector<float> residuals;
     std::vector<TileBuffers> buffers;  // one per thread
     std::vector<std::int64_t> visit;
+    std::vector<CellBox> boxes;         // per visited tile: the cells that can change
     std::vector<TileLevelStats> stats;  // per visited tile and level
     std::vector<std::int64_t> origin;   // per visited tile: its buffer's first cell (i, j)
 };

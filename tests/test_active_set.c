@@ -106,13 +106,15 @@ static void test_active_set_changes_no_result(void **state) {
     }
 }
 
+/* Every tile visited, so that each sweep has enough cells (8 tiles' worth) for
+ * the library to share it among threads. */
 static void test_results_do_not_depend_on_threads(void **state) {
     (void)state;
     ledger_t l1, l2, l3;
     double w1, w2, w3;
-    double *a = run_scene(DPSM_SCHEME_ISOTROPIC, 1, 0, &l1, &w1);
-    double *b = run_scene(DPSM_SCHEME_ISOTROPIC, 2, 0, &l2, &w2);
-    double *c = run_scene(DPSM_SCHEME_ISOTROPIC, 3, 0, &l3, &w3);
+    double *a = run_scene(DPSM_SCHEME_ISOTROPIC, 1, 1, &l1, &w1);
+    double *b = run_scene(DPSM_SCHEME_ISOTROPIC, 2, 1, &l2, &w2);
+    double *c = run_scene(DPSM_SCHEME_ISOTROPIC, 3, 1, &l3, &w3);
     assert_same_run(a, b, &l1, &l2);
     assert_same_run(a, c, &l1, &l3);
     assert_true(w1 == w2 && w1 == w3);

@@ -1,0 +1,43 @@
+/* What every dpsm-bench subcommand shares: a clock, checked calls, memory. */
+#ifndef DPSM_BENCH_UTIL_H
+#define DPSM_BENCH_UTIL_H
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <time.h>
+
+#include <dpsm/dpsm.h>
+
+#define CHECK(g, call)                                                                             \
+    do {                                                                                           \
+        int status_ = (call);                                                                      \
+        if (status_ != DPSM_OK) {                                                                  \
+            fprintf(stderr, "dpsm-bench: %s failed: %s: %s\n", #call, dpsm_status_string(status_), \
+                    dpsm_last_error(g));                                                           \
+            exit(1);                                                                               \
+        }                                                                                          \
+    } while (0)
+
+static inline double now_seconds(void) {
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+static inline void *xcalloc(size_t n, size_t size) {
+    void *p = calloc(n, size);
+    if (!p) {
+        fprintf(stderr, "dpsm-bench: out of memory\n");
+        exit(1);
+    }
+    return p;
+}
+
+/* The speed subcommands (speed.c). */
+int cmd_throughput(int argc, char **argv);
+int cmd_sparse(int argc, char **argv);
+int cmd_idle(int argc, char **argv);
+int cmd_cone(int argc, char **argv);
+int cmd_steps(int argc, char **argv); /* relax_study.c */
+
+#endif

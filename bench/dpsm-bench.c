@@ -1,0 +1,234 @@
+/* dpsm-bench: benchmarks of dpsm through its public C API. Each subcommand
+ * prints CSV on stdout (a log on stderr); none is run by the tests.
+ *
+ *   dpsm-bench work-precision [max_n [threads]]
+ *       Run time against error of the column collapse (a = 0.5, theta = 30
+ *       degrees, open table, run to rest): 2D grids 32^2 ... max_n^2 (default
+ *       512) with both schemes, and the axisymmetric grid at 40 ... 1280 rings
+ *       (fewer when max_n is smaller). CSV: scene,scheme,n,seconds,l1_error.
+ *       threads (default 1) goes to dpsm_set_threads(); 0 is the library's
+ *       default (one per core). One thread by default because timings on a
+ *       shared machine are far steadier without OpenMP barriers.
+ *
+ *   dpsm-bench throughput [n ...]      fully active 2D surfaces (512, 2048, 4096)
+ *   dpsm-bench sparse [n [fraction]]   a dune field with ~1 % of cells on slip faces
+ *   dpsm-bench idle [n]                a surface at rest
+ *   dpsm-bench cone [tolerance]        a cone relaxed to rest (the dune models' scene)
+ *   dpsm-bench steps                   the study of larger steps (relax_study.c)
+ * Each of these also times the plain reference loop of reference.c, so every
+ * figure is also a ratio (speed.c).
+ *
+ * To add a subcommand: write `int cmd_NAME(int argc, char **argv)` (argv holds
+ * the arguments after the subcommand's name) and add a row to kCommands below.
+ */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "bench_util.h"
+
+static const double kPi = 3.14159265358979323846;
+
+/* Threads for the work-precision runs (its second argument; default 1). */
+static int g_threads = 1;
+
+/* Steps a scene without a source until it rests (one call, normally). */
+static void run_to_rest(dpsm_grid *g) {
+    for (int k = 0; k < 100; ++k) {
+        double at_rest = 0.0;
+        CHECK(g, dpsm_step(g, 1e6));
+        CHECK(g, dpsm_get_step_info(g, DPSM_INFO_AT_REST, &at_rest));
+        if (at_rest > 0.0) return;
+    }
+    fprintf(stderr, "dpsm-bench: warning: the scene did not come to rest\n");
+}
+
+/* ---- the column collapse and its exact deposit ------------------------------- */
+
+typedef struct {
+    double r0, h0, alpha, theta;
+    double rf;     /* foot radius of the exact deposit */
+    double rtop;   /* radius of its flat top (0 for a cone) */
+    double hf;     /* its height */
+} column;
+
+static column make_column(double a, double theta_deg) {
+    column c;
+    c.r0 = 1.0;
+    c.h0 = a * c.r0;
+    c.theta = theta_deg * kPi / 180.0;
+    c.alpha = tan(c.theta);
+    if (a <= sqrt(3.0) * c.alpha) {
+        c.rf = c.r0 * (a + sqrt(4.0 * c.alpha * c.alpha - a * a / 3.0)) / (2.0 * c.alpha);
+        c.hf = c.h0;
+    } else {
+        c.rf = c.r0 * cbrt(3.0 * a / c.alpha);
+        c.hf = c.alpha * c.rf;
+    }
+    c.rtop = c.rf - c.hf / c.alpha;
+    return c;
+}
+
+/* The exact deposit at radius r: a truncated cone (or a cone). */
+static double exact_height(const column *c, double r) {
+    const double flank = c->alpha * (c->rf - r);
+    return flank <= 0.0 ? 0.0 : fmin(c->hf, flank);
+}
+
+/* The fraction of the cell [x0, x0+dx] x [y0, y0+dx] inside the circle of
+ * radius r about the origin: 1 or 0 away from the rim, sampled on a 64 x 64
+ * lattice of points across it. */
+static double disk_fraction(double x0, double y0, double dx, double r) {
+    const double xn = fmax(0.0, fmax(x0, -(x0 + dx))), yn = fmax(0.0, fmax(y0, -(y0 + dx)));
+    const double xf = fmax(fabs(x0), fabs(x0 + dx)), yf = fmax(fabs(y0), fabs(y0 + dx));
+    if (xf * xf + yf * yf <= r * r) return 1.0;
+    if (xn * xn + yn * yn >= r * r) return 0.0;
+    const int ns = 64;
+    int in = 0;
+    for (int j = 0; j < ns; ++j)
+        for (int i = 0; i < ns; ++i) {
+            const double x = x0 + (i + 0.5) * dx / ns, y = y0 + (j + 0.5) * dx / ns;
+            in += x * x + y * y <= r * r;
+        }
+    return (double)in / (ns * ns);
+}
+
+/* One 2D collapse on an n x n open table of half-width L centred on the
+ * column; the column is given by cell averages (a rim cell holds h0 times the
+ * fraction of it inside r0), so its volume is pi r0^2 h0 to sampling accuracy
+ * on every grid. Returns the wall time of the run (grid creation to heights
+ * read back) and the L1 error against the exact deposit. */
+static void collapse_2d(const column *c, int n, int scheme, double *seconds, double *l1) {
+    const double half_width = 1.25 * fmax(2.0 * c->r0, c->rf);
+    const double dx = 2.0 * half_width / n;
+    const size_t cells = (size_t)n * (size_t)n;
+    double *h0 = xcalloc(cells, sizeof *h0), *h = xcalloc(cells, sizeof *h);
+    for (int j = 0; j < n; ++j)
+        for (int i = 0; i < n; ++i)
+            h0[i + (size_t)n * j] = c->h0 * disk_fraction(i * dx - half_width, j * dx - half_width, dx, c->r0);
+
+    const double t0 = now_seconds();
+    dpsm_grid *g = NULL;
+    CHECK(NULL, dpsm_create_2d(n, n, dx, dx, &g));
+    CHECK(g, dpsm_set_threads(g, g_threads));
+    CHECK(g, dpsm_set_repose_angle(g, c->theta));
+    CHECK(g, dpsm_set_scheme(g, scheme));
+    for (int side = DPSM_XMIN; side <= DPSM_YMAX; ++side) CHECK(g, dpsm_set_boundary(g, side, DPSM_OPEN));
+    CHECK(g, dpsm_set_heights(g, h0));
+    run_to_rest(g);
+    CHECK(g, dpsm_get_heights(g, h));
+    *seconds = now_seconds() - t0;
+
+    double volume = 0.0, err = 0.0;
+    for (int j = 0; j < n; ++j)
+        for (int i = 0; i < n; ++i) {
+            const double x = (i + 0.5) * dx - half_width, y = (j + 0.5) * dx - half_width;
+            const size_t k = i + (size_t)n * j;
+            volume += h0[k] * dx * dx;
+            err += fabs(h[k] - exact_height(c, sqrt(x * x + y * y))) * dx * dx;
+        }
+    *l1 = err / volume;
+    dpsm_destroy(g);
+    free(h0);
+    free(h);
+}
+
+/* One axisymmetric collapse: nr rings over [0, 2.5 r0], the outer side open. */
+static void collapse_axisymmetric(const column *c, int nr, double *seconds, double *l1) {
+    const double outer = 1.25 * fmax(2.0 * c->r0, c->rf);
+    const double dr = outer / nr;
+    double *h = xcalloc((size_t)nr, sizeof *h);
+    const double t0 = now_seconds();
+    dpsm_grid *g = NULL;
+    CHECK(NULL, dpsm_create_axisymmetric(nr, dr, &g));
+    CHECK(g, dpsm_set_threads(g, g_threads));
+    CHECK(g, dpsm_set_repose_angle(g, c->theta));
+    CHECK(g, dpsm_set_boundary(g, DPSM_XMAX, DPSM_OPEN));
+    for (int i = 0; i < nr; ++i) {
+        const double r_in = i * dr, r_out = (i + 1) * dr;
+        /* the ring's share inside r0, by area (1 except at most one ring) */
+        const double inner = fmin(fmax(c->r0, r_in), r_out);
+        h[i] = c->h0 * (inner * inner - r_in * r_in) / (r_out * r_out - r_in * r_in);
+    }
+    CHECK(g, dpsm_set_heights(g, h));
+    run_to_rest(g);
+    CHECK(g, dpsm_get_heights(g, h));
+    *seconds = now_seconds() - t0;
+    double err = 0.0;
+    for (int i = 0; i < nr; ++i) {
+        const double r = (i + 0.5) * dr;
+        err += fabs(h[i] - exact_height(c, r)) * 2.0 * kPi * r * dr;
+    }
+    *l1 = err / (kPi * c->r0 * c->r0 * c->h0);
+    dpsm_destroy(g);
+    free(h);
+}
+
+static int cmd_work_precision(int argc, char **argv) {
+    const int max_n = argc > 0 ? atoi(argv[0]) : 512;
+    g_threads = argc > 1 ? atoi(argv[1]) : 1;
+    if (max_n < 32 || g_threads < 0) {
+        fprintf(stderr, "usage: dpsm-bench work-precision [max_n >= 32 [threads >= 0]]\n");
+        return 2;
+    }
+    const column c = make_column(0.5, 30.0);
+    fprintf(stderr,
+            "work-precision: column collapse a = 0.5, theta = 30 deg; exact deposit a truncated cone of height %.4f,"
+            " top radius %.4f, foot radius %.4f; threads %d\n",
+            c.hf, c.rtop, c.rf, g_threads);
+    printf("scene,scheme,n,seconds,l1_error\n");
+    fflush(stdout);
+    for (int n = 32; n <= max_n; n *= 2)
+        for (int scheme = DPSM_SCHEME_PAIRWISE; scheme <= DPSM_SCHEME_ISOTROPIC; ++scheme) {
+            double seconds, l1;
+            collapse_2d(&c, n, scheme, &seconds, &l1);
+            printf("column_2d,%s,%d,%.6f,%.6e\n", scheme == DPSM_SCHEME_PAIRWISE ? "pairwise" : "isotropic", n,
+                   seconds, l1);
+            fflush(stdout);
+        }
+    for (int nr = 40; nr <= 2 * max_n + 256 && nr <= 1280; nr *= 2) {
+        double seconds, l1;
+        collapse_axisymmetric(&c, nr, &seconds, &l1);
+        printf("column_axisymmetric,axisymmetric,%d,%.6f,%.6e\n", nr, seconds, l1);
+        fflush(stdout);
+    }
+    return 0;
+}
+
+/* ---- dispatch ---------------------------------------------------------------- */
+
+typedef struct {
+    const char *name;
+    int (*run)(int argc, char **argv);
+    const char *help;
+} command;
+
+static const command kCommands[] = {
+    {"throughput", cmd_throughput, "[n ...]  fully active surfaces; CSV n,threads,mcells_per_s,reference_mcells_per_s,ratio"},
+    {"sparse", cmd_sparse, "[n [fraction]]  ~1 % of cells on slip faces; cost of a sub-step against a fully active one"},
+    {"idle", cmd_idle, "[n]  a surface at rest: seconds per dpsm_step against a fully active sub-step"},
+    {"cone", cmd_cone, "[tolerance]  cone 40 high, slope 1.5, 101^2, to rest at 33 deg; seconds and top vs 22.89"},
+    {"steps", cmd_steps, "explicit sub-steps against the bounded exchange at dt -> infinity: time and error to rest"},
+    {"work-precision", cmd_work_precision,
+     "[max_n [threads]]  column collapse (a = 0.5, 30 deg) to rest: 2D n^2 up to max_n^2 (default 512), both schemes,"
+     " and axisymmetric; threads default 1; CSV scene,scheme,n,seconds,l1_error"},
+};
+
+static void usage(FILE *out) {
+    fprintf(out, "usage: dpsm-bench COMMAND ARGS...   (dpsm %s)\n", dpsm_version_string());
+    for (size_t k = 0; k < sizeof kCommands / sizeof kCommands[0]; ++k)
+        fprintf(out, "  %-15s %s\n", kCommands[k].name, kCommands[k].help);
+}
+
+int main(int argc, char **argv) {
+    if (argc < 2 || !strcmp(argv[1], "-h") || !strcmp(argv[1], "--help")) {
+        usage(argc < 2 ? stderr : stdout);
+        return argc < 2 ? 2 : 0;
+    }
+    for (size_t k = 0; k < sizeof kCommands / sizeof kCommands[0]; ++k)
+        if (!strcmp(argv[1], kCommands[k].name)) return kCommands[k].run(argc - 2, argv + 2);
+    fprintf(stderr, "dpsm-bench: unknown command '%s'\n", argv[1]);
+    usage(stderr);
+    return 2;
+}
