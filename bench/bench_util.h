@@ -1,4 +1,6 @@
-/* What every dpsm-bench subcommand shares: a clock, checked calls, memory. */
+/* What the benchmark and validation programs share: a clock, checked calls,
+ * memory. Define DPSM_TOOL_NAME before including to name the program in
+ * messages. */
 #ifndef DPSM_BENCH_UTIL_H
 #define DPSM_BENCH_UTIL_H
 
@@ -8,11 +10,15 @@
 
 #include <dpsm/dpsm.h>
 
+#ifndef DPSM_TOOL_NAME
+#define DPSM_TOOL_NAME "dpsm-bench"
+#endif
+
 #define CHECK(g, call)                                                                             \
     do {                                                                                           \
         int status_ = (call);                                                                      \
         if (status_ != DPSM_OK) {                                                                  \
-            fprintf(stderr, "dpsm-bench: %s failed: %s: %s\n", #call, dpsm_status_string(status_), \
+            fprintf(stderr, DPSM_TOOL_NAME ": %s failed: %s: %s\n", #call, dpsm_status_string(status_), \
                     dpsm_last_error(g));                                                           \
             exit(1);                                                                               \
         }                                                                                          \
@@ -27,7 +33,7 @@ static inline double now_seconds(void) {
 static inline void *xcalloc(size_t n, size_t size) {
     void *p = calloc(n, size);
     if (!p) {
-        fprintf(stderr, "dpsm-bench: out of memory\n");
+        fprintf(stderr, DPSM_TOOL_NAME ": out of memory\n");
         exit(1);
     }
     return p;

@@ -12,6 +12,16 @@ namespace {
 constexpr std::int64_t kReach = ActiveSet::kMaxLevels + 1;
 }  // namespace
 
+template <class Visit>
+void ActiveSet::for_tiles_reaching(std::int64_t i, std::int64_t j, Visit &&visit) const {
+    const std::int64_t t0 = std::max<std::int64_t>(0, (i - kReach) / kTile);
+    const std::int64_t t1 = std::min(tiles_x_ - 1, (i + kReach) / kTile);
+    const std::int64_t s0 = std::max<std::int64_t>(0, (j - kReach) / kTile);
+    const std::int64_t s1 = std::min(tiles_y_ - 1, (j + kReach) / kTile);
+    for (std::int64_t tj = s0; tj <= s1; ++tj)
+        for (std::int64_t ti = t0; ti <= t1; ++ti) visit(ti + tiles_x_ * tj);
+}
+
 ActiveSet::ActiveSet(std::int64_t nx, std::int64_t ny)
     : nx_(nx),
       ny_(ny),
@@ -56,13 +66,7 @@ void ActiveSet::refresh_masks(const Grid &grid) {
     }
     for (std::int64_t j = 0; j < ny_; ++j)
         for (std::int64_t i = 0; i < nx_; ++i) {
-            if (kind[i + nx_ * j] == kSand) continue;
-            const std::int64_t t0 = std::max<std::int64_t>(0, (i - kReach) / kTile);
-            const std::int64_t t1 = std::min(tiles_x_ - 1, (i + kReach) / kTile);
-            const std::int64_t s0 = std::max<std::int64_t>(0, (j - kReach) / kTile);
-            const std::int64_t s1 = std::min(tiles_y_ - 1, (j + kReach) / kTile);
-            for (std::int64_t tj = s0; tj <= s1; ++tj)
-                for (std::int64_t ti = t0; ti <= t1; ++ti) masked_[ti + tiles_x_ * tj] = 1;
+            if (kind[i + nx_ * j] != kSand) for_tiles_reaching(i, j, [&](std::int64_t t) { masked_[t] = 1; });
         }
 }
 
@@ -77,12 +81,7 @@ void ActiveSet::refresh_source(const Grid &grid) {
             const std::int64_t c = i + nx_ * j;
             if (q[c] == 0.0 || kind[c] != kSand) continue;
             source_[(i / kTile) + tiles_x_ * (j / kTile)].add(i, i + 1, j, j + 1);
-            const std::int64_t t0 = std::max<std::int64_t>(0, (i - kReach) / kTile);
-            const std::int64_t t1 = std::min(tiles_x_ - 1, (i + kReach) / kTile);
-            const std::int64_t s0 = std::max<std::int64_t>(0, (j - kReach) / kTile);
-            const std::int64_t s1 = std::min(tiles_y_ - 1, (j + kReach) / kTile);
-            for (std::int64_t tj = s0; tj <= s1; ++tj)
-                for (std::int64_t ti = t0; ti <= t1; ++ti) has_source_[ti + tiles_x_ * tj] = 1;
+            for_tiles_reaching(i, j, [&](std::int64_t t) { has_source_[t] = 1; });
         }
 }
 

@@ -70,6 +70,10 @@ public:
     bool has_source(std::int64_t t) const { return has_source_[t] != 0; }
 
 private:
+    // Calls visit(t) for every tile whose sweep reads cell (i, j).
+    template <class Visit>
+    void for_tiles_reaching(std::int64_t i, std::int64_t j, Visit &&visit) const;
+
     std::int64_t nx_, ny_, tiles_x_, tiles_y_;
     std::vector<CellBox> hot_;
     std::vector<CellBox> source_;          // cells with a source, per tile

@@ -26,36 +26,12 @@
 
 #include <dpsm/dpsm.h>
 
+#define DPSM_TOOL_NAME "dpsm-validate"
+#include "bench_util.h"
+
 static const double kPi = 3.14159265358979323846;
 
 static double deg(double d) { return d * kPi / 180.0; }
-
-static double now_seconds(void) {
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
-/* Every API call is checked; a failure ends the program with the library's
- * own message. */
-#define CHECK(g, call)                                                                                \
-    do {                                                                                              \
-        int status_ = (call);                                                                         \
-        if (status_ != DPSM_OK) {                                                                     \
-            fprintf(stderr, "dpsm-validate: %s failed: %s: %s\n", #call, dpsm_status_string(status_), \
-                    dpsm_last_error(g));                                                              \
-            exit(1);                                                                                  \
-        }                                                                                             \
-    } while (0)
-
-static void *xcalloc(size_t n, size_t size) {
-    void *p = calloc(n, size);
-    if (!p) {
-        fprintf(stderr, "dpsm-validate: out of memory\n");
-        exit(1);
-    }
-    return p;
-}
 
 static FILE *open_csv(const char *dir, const char *name) {
     char path[4096];
