@@ -52,11 +52,12 @@ def speed_table(data):
 
 
 def steps_table(data):
-    out = ["| scene | method | tolerance | sweeps | seconds | top | top error |",
-           "| --- | --- | --- | --- | --- | --- | --- |"]
+    out = ["| scene | method | tolerance | sweeps | seconds | top | top error | at rest |",
+           "| --- | --- | --- | --- | --- | --- | --- | --- |"]
     for r in rows(data, "steps"):
         out.append(f"| {r['scene']} | {r['method']} | {r['tolerance']} | {r['sweeps']} | {float(r['seconds']):.3f} | "
-                   f"{float(r['top']):.4f} | {float(r['top_error_percent']):+.2f} % |")
+                   f"{float(r['top']):.4f} | {float(r['top_error_percent']):+.2f} % | "
+                   f"{'yes' if r['at_rest'] == '1' else 'no'} |")
     return out
 
 

@@ -31,6 +31,8 @@ void reference_free(reference_grid *r) {
 
 double reference_height(const reference_grid *r, int64_t i, int64_t j) { return AT(r, r->h, i, j); }
 
+void reference_set_height(reference_grid *r, int64_t i, int64_t j, double h) { AT(r, r->h, i, j) = h; }
+
 /* Central differences; the frame (the outside of the open sides) is flat at 0. */
 static double slope_y(const reference_grid *r, int64_t i, int64_t j) {
     if (i < 0 || i >= r->nx || j < 0 || j >= r->ny) return 0.0;
@@ -48,6 +50,24 @@ static double flux(const reference_grid *r, double normal, double transverse, do
     if (!(g > r->threshold)) return 0.0;
     if (g - r->tan_theta > *excess) *excess = g - r->tan_theta;
     return r->nu * (g - r->tan_theta) / sqrt(1.0 + g * g) * normal / g;
+}
+
+double reference_rates(const reference_grid *r, double *rate) {
+    double excess = 0.0;
+    for (int64_t j = 0; j < r->ny; ++j)
+        for (int64_t i = 0; i < r->nx; ++i) {
+            const double hc = AT(r, r->h, i, j);
+            const double west = flux(r, (AT(r, r->h, i - 1, j) - hc) / r->dx,
+                                     0.5 * (slope_y(r, i - 1, j) + slope_y(r, i, j)), &excess);
+            const double east = flux(r, (hc - AT(r, r->h, i + 1, j)) / r->dx,
+                                     0.5 * (slope_y(r, i, j) + slope_y(r, i + 1, j)), &excess);
+            const double south = flux(r, (AT(r, r->h, i, j - 1) - hc) / r->dy,
+                                      0.5 * (slope_x(r, i, j - 1) + slope_x(r, i, j)), &excess);
+            const double north = flux(r, (hc - AT(r, r->h, i, j + 1)) / r->dy,
+                                      0.5 * (slope_x(r, i, j) + slope_x(r, i, j + 1)), &excess);
+            rate[i + r->nx * j] = (west - east) / r->dx + (south - north) / r->dy;
+        }
+    return excess;
 }
 
 double reference_substep(reference_grid *r, double dt) {

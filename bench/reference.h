@@ -21,5 +21,9 @@ void reference_free(reference_grid *r);
 /* One sub-step of dt; returns the largest slope excess over faces that carried sand (0 at rest). */
 double reference_substep(reference_grid *r, double dt);
 double reference_height(const reference_grid *r, int64_t i, int64_t j);
+void reference_set_height(reference_grid *r, int64_t i, int64_t j, double h);
+/* dh/dt of every cell (nx*ny, x fastest) at the present heights; returns the
+ * largest slope excess over faces that carried sand. */
+double reference_rates(const reference_grid *r, double *rate);
 
 #endif
