@@ -87,6 +87,11 @@ void require_positive(double value, const char *function, const char *name) {
     if (!(value > 0.0)) fail(DPSM_ERR_INVALID_VALUE, function, name, " = ", value, " must be positive");
 }
 
+// The range in which every slope, its square and every cell area stay finite:
+// heights and sources within +-kMaxMagnitude, spacings and the mobility within
+// [1/kMaxMagnitude, kMaxMagnitude] (so |dh| / d <= 2e100, squared 4e200).
+constexpr double kMaxMagnitude = 1e50;
+
 const char *describe(double value) { return std::isnan(value) ? "NaN" : value > 0 ? "+Inf" : "-Inf"; }
 
 // Names the first non-finite element by its index and cell.
@@ -98,6 +103,9 @@ void require_finite_array(const dpsm_grid *g, const double *values, const char *
         if (!std::isfinite(values[c]))
             fail(DPSM_ERR_INVALID_VALUE, function, name, "[", c, "] (cell i = ", c % geo.nx, ", j = ", c / geo.nx,
                  ") is ", describe(values[c]));
+        if (!(std::fabs(values[c]) <= kMaxMagnitude))
+            fail(DPSM_ERR_INVALID_VALUE, function, name, "[", c, "] (cell i = ", c % geo.nx, ", j = ", c / geo.nx,
+                 ") = ", values[c], " is outside the supported range [-1e50, 1e50]");
     }
 }
 
@@ -123,10 +131,20 @@ dpsm::Grid::Block require_block(const dpsm_grid *g, std::int64_t i0, std::int64_
 // Names the first non-finite value of a block by its index and cell.
 void require_finite_block(const double *values, const dpsm::Grid::Block &b, const char *function, const char *name) {
     require_pointer(values, function, name);
-    for (std::int64_t k = 0; k < b.ni * b.nj; ++k)
+    for (std::int64_t k = 0; k < b.ni * b.nj; ++k) {
         if (!std::isfinite(values[k]))
             fail(DPSM_ERR_INVALID_VALUE, function, name, "[", k, "] (cell i = ", b.i0 + k % b.ni, ", j = ", b.j0 + k / b.ni,
                  ") is ", describe(values[k]));
+        if (!(std::fabs(values[k]) <= kMaxMagnitude))
+            fail(DPSM_ERR_INVALID_VALUE, function, name, "[", k, "] (cell i = ", b.i0 + k % b.ni, ", j = ", b.j0 + k / b.ni,
+                 ") = ", values[k], " is outside the supported range [-1e50, 1e50]");
+    }
+}
+
+void require_scale(double value, const char *function, const char *name) {
+    require_positive(value, function, name);
+    if (value < 1.0 / kMaxMagnitude || value > kMaxMagnitude)
+        fail(DPSM_ERR_INVALID_VALUE, function, name, " = ", value, " is outside the supported range [1e-50, 1e50]");
 }
 
 // The largest number of cells we agree to address: every per-cell array must
@@ -143,8 +161,8 @@ int create(int dim, bool axisymmetric, std::int64_t nx, std::int64_t ny, double 
             fail(DPSM_ERR_INVALID_SIZE, function, axisymmetric ? "nr = " : "nx * ny = ", nx, axisymmetric ? "" : " * ",
                  axisymmetric ? std::string() : std::to_string(ny), " cells is more than this library can address (",
                  kMaxCells, ")");
-        require_positive(dx, function, axisymmetric ? "dr" : "dx");
-        require_positive(dy, function, "dy");
+        require_scale(dx, function, axisymmetric ? "dr" : "dx");
+        require_scale(dy, function, "dy");
         *out = new dpsm_grid(dpsm::Geometry{dim, axisymmetric, nx, ny, dx, dy});
     });
 }
@@ -182,7 +200,7 @@ int dpsm_set_mobility(dpsm_grid *g, double nu) {
     const char *fn = "dpsm_set_mobility";
     return guarded(g, fn, [&] {
         require_grid(g, fn);
-        require_positive(nu, fn, "nu");
+        require_scale(nu, fn, "nu");
         g->core.set_mobility(nu);
     });
 }
@@ -260,9 +278,9 @@ int dpsm_add_heights_region(dpsm_grid *g, int64_t i0, int64_t j0, int64_t ni, in
         const std::int64_t nx = g->core.geometry().nx;
         for (std::int64_t k = 0; k < ni * nj; ++k) {
             const std::int64_t c = (i0 + k % ni) + nx * (j0 + k / ni);
-            if (!std::isfinite(h[c] + dh[k]))
+            if (!(std::fabs(h[c] + dh[k]) <= kMaxMagnitude))
                 fail(DPSM_ERR_INVALID_VALUE, fn, "dh[", k, "] = ", dh[k], " added to cell i = ", c % nx, ", j = ", c / nx,
-                     " of height ", h[c], " overflows");
+                     " of height ", h[c], " leaves the supported range [-1e50, 1e50]");
         }
         g->core.write_heights(block, dh, true);
     });

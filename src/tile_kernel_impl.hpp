@@ -148,11 +148,15 @@ void advance_tile_level(TileBuffers &b, int in, const TileRect &reg, const TileR
             store(h_out + c, sum, m);
             store(res_out + c, err, m);
 
-            moved = V::either(moved, changes);
+            // Motion is sand carried by a face, even where an increment is too
+            // small to change a height (a tiny dt): such a cell stays hot.
+            const M carried = V::either(V::either(f_west != zero, f_east != zero),
+                                        V::either(f_south != zero, f_north != zero));
+            moved = V::either(moved, V::either(changes, carried));
             if (!row_in_tile) continue;
             const M in_tile =
                 V::both(V::but_not(V::first_lanes(tile.c1 - col), V::first_lanes(tile.c0 - col)), V::first_lanes(m));
-            const M hot = V::both(changes, in_tile);
+            const M hot = V::both(V::either(changes, carried), in_tile);
             if (V::any(hot)) {
                 moved_r0 = std::min(moved_r0, r);
                 moved_r1 = std::max(moved_r1, r + 1);

@@ -793,8 +793,12 @@ static void test_set_repose_angle_edges(void **state) {
         CHECK_OK(g, dpsm_stable_dt(g, &dt));
         REQUIRE_REL(dt, 1.0 / (2.0 * cos(thetas[k])), 1e-15);
     }
-    CHECK_OK(g, dpsm_set_mobility(g, 1e-300));
-    CHECK_OK(g, dpsm_set_mobility(g, 1e300));
+    /* The supported range of the mobility is [1e-50, 1e50], ends included. */
+    CHECK_OK(g, dpsm_set_mobility(g, 1e-50));
+    CHECK_OK(g, dpsm_set_mobility(g, 1e50));
+    REQUIRE(dpsm_set_mobility(g, 1e-51) == DPSM_ERR_INVALID_VALUE, "mobility 1e-51 accepted");
+    REQUIRE(dpsm_set_mobility(g, 1e51) == DPSM_ERR_INVALID_VALUE, "mobility 1e51 accepted");
+    REQUIRE(strstr(dpsm_last_error(g), "supported range") != NULL, "message: %s", dpsm_last_error(g));
     CHECK_OK(g, dpsm_set_rest_tolerance(g, 1e-300));
     CHECK_OK(g, dpsm_set_rest_tolerance(g, 1e300));
     CHECK_OK(g, dpsm_set_max_substeps(g, 1));
@@ -928,10 +932,10 @@ static void test_heights_round_trip(void **state) {
     for (int c = 0; c < N; ++c) h[c] = 0.1 * c - 0.7;
     h[0] = -0.0;
     h[1] = DBL_MIN / 4.0; /* subnormal */
-    h[2] = 1e300;
+    h[2] = 1e50; /* the ends of the supported range */
     h[3] = -123.456; /* the wall cell keeps its height */
-    h[4] = 1e200;
-    h[N - 1] = -1e200;
+    h[4] = 1e49;
+    h[N - 1] = -1e50;
     CHECK_OK(g, dpsm_set_heights(g, h));
     memset(back, 0xA5, sizeof back);
     CHECK_OK(g, dpsm_get_heights(g, back));
@@ -1381,22 +1385,27 @@ static void test_heights_region_1d_and_axisymmetric(void **state) {
     }
 }
 
-/* A sum that overflows is refused (and changes nothing). */
+/* A sum that leaves the supported range [-1e50, 1e50] (or overflows) is
+ * refused, and changes nothing; so are heights and changes beyond it. */
 static void test_add_heights_region_overflow(void **state) {
     (void)state;
     dpsm_grid *g = NULL;
     CHECK_OK(NULL, dpsm_create_2d(3, 2, 1.0, 1.0, &g));
-    const double h[6] = {0.0, 1e308, -1e308, 0.0, 0.0, 0.0};
+    const double h[6] = {0.0, 1e50, -1e50, 0.0, 0.0, 0.0};
     CHECK_OK(g, dpsm_set_heights(g, h));
-    const double up[2] = {1.0, 1e308}, down[2] = {-1e308, 0.0};
+    const double up[2] = {1.0, 1e50}, down[2] = {-1e50, 0.0};
     EXPECT_FAIL_EX(NULL, g, dpsm_add_heights_region(g, 0, 0, 2, 1, up), DPSM_ERR_INVALID_VALUE,
                    "dpsm_add_heights_region", "dh", "dh[1]");
     EXPECT_FAIL_EX(NULL, g, dpsm_add_heights_region(g, 2, 0, 1, 1, down), DPSM_ERR_INVALID_VALUE,
                    "dpsm_add_heights_region", "dh", "dh[0]");
-    EXPECT_FAIL_EX(NULL, g, dpsm_add_heights_region(g, 0, 0, 3, 1, (const double[3]){DBL_MAX, 1e308, 0.0}),
+    EXPECT_FAIL_EX(NULL, g, dpsm_add_heights_region(g, 0, 0, 3, 1, (const double[3]){0.0, DBL_MAX, 0.0}),
                    DPSM_ERR_INVALID_VALUE, "dpsm_add_heights_region", "dh", "dh[1]");
-    /* Large but finite sums are fine. */
-    CHECK_OK(g, dpsm_add_heights_region(g, 1, 0, 2, 1, (const double[2]){-1e308, 1e308}));
+    EXPECT_FAIL_EX(NULL, g, dpsm_set_heights(g, (const double[6]){0.0, 0.0, 0.0, 0.0, 2e50, 0.0}),
+                   DPSM_ERR_INVALID_VALUE, "dpsm_set_heights", "h", "h[4]");
+    EXPECT_FAIL_EX(NULL, g, dpsm_set_source(g, (const double[6]){0.0, 0.0, 0.0, -1e51, 0.0, 0.0}),
+                   DPSM_ERR_INVALID_VALUE, "dpsm_set_source", "q", "q[3]");
+    /* Sums at the ends of the range are fine. */
+    CHECK_OK(g, dpsm_add_heights_region(g, 1, 0, 2, 1, (const double[2]){-1e50, 1e50}));
     dpsm_destroy(g);
 }
 

@@ -15,6 +15,10 @@
  *   is element `i + nx*j`, so a Fortran `h(nx, ny)` and a C `h[ny][nx]` match.
  * - Sizes are `int64_t`; angles are in radians; heights, lengths and times are
  *   in whatever consistent units the host uses.
+ * - The supported range, in which every slope, its square and every mass stay
+ *   finite: heights and sources within [-1e50, 1e50]; cell sizes and the
+ *   mobility within [1e-50, 1e50]. Values outside it are refused with
+ *   ::DPSM_ERR_INVALID_VALUE.
  * - A handle may be used by one thread at a time; any number of handles may be
  *   used concurrently.
  */
