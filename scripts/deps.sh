@@ -18,6 +18,10 @@ DPSM_APT_PACKAGES=(
     python3            # the Python binding's tests, the binding coverage checks
     python3-numpy      # the Python tests with numpy (Debian's /usr/bin/python3)
     python3-matplotlib # the Python example's plot
+    clang              # scripts/sanitize: ThreadSanitizer and libFuzzer builds
+    libclang-rt-14-dev # scripts/sanitize: clang's sanitizer and libFuzzer runtimes
+    libomp-14-dev      # scripts/sanitize: OpenMP (libomp and its Archer tool) under ThreadSanitizer
+    abigail-tools      # the `abi` test: abidw/abidiff against tests/abi/libdpsm.abi
 )
 
 DPSM_ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)

@@ -1072,8 +1072,10 @@ static void test_last_error_is_per_grid(void **state) {
     assert_true(kept[0] != '\0');
     assert_int_equal(dpsm_set_repose_angle(b, 3.0), DPSM_ERR_INVALID_VALUE);
     assert_int_equal(dpsm_step(NULL, 1.0), DPSM_ERR_NULL_POINTER);
-    assert_int_equal(dpsm_create_1d(0, 1.0, &b), DPSM_ERR_INVALID_SIZE); /* b is set to NULL here */
-    assert_null(b);
+    dpsm_grid *c = b;
+    assert_int_equal(dpsm_create_1d(0, 1.0, &c), DPSM_ERR_INVALID_SIZE); /* c is set to NULL here */
+    assert_null(c);
+    dpsm_destroy(b);
     assert_string_equal(dpsm_last_error(a), kept);
     check_message_at(dpsm_last_error(NULL), "dpsm_create_1d", "nx", NULL, __FILE__, __LINE__);
     dpsm_destroy(a);

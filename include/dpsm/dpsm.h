@@ -364,11 +364,11 @@ DPSM_API int dpsm_set_source(dpsm_grid *g, const double *q);
  *
  * `cos(theta)` is the largest slope of the flux law. At this sub-step no pair
  * of cells exchanges more sand than brings it to the angle of repose (the
- * paper's bound on the mass exchanged per step) and, for the pairwise scheme
- * and on 1D and axisymmetric grids, every new height is a weighted mean of old
- * ones, so the surface gains no new maximum or minimum. For the isotropic
- * scheme this is tested on rough terrains, not proven. dpsm_step() picks its
- * sub-steps from it.
+ * paper's bound on the mass exchanged per step), and every new height is a
+ * weighted mean of old ones, so the surface gains no new maximum or minimum:
+ * a face carries `C * (h_a - h_b)` with `0 <= C <= nu cos(theta) / d`, for both
+ * schemes (the isotropic one only makes `C` depend on the transverse slope).
+ * dpsm_step() picks its sub-steps from it.
  *
  * @param g   the grid.
  * @param dt  receives the sub-step.

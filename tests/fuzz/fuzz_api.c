@@ -1,0 +1,919 @@
+/* A fuzzer of the whole C API (libFuzzer's entry point, LLVMFuzzerTestOneInput).
+ *
+ * The input bytes are read as a program: each operation is one byte of
+ * opcode followed by its arguments (a grid slot, sizes, indices, a choice of
+ * value from the tables below, array patterns). Up to three grids live at
+ * once. Each grid has a twin that receives only the calls that succeeded on
+ * it, so that a failed call that changed hidden state (a parameter, a mask, the
+ * active set) shows up as a difference in a later step.
+ *
+ * After every operation:
+ *   - the status is one dpsm documents for that function and, where the
+ *     arguments decide it, exactly the expected one (a value out of range, a
+ *     block off the grid, a step over the sub-step limit in a scene that may
+ *     flow forever, ...); never DPSM_ERR_INTERNAL;
+ *   - a failed call left a message naming the function and changed nothing
+ *     (heights, ledger, step information, stable step: bit for bit); a
+ *     successful one cleared the message;
+ *   - every height is finite; the ledger closes to 1e-12 of the largest mass
+ *     figure; the grid and its twin are bit-identical;
+ *   - after a step without a source: no new extremum (sand, held levels of
+ *     open cells, 0 beyond an open side), held cells unchanged; at rest (and
+ *     not driven): no face steeper than tan(theta) (1 + tol).
+ * A violated check prints what it saw and calls abort(), which libFuzzer (or
+ * the replay driver, fuzz_replay.c) reports with the input.
+ *
+ * Values stay in the range where the library is meant to work (heights up to
+ * 1e6, spacings 1e-3 .. 1e3, mobility 1e-6 .. 1e6, dt from 1e-300). With
+ * DPSM_FUZZ_EXTREME=1 in the environment it also tries the far ends of double
+ * (heights to DBL_MAX, spacings 1e-200 and 1e200, dt = 5e-324, huge dt on
+ * scenes that rest by themselves), where the library is known to fail
+ * (docs/guarantees.md, "Known limits"). */
+#include <float.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <dpsm/dpsm.h>
+
+int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
+
+/* ------------------------------------------------------------------------ */
+/* Reading the input                                                         */
+/* ------------------------------------------------------------------------ */
+
+typedef struct {
+    const uint8_t *p;
+    size_t n, at;
+} reader_t;
+
+static unsigned u8(reader_t *r) { return r->at < r->n ? r->p[r->at++] : 0u; }
+static unsigned u16(reader_t *r) { return u8(r) | (u8(r) << 8); }
+static int more(const reader_t *r) { return r->at < r->n; }
+
+static int extreme_mode(void) {
+    static int mode = -1;
+    if (mode < 0) {
+        const char *e = getenv("DPSM_FUZZ_EXTREME");
+        mode = e && *e && *e != '0';
+    }
+    return mode;
+}
+
+#define COUNT(a) (sizeof(a) / sizeof((a)[0]))
+
+/* Picks from a table of ordinary values, or (when the byte's top bit is set)
+ * from a table of hostile ones. */
+static double pick(reader_t *r, const double *ok, size_t nok, const double *bad, size_t nbad) {
+    const unsigned b = u8(r);
+    if ((b & 0x80) && nbad) return bad[(b & 0x7f) % nbad];
+    return ok[b % nok];
+}
+
+static const double kNaN = NAN;
+static const double kInf = INFINITY;
+
+static const double kSpacings[] = {1.0, 0.5, 2.0, 0.1, 10.0, 0.25, 3.0, 1e-3, 1e3, 0.37};
+static const double kSpacingsBad[] = {0.0, -0.0, -1.0, NAN, INFINITY, -INFINITY, -1e-300};
+static const double kSpacingsExtreme[] = {1e-200, 1e200, 1e-155, 1e150, DBL_MIN, DBL_MAX};
+
+static const double kHeights[] = {0.0, 1.0, -1.0, 0.25, 3.0, 10.0, 100.0, 1e3, 1e-9, -1e3, 1e6, -0.0, 5e-324,
+                                  0.5, 2.0, -3.0, 7.0, 1e-3, 30.0, -1e6};
+static const double kHeightsExtreme[] = {1e150, -1e150, 1e300, -1e300, DBL_MAX, -DBL_MAX};
+
+static const double kSources[] = {0.0, 1e-3, -1e-3, 0.1, -0.1, 1.0, -1.0, 10.0, 1e-9, 0.0, 0.0, 0.0};
+
+static const double kAngles[] = {0.5235987755982988, 0.1, 1.0, 0.00872664625997165, 1.562069680534925,
+                                 1e-6, 1.5707963267948963, 0.7853981633974483, 1.3, 0.3};
+static const double kAnglesBad[] = {0.0, -0.1, 1.5707963267948966, 2.0, 3.14159, NAN, INFINITY, -INFINITY};
+
+static const double kMobilities[] = {1.0, 0.5, 2.0, 1e-6, 1e6, 1e-3, 1e3, 0.1};
+static const double kPositiveBad[] = {0.0, -0.0, -1.0, NAN, INFINITY, -INFINITY, -1e-300};
+
+static const double kTolerances[] = {1e-6, 1e-9, 1e-3, 1e-15, 0.1, 1.0, 1e3, 1e-12};
+
+static const double kDtFactors[] = {1e-12, 1e-6, 0.1, 0.5, 1.0, 1.5, 2.0, 4.0, 10.0, 100.0, 1000.0, 0.999, 3.7};
+static const double kDtBad[] = {0.0, -0.0, -1.0, NAN, INFINITY, -INFINITY, -1e-300};
+
+/* ------------------------------------------------------------------------ */
+/* Failing loudly                                                            */
+/* ------------------------------------------------------------------------ */
+
+static const char *g_op = "?"; /* the operation under way, for messages */
+static long g_opcount;
+
+/* DPSM_FUZZ_TRACE=1: one line per call on stderr (to see what an input does). */
+static int trace_on(void) {
+    static int on = -1;
+    if (on < 0) {
+        const char *e = getenv("DPSM_FUZZ_TRACE");
+        on = e && *e && *e != '0';
+    }
+    return on;
+}
+static void trace(const char *fmt, ...) {
+    if (!trace_on()) return;
+    va_list ap;
+    va_start(ap, fmt);
+    fprintf(stderr, "  [%ld] ", g_opcount);
+    vfprintf(stderr, fmt, ap);
+    va_end(ap);
+    fprintf(stderr, "\n");
+}
+
+static void die(const char *fmt, ...) {
+    va_list ap;
+    fprintf(stderr, "\ndpsm fuzz: check failed in operation %ld (%s): ", g_opcount, g_op);
+    va_start(ap, fmt);
+    vfprintf(stderr, fmt, ap);
+    va_end(ap);
+    fprintf(stderr, "\n");
+    abort();
+}
+
+/* ------------------------------------------------------------------------ */
+/* Grids and what the harness knows about them                               */
+/* ------------------------------------------------------------------------ */
+
+enum { GEOM_1D = 1, GEOM_2D = 2, GEOM_AXI = 3 };
+#define NSLOTS 3
+#define MAX_CELLS 4900
+
+typedef struct {
+    dpsm_grid *g, *twin;
+    int geom;
+    int64_t nx, ny, n;
+    double dx, dy, theta, tol;
+    int64_t max_substeps;
+    int open[4];
+    uint8_t *kinds;
+    double *source; /* NULL: none */
+    double mass_scale;
+} slot_t;
+
+/* The step information items this header knows (a newer header may add some). */
+#ifdef DPSM_INFO_CELL_UPDATES
+#define NINFO (DPSM_INFO_CELL_UPDATES + 1)
+#else
+#define NINFO (DPSM_INFO_MAX_EXCESS_SLOPE + 1)
+#endif
+
+typedef struct {
+    int64_t nx, ny;
+    double *h;
+    double mass[4], info[NINFO], stable_dt;
+} snap_t;
+
+static slot_t g_slots[NSLOTS];
+static double g_work; /* cell sub-steps spent on this input */
+static const double kWorkBudget = 3e6;
+
+static void snap(const dpsm_grid *g, const slot_t *s, snap_t *out) {
+    out->h = malloc(sizeof(double) * (size_t)s->n);
+    if (!out->h) die("out of memory");
+    if (dpsm_get_shape(g, &out->nx, &out->ny) != DPSM_OK) die("get_shape failed: %s", dpsm_last_error(g));
+    if (dpsm_get_heights(g, out->h) != DPSM_OK) die("get_heights failed: %s", dpsm_last_error(g));
+    for (int q = 0; q < 4; ++q)
+        if (dpsm_get_mass(g, q, &out->mass[q]) != DPSM_OK) die("get_mass failed");
+    for (int i = 0; i < NINFO; ++i)
+        if (dpsm_get_step_info(g, i, &out->info[i]) != DPSM_OK) die("get_step_info failed");
+    if (dpsm_stable_dt(g, &out->stable_dt) != DPSM_OK) die("stable_dt failed");
+}
+
+static void unsnap(snap_t *s) {
+    free(s->h);
+    s->h = NULL;
+}
+
+static void same(const slot_t *s, const snap_t *a, const snap_t *b, const char *what) {
+    if (a->nx != b->nx || a->ny != b->ny) die("%s: the shape changed", what);
+    for (int64_t c = 0; c < s->n; ++c)
+        if (memcmp(&a->h[c], &b->h[c], sizeof(double)) != 0)
+            die("%s: height %lld differs: %.17g vs %.17g", what, (long long)c, a->h[c], b->h[c]);
+    static const char *const mass_names[4] = {"TOTAL", "SOURCED", "EXTERNAL", "OUTFLOW"};
+    for (int q = 0; q < 4; ++q)
+        if (memcmp(&a->mass[q], &b->mass[q], sizeof(double)) != 0)
+            die("%s: mass %s differs: %.17g vs %.17g", what, mass_names[q], a->mass[q], b->mass[q]);
+    static const char *const info_names[] = {"SUBSTEPS", "TIME_INTEGRATED", "AT_REST", "MAX_EXCESS_SLOPE",
+                                             "CELL_UPDATES", "?", "?", "?"};
+    for (int i = 0; i < NINFO; ++i)
+        if (memcmp(&a->info[i], &b->info[i], sizeof(double)) != 0)
+            die("%s: step info %s differs: %.17g vs %.17g", what, info_names[i], a->info[i], b->info[i]);
+    if (memcmp(&a->stable_dt, &b->stable_dt, sizeof(double)) != 0)
+        die("%s: stable_dt differs: %.17g vs %.17g", what, a->stable_dt, b->stable_dt);
+}
+
+static double cell_area(const slot_t *s, int64_t c) {
+    if (s->geom == GEOM_AXI) return 6.283185307179586476925 * ((double)c + 0.5) * s->dx * s->dx;
+    return s->geom == GEOM_1D ? s->dx : s->dx * s->dy;
+}
+
+static int any_side_open(const slot_t *s) { return s->open[0] || s->open[1] || s->open[2] || s->open[3]; }
+
+static int source_active(const slot_t *s) {
+    if (!s->source) return 0;
+    for (int64_t c = 0; c < s->n; ++c)
+        if (s->kinds[c] == DPSM_CELL_SAND && s->source[c] != 0.0) return 1;
+    return 0;
+}
+
+/* As dpsm_step documents: a source acts, or held levels differ. */
+static int driven(const slot_t *s, const double *h) {
+    if (source_active(s)) return 1;
+    int have = any_side_open(s);
+    double level = 0.0;
+    for (int64_t c = 0; c < s->n; ++c) {
+        if (s->kinds[c] != DPSM_CELL_OPEN) continue;
+        if (have && h[c] != level) return 1;
+        level = h[c];
+        have = 1;
+    }
+    return 0;
+}
+
+/* The invariants of any state. */
+static void check_state(slot_t *s, const snap_t *now) {
+    for (int64_t c = 0; c < s->n; ++c)
+        if (!isfinite(now->h[c])) die("height %lld is %g", (long long)c, now->h[c]);
+    for (int q = 0; q < 4; ++q)
+        if (!isfinite(now->mass[q])) die("mass figure %d is %g", q, now->mass[q]);
+    double gross = 0.0, sand_gross = 0.0;
+    for (int64_t c = 0; c < s->n; ++c) {
+        const double m = fabs(now->h[c]) * cell_area(s, c);
+        gross += m;
+        if (s->kinds[c] == DPSM_CELL_SAND) sand_gross += m;
+    }
+    double scale = fmax(fmax(s->mass_scale, sand_gross), 1e-300);
+    for (int q = 0; q < 4; ++q) scale = fmax(scale, fabs(now->mass[q]));
+    const double residual = fabs(now->mass[0] - (now->mass[1] + now->mass[2] - now->mass[3]));
+    if (residual > 1e-12 * scale)
+        die("the ledger does not close: total %.17g, sourced %.17g, external %.17g, outflow %.17g: residual %.3g "
+            "(%.3g relative)",
+            now->mass[0], now->mass[1], now->mass[2], now->mass[3], residual, residual / scale);
+    if (!(now->stable_dt > 0.0)) die("stable_dt = %g", now->stable_dt);
+    (void)gross;
+}
+
+/* After host changes: what the ledger's round-off is relative to. */
+static void note_mass_scale(slot_t *s, const snap_t *now) {
+    double gross = 0.0;
+    for (int64_t c = 0; c < s->n; ++c) gross += fabs(now->h[c]) * cell_area(s, c);
+    s->mass_scale = fmax(s->mass_scale, gross);
+}
+
+static void compare_twin(slot_t *s, const snap_t *main_snap) {
+    snap_t t;
+    snap(s->twin, s, &t);
+    same(s, main_snap, &t, "the grid and its twin");
+    unsnap(&t);
+}
+
+/* A failed call: a documented status, the function named in the message,
+ * nothing changed. */
+static void check_failed(slot_t *s, const dpsm_grid *g, const snap_t *before, int status, const char *fn) {
+    if (status == DPSM_ERR_INTERNAL) die("%s: DPSM_ERR_INTERNAL: %s", fn, dpsm_last_error(g));
+    if (status < 0 || status > DPSM_ERR_INTERNAL) die("%s: unknown status %d", fn, status);
+    const char *msg = dpsm_last_error(g);
+    if (!msg || !*msg) die("%s failed with %s and no message", fn, dpsm_status_string(status));
+    if (!strstr(msg, fn)) die("%s failed with the message \"%s\", which does not name it", fn, msg);
+    if (s && before) {
+        snap_t after;
+        snap(s->g, s, &after);
+        same(s, before, &after, "a failed call changed the grid");
+        unsnap(&after);
+    }
+}
+
+static void expect_status(int got, int want, const char *fn, const dpsm_grid *g) {
+    trace("%s -> %s", fn, dpsm_status_string(got));
+    if (got != want)
+        die("%s returned %s, expected %s (%s)", fn, dpsm_status_string(got), dpsm_status_string(want),
+            dpsm_last_error(g));
+}
+
+/* Runs `call` on the slot's grid; on success runs it on the twin too. */
+#define ON_BOTH(s, want, fn, call_on)                                                                   \
+    do {                                                                                                \
+        snap_t before_;                                                                                 \
+        snap((s)->g, (s), &before_);                                                                    \
+        const dpsm_grid *target_ = (s)->g;                                                              \
+        dpsm_grid *g_ = (s)->g;                                                                         \
+        const int st_ = (call_on);                                                                      \
+        expect_status(st_, (want), (fn), target_);                                                      \
+        if (st_ != DPSM_OK) {                                                                           \
+            check_failed((s), target_, &before_, st_, (fn));                                            \
+        } else {                                                                                        \
+            if (*dpsm_last_error(target_)) die("%s succeeded but left the message \"%s\"", (fn),         \
+                                               dpsm_last_error(target_));                               \
+            g_ = (s)->twin;                                                                             \
+            const int tw_ = (call_on);                                                                  \
+            if (tw_ != DPSM_OK) die("%s failed on the twin: %s", (fn), dpsm_last_error((s)->twin));     \
+        }                                                                                               \
+        unsnap(&before_);                                                                               \
+    } while (0)
+
+static void destroy_slot(slot_t *s) {
+    dpsm_destroy(s->g);
+    dpsm_destroy(s->twin);
+    free(s->kinds);
+    free(s->source);
+    memset(s, 0, sizeof *s);
+}
+
+/* ------------------------------------------------------------------------ */
+/* Arrays                                                                    */
+/* ------------------------------------------------------------------------ */
+
+static double height_value(reader_t *r) {
+    const unsigned b = u8(r);
+    if (extreme_mode() && (b & 0xc0) == 0xc0) return kHeightsExtreme[b % COUNT(kHeightsExtreme)];
+    return kHeights[b % COUNT(kHeights)];
+}
+
+/* Fills n values by a pattern from the input. Returns 1 if it planted a
+ * non-finite value (the call must then fail with DPSM_ERR_INVALID_VALUE). */
+static int fill(reader_t *r, double *a, int64_t n, int64_t nx, int source) {
+    const unsigned mode = u8(r);
+    const double v = source ? kSources[u8(r) % COUNT(kSources)] : height_value(r);
+    const double w = source ? kSources[u8(r) % COUNT(kSources)] : height_value(r);
+    for (int64_t c = 0; c < n; ++c) {
+        const int64_t i = c % nx, j = c / nx;
+        switch (mode % 6) {
+            case 0: a[c] = v; break;
+            case 1: a[c] = (i + j) % 2 ? v : w; break;
+            case 2: a[c] = (2 * i > nx - 1 && i < nx - 1) ? v : w; break;
+            case 3: a[c] = v + w * (double)i; break;
+            case 4: a[c] = source ? kSources[u8(r) % COUNT(kSources)] : height_value(r); break;
+            default: a[c] = c == (int64_t)(u8(r) % (unsigned)n) ? v : w; break;
+        }
+        if (!isfinite(a[c])) a[c] = 0.0; /* v + w * i may overflow in extreme mode */
+    }
+    if ((mode & 0xc0) == 0xc0 && n > 0) {
+        static const double bad[] = {NAN, INFINITY, -INFINITY};
+        a[u16(r) % (unsigned)n] = bad[u8(r) % 3];
+        return 1;
+    }
+    return 0;
+}
+
+/* ------------------------------------------------------------------------ */
+/* Operations                                                                */
+/* ------------------------------------------------------------------------ */
+
+static slot_t *pick_slot(reader_t *r) {
+    slot_t *s = &g_slots[u8(r) % NSLOTS];
+    return s->g ? s : NULL;
+}
+
+static int64_t size_value(reader_t *r, int *bad) {
+    const unsigned b = u8(r);
+    *bad = 0;
+    if (b < 160) return 1 + b % 9;
+    if (b < 230) return 60 + b % 12; /* across the 64-cell tile edge */
+    static const int64_t hostile[] = {0, -1, INT64_MIN, -64, INT64_MAX, INT64_MAX / 64 + 1};
+    const int64_t v = hostile[b % COUNT(hostile)];
+    *bad = 1;
+    return v;
+}
+
+static double spacing_value(reader_t *r) {
+    const unsigned b = u8(r);
+    if (extreme_mode() && (b & 0xe0) == 0xe0) return kSpacingsExtreme[b % COUNT(kSpacingsExtreme)];
+    if (b & 0x80 && (b & 0x40)) return kSpacingsBad[b % COUNT(kSpacingsBad)];
+    return kSpacings[b % COUNT(kSpacings)];
+}
+
+static int valid_positive(double v) { return isfinite(v) && v > 0.0; }
+
+static void op_create(reader_t *r) {
+    g_op = "create";
+    slot_t *s = &g_slots[u8(r) % NSLOTS];
+    if (s->g) destroy_slot(s);
+    const int geom = 1 + (int)(u8(r) % 3);
+    int bad_nx, bad_ny;
+    int64_t nx = size_value(r, &bad_nx), ny = geom == GEOM_2D ? size_value(r, &bad_ny) : 1;
+    if (geom != GEOM_2D) bad_ny = 0;
+    const double dx = spacing_value(r), dy = geom == GEOM_2D ? spacing_value(r) : 1.0;
+    const int null_out = u8(r) == 0xff;
+    if (!bad_nx && !bad_ny && nx * ny > MAX_CELLS) ny = MAX_CELLS / nx; /* keep inputs fast */
+    int want = DPSM_OK;
+    if (null_out)
+        want = DPSM_ERR_NULL_POINTER;
+    else if (bad_nx || bad_ny)
+        want = DPSM_ERR_INVALID_SIZE;
+    else if (!valid_positive(dx) || !valid_positive(dy))
+        want = DPSM_ERR_INVALID_VALUE;
+    const char *fn = geom == GEOM_1D ? "dpsm_create_1d" : geom == GEOM_2D ? "dpsm_create_2d" : "dpsm_create_axisymmetric";
+    dpsm_grid *made[2] = {(dpsm_grid *)&made, (dpsm_grid *)&made}; /* not NULL: a failure must set NULL */
+    for (int k = 0; k < (want == DPSM_OK ? 2 : 1); ++k) {
+        dpsm_grid **out = null_out ? NULL : &made[k];
+        int st;
+        if (geom == GEOM_1D)
+            st = dpsm_create_1d(nx, dx, out);
+        else if (geom == GEOM_2D)
+            st = dpsm_create_2d(nx, ny, dx, dy, out);
+        else
+            st = dpsm_create_axisymmetric(nx, dx, out);
+        expect_status(st, want, fn, NULL);
+        if (st != DPSM_OK) {
+            check_failed(NULL, NULL, NULL, st, fn);
+            if (!null_out && made[k] != NULL) die("%s failed but did not set *out to NULL", fn);
+            return;
+        }
+        if (*dpsm_last_error(NULL)) die("%s succeeded but left the message \"%s\"", fn, dpsm_last_error(NULL));
+    }
+    s->g = made[0];
+    s->twin = made[1];
+    s->geom = geom;
+    s->nx = nx;
+    s->ny = ny;
+    s->n = nx * ny;
+    s->dx = dx;
+    s->dy = geom == GEOM_2D ? dy : 1.0;
+    s->theta = DPSM_DEFAULT_REPOSE_ANGLE;
+    s->tol = DPSM_DEFAULT_REST_TOLERANCE;
+    s->max_substeps = DPSM_DEFAULT_MAX_SUBSTEPS;
+    s->kinds = calloc((size_t)s->n, 1);
+    if (!s->kinds) die("out of memory");
+    int64_t sx, sy;
+    if (dpsm_get_shape(s->g, &sx, &sy) != DPSM_OK || sx != nx || sy != ny)
+        die("the new grid's shape is not %lld x %lld", (long long)nx, (long long)ny);
+}
+
+static void op_parameter(reader_t *r, unsigned which) {
+    slot_t *s = pick_slot(r);
+    if (!s) return;
+    switch (which) {
+        case 0: {
+            g_op = "dpsm_set_repose_angle";
+            const double v = pick(r, kAngles, COUNT(kAngles), kAnglesBad, COUNT(kAnglesBad));
+            const int ok = isfinite(v) && v > 0.0 && v < 0.5 * 3.14159265358979323846;
+            ON_BOTH(s, ok ? DPSM_OK : DPSM_ERR_INVALID_VALUE, g_op, dpsm_set_repose_angle(g_, v));
+            if (ok) s->theta = v;
+            break;
+        }
+        case 1: {
+            g_op = "dpsm_set_mobility";
+            const double v = pick(r, kMobilities, COUNT(kMobilities), kPositiveBad, COUNT(kPositiveBad));
+            ON_BOTH(s, valid_positive(v) ? DPSM_OK : DPSM_ERR_INVALID_VALUE, g_op, dpsm_set_mobility(g_, v));
+            break;
+        }
+        case 2: {
+            g_op = "dpsm_set_scheme";
+            static const int schemes[] = {0, 1, 0, 1, 2, -1, 1000, INT32_MIN};
+            const int v = schemes[u8(r) % COUNT(schemes)];
+            ON_BOTH(s, v == 0 || v == 1 ? DPSM_OK : DPSM_ERR_UNKNOWN_ENUM, g_op, dpsm_set_scheme(g_, v));
+            break;
+        }
+        case 3: {
+            g_op = "dpsm_set_boundary";
+            const unsigned b = u8(r);
+            const int side = (int)(b % 6) - 1, kind = (int)((b / 6) % 4) - 1;
+            int want = DPSM_OK;
+            if (side < 0 || side > 3 || kind < 0 || kind > 1)
+                want = DPSM_ERR_UNKNOWN_ENUM;
+            else if ((s->geom != GEOM_2D && side >= 2) || (s->geom == GEOM_AXI && side == DPSM_XMIN))
+                want = DPSM_ERR_NOT_APPLICABLE;
+            ON_BOTH(s, want, g_op, dpsm_set_boundary(g_, side, kind));
+            if (want == DPSM_OK) s->open[side] = kind == DPSM_OPEN;
+            break;
+        }
+        case 4: {
+            g_op = "dpsm_set_rest_tolerance";
+            const double v = pick(r, kTolerances, COUNT(kTolerances), kPositiveBad, COUNT(kPositiveBad));
+            ON_BOTH(s, valid_positive(v) ? DPSM_OK : DPSM_ERR_INVALID_VALUE, g_op, dpsm_set_rest_tolerance(g_, v));
+            if (valid_positive(v)) s->tol = v;
+            break;
+        }
+        case 5: {
+            g_op = "dpsm_set_max_substeps";
+            static const int64_t values[] = {1, 2, 10, 1000, 100000, DPSM_DEFAULT_MAX_SUBSTEPS, INT64_MAX, 0, -1,
+                                             INT64_MIN};
+            const int64_t v = values[u8(r) % COUNT(values)];
+            ON_BOTH(s, v >= 1 ? DPSM_OK : DPSM_ERR_INVALID_VALUE, g_op, dpsm_set_max_substeps(g_, v));
+            if (v >= 1) s->max_substeps = v;
+            break;
+        }
+        default: {
+            g_op = "dpsm_set_threads";
+            static const int values[] = {0, 1, 2, 3, 1, 2, -1, INT32_MIN};
+            const int v = values[u8(r) % COUNT(values)];
+            ON_BOTH(s, v >= 0 ? DPSM_OK : DPSM_ERR_INVALID_VALUE, g_op, dpsm_set_threads(g_, v));
+            break;
+        }
+    }
+}
+
+static void op_kinds(reader_t *r) {
+    g_op = "dpsm_set_cell_kinds";
+    slot_t *s = pick_slot(r);
+    if (!s) return;
+    const unsigned mode = u8(r);
+    uint8_t *k = NULL;
+    int want = DPSM_OK;
+    if (mode % 8 != 0) {
+        k = malloc((size_t)s->n);
+        if (!k) die("out of memory");
+        for (int64_t c = 0; c < s->n; ++c) {
+            const unsigned b = mode % 8 == 1 ? u8(r) : (unsigned)(c * 7 + mode) % 13;
+            k[c] = b < 9 ? DPSM_CELL_SAND : b < 11 ? DPSM_CELL_WALL : DPSM_CELL_OPEN;
+        }
+        if ((mode & 0xe0) == 0xe0) {
+            static const uint8_t bad[] = {3, 4, 200, 255};
+            k[u16(r) % (unsigned)s->n] = bad[u8(r) % 4];
+            want = DPSM_ERR_UNKNOWN_ENUM;
+        }
+    }
+    ON_BOTH(s, want, g_op, dpsm_set_cell_kinds(g_, k));
+    if (want == DPSM_OK) {
+        if (k)
+            memcpy(s->kinds, k, (size_t)s->n);
+        else
+            memset(s->kinds, 0, (size_t)s->n);
+    }
+    free(k);
+}
+
+static void op_heights(reader_t *r) {
+    g_op = "dpsm_set_heights";
+    slot_t *s = pick_slot(r);
+    if (!s) return;
+    double *h = malloc(sizeof(double) * (size_t)s->n);
+    if (!h) die("out of memory");
+    const int planted = fill(r, h, s->n, s->nx, 0);
+    const int null_array = u8(r) == 0xfe;
+    const double *arg = null_array ? NULL : h;
+    const int want = null_array ? DPSM_ERR_NULL_POINTER : planted ? DPSM_ERR_INVALID_VALUE : DPSM_OK;
+    ON_BOTH(s, want, g_op, dpsm_set_heights(g_, arg));
+    free(h);
+}
+
+static void op_source(reader_t *r) {
+    g_op = "dpsm_set_source";
+    slot_t *s = pick_slot(r);
+    if (!s) return;
+    double *q = malloc(sizeof(double) * (size_t)s->n);
+    if (!q) die("out of memory");
+    const int none = u8(r) % 4 == 0;
+    const int planted = none ? 0 : fill(r, q, s->n, s->nx, 1);
+    const int want = planted ? DPSM_ERR_INVALID_VALUE : DPSM_OK;
+    const double *arg = none ? NULL : q;
+    ON_BOTH(s, want, g_op, dpsm_set_source(g_, arg));
+    if (want == DPSM_OK) {
+        free(s->source);
+        s->source = none ? NULL : q;
+        if (!none) q = NULL;
+    }
+    free(q);
+}
+
+/* Block arguments: mostly on the grid, sometimes off it. */
+static void block_args(reader_t *r, const slot_t *s, int64_t *i0, int64_t *j0, int64_t *ni, int64_t *nj, int *bad) {
+    const unsigned b = u8(r);
+    *i0 = (int64_t)(u8(r) % (unsigned)s->nx);
+    *j0 = (int64_t)(u8(r) % (unsigned)s->ny);
+    *ni = 1 + (int64_t)(u8(r) % (unsigned)(s->nx - *i0));
+    *nj = 1 + (int64_t)(u8(r) % (unsigned)(s->ny - *j0));
+    *bad = 0;
+    if ((b & 0xc0) == 0xc0) {
+        static const int64_t wild[] = {-1, 0, 1, INT64_MAX, INT64_MIN, 64, -64, INT64_MAX - 1};
+        switch (b % 4) {
+            case 0: *i0 = wild[u8(r) % COUNT(wild)]; break;
+            case 1: *j0 = wild[u8(r) % COUNT(wild)]; break;
+            case 2: *ni = wild[u8(r) % COUNT(wild)]; break;
+            default: *nj = wild[u8(r) % COUNT(wild)]; break;
+        }
+        *bad = !(*ni >= 1 && *nj >= 1 && *i0 >= 0 && *j0 >= 0 && *i0 <= s->nx - *ni && *j0 <= s->ny - *nj);
+    }
+}
+
+static void op_region(reader_t *r, unsigned which) {
+    slot_t *s = pick_slot(r);
+    if (!s) return;
+    int64_t i0, j0, ni, nj;
+    int bad;
+    block_args(r, s, &i0, &j0, &ni, &nj, &bad);
+    const int64_t m = bad ? 1 : ni * nj;
+    double *v = malloc(sizeof(double) * (size_t)m);
+    if (!v) die("out of memory");
+    const int planted = fill(r, v, m, bad ? 1 : ni, 0);
+    const int null_array = u8(r) == 0xfd;
+    double *arg = null_array ? NULL : v;
+    int want = bad ? DPSM_ERR_INVALID_SIZE : null_array ? DPSM_ERR_NULL_POINTER : DPSM_OK;
+    if (which == 0) {
+        g_op = "dpsm_set_heights_region";
+        if (want == DPSM_OK && planted) want = DPSM_ERR_INVALID_VALUE;
+        ON_BOTH(s, want, g_op, dpsm_set_heights_region(g_, i0, j0, ni, nj, arg));
+    } else if (which == 1) {
+        g_op = "dpsm_add_heights_region";
+        if (want == DPSM_OK && planted) want = DPSM_ERR_INVALID_VALUE;
+        if (want == DPSM_OK) { /* a sum that overflows fails too */
+            snap_t now;
+            snap(s->g, s, &now);
+            for (int64_t k = 0; k < m; ++k)
+                if (!isfinite(now.h[(i0 + k % ni) + s->nx * (j0 + k / ni)] + v[k])) want = DPSM_ERR_INVALID_VALUE;
+            unsnap(&now);
+        }
+        ON_BOTH(s, want, g_op, dpsm_add_heights_region(g_, i0, j0, ni, nj, arg));
+    } else {
+        g_op = "dpsm_get_heights_region";
+        ON_BOTH(s, want, g_op, dpsm_get_heights_region(g_, i0, j0, ni, nj, arg));
+        if (want == DPSM_OK) {
+            snap_t now;
+            snap(s->g, s, &now);
+            for (int64_t k = 0; k < m; ++k) {
+                const double expected = now.h[(i0 + k % ni) + s->nx * (j0 + k / ni)];
+                if (memcmp(&v[k], &expected, sizeof(double)) != 0)
+                    die("get_heights_region value %lld is %.17g, the grid has %.17g", (long long)k, v[k], expected);
+            }
+            unsnap(&now);
+        }
+    }
+    free(v);
+}
+
+/* The largest face slope over tan(theta) (1 + tol), minus 1. */
+static double rest_excess(const slot_t *s, const double *h) {
+    const double threshold = tan(s->theta) * (1.0 + s->tol);
+    double worst = -INFINITY;
+    for (int64_t j = 0; j < s->ny; ++j)
+        for (int64_t i = 0; i < s->nx; ++i) {
+            const int64_t c = i + s->nx * j;
+            for (int f = 0; f < 6; ++f) {
+                int64_t b;
+                double d;
+                if (f == 0 && i + 1 < s->nx) b = c + 1, d = s->dx;
+                else if (f == 1 && j + 1 < s->ny) b = c + s->nx, d = s->dy;
+                else if (f == 2 && i == 0 && s->open[DPSM_XMIN] && s->geom != GEOM_AXI) b = -1, d = s->dx;
+                else if (f == 3 && i == s->nx - 1 && s->open[DPSM_XMAX]) b = -1, d = s->dx;
+                else if (f == 4 && j == 0 && s->geom == GEOM_2D && s->open[DPSM_YMIN]) b = -1, d = s->dy;
+                else if (f == 5 && j == s->ny - 1 && s->geom == GEOM_2D && s->open[DPSM_YMAX]) b = -1, d = s->dy;
+                else continue;
+                const int kb = b < 0 ? DPSM_CELL_OPEN : s->kinds[b];
+                const double hb = b < 0 ? 0.0 : h[b];
+                if (s->kinds[c] == DPSM_CELL_WALL || kb == DPSM_CELL_WALL) continue;
+                if (s->kinds[c] != DPSM_CELL_SAND && kb != DPSM_CELL_SAND) continue;
+                const double slope = fabs(h[c] - hb) / d;
+                const double slack = 4.0 * DBL_EPSILON * fmax(fabs(h[c]), fabs(hb)) / d;
+                worst = fmax(worst, (slope - slack) / threshold - 1.0);
+            }
+        }
+    return worst;
+}
+
+static void op_step(reader_t *r) {
+    g_op = "dpsm_step";
+    slot_t *s = pick_slot(r);
+    if (!s) return;
+    snap_t before;
+    snap(s->g, s, &before);
+    const unsigned b = u8(r);
+    const int drives = driven(s, before.h);
+    double dt;
+    if ((b & 0xe0) == 0xe0)
+        dt = kDtBad[b % COUNT(kDtBad)];
+    else if ((b & 0xe0) == 0xc0) {
+        /* 5e-324: every increment rounds to 0; the 2D sweep then takes a
+         * supercritical surface for one at rest (docs/guarantees.md). */
+        static const double absolute[] = {1e12, 1e300, DBL_MAX, 1e-300, 1e-12, 5e-324};
+        dt = absolute[b % (COUNT(absolute) - (extreme_mode() ? 0 : 1))];
+    } else
+        dt = before.stable_dt * kDtFactors[b % COUNT(kDtFactors)];
+
+    int want = DPSM_OK, either = 0;
+    double needed = 0.0;
+    if (!valid_positive(dt)) {
+        want = DPSM_ERR_INVALID_VALUE;
+    } else {
+        needed = ceil(dt / before.stable_dt);
+        const double limit = (double)s->max_substeps;
+        if (drives && (needed > 9007199254740992.0 || needed > limit)) want = DPSM_ERR_WORK_LIMIT;
+        if (drives && fabs(needed - limit) <= 1.0) either = 1; /* rounding of dt / stable_dt */
+        /* Bounded work: a scene at rest by itself stops early, but how early
+         * depends on the scene; keep to steps whose sub-steps we can afford. */
+        const double cost = fmin(needed, 1e18) * (double)s->n;
+        if ((want == DPSM_OK || either) && g_work + cost > kWorkBudget && !extreme_mode()) {
+            unsnap(&before);
+            return;
+        }
+        if (want == DPSM_OK || either) g_work += cost;
+    }
+
+    double hi = -INFINITY, lo = INFINITY;
+    for (int64_t c = 0; c < s->n; ++c)
+        if (s->kinds[c] != DPSM_CELL_WALL) {
+            hi = fmax(hi, before.h[c]);
+            lo = fmin(lo, before.h[c]);
+        }
+    if (any_side_open(s)) {
+        hi = fmax(hi, 0.0);
+        lo = fmin(lo, 0.0);
+    }
+
+    const int st = dpsm_step(s->g, dt);
+    trace("dpsm_step(%g = %g stable steps) on %lld x %lld, %s", dt, dt / before.stable_dt, (long long)s->nx,
+          (long long)s->ny, drives ? "driven" : "not driven");
+    if (either && (st == DPSM_OK || st == DPSM_ERR_WORK_LIMIT)) want = st;
+    expect_status(st, want, g_op, s->g);
+    if (st != DPSM_OK) {
+        if (st == DPSM_ERR_WORK_LIMIT && !strstr(dpsm_last_error(s->g), "dpsm_set_max_substeps"))
+            die("the work-limit message does not say how to raise the limit: %s", dpsm_last_error(s->g));
+        check_failed(s, s->g, &before, st, g_op);
+        unsnap(&before);
+        return;
+    }
+    if (*dpsm_last_error(s->g)) die("dpsm_step succeeded but left the message \"%s\"", dpsm_last_error(s->g));
+    if (dpsm_step(s->twin, dt) != DPSM_OK) die("the twin's step failed: %s", dpsm_last_error(s->twin));
+
+    snap_t after;
+    snap(s->g, s, &after);
+    check_state(s, &after);
+    for (int64_t c = 0; c < s->n; ++c)
+        if (s->kinds[c] != DPSM_CELL_SAND && memcmp(&after.h[c], &before.h[c], sizeof(double)) != 0)
+            die("the held height of cell %lld changed from %.17g to %.17g", (long long)c, before.h[c], after.h[c]);
+    if (!source_active(s) && hi >= lo) {
+        const double magnitude = fmax(fmax(fabs(hi), fabs(lo)), DBL_MIN);
+        for (int64_t c = 0; c < s->n; ++c) {
+            if (s->kinds[c] != DPSM_CELL_SAND) continue;
+            if ((after.h[c] - hi) / magnitude > 4 * DBL_EPSILON || (lo - after.h[c]) / magnitude > 4 * DBL_EPSILON)
+                die("new extremum without a source at cell %lld: %.17g outside [%.17g, %.17g] (scheme %s)",
+                    (long long)c, after.h[c], lo, hi, s->geom == GEOM_2D ? "2D" : "1D/axisymmetric");
+        }
+    }
+    const double at_rest = after.info[DPSM_INFO_AT_REST];
+    if (at_rest != 0.0 && at_rest != 1.0) die("AT_REST = %g", at_rest);
+    if (at_rest == 1.0 && !drives) {
+        const double excess = rest_excess(s, after.h);
+        if (excess > 1e-12) die("reported at rest with a face steeper than tan(theta)(1+tol) by %.3g", excess);
+    }
+    const double substeps = after.info[DPSM_INFO_SUBSTEPS];
+    if (!(substeps >= 0.0) || (at_rest == 0.0 && substeps != fmax(needed, 1.0)))
+        die("SUBSTEPS = %g, AT_REST = %g, for %g needed", substeps, at_rest, needed);
+    if (at_rest == 0.0 && after.info[DPSM_INFO_TIME_INTEGRATED] != dt)
+        die("TIME_INTEGRATED = %.17g, dt = %.17g, not at rest", after.info[DPSM_INFO_TIME_INTEGRATED], dt);
+    if (!(after.info[DPSM_INFO_MAX_EXCESS_SLOPE] >= 0.0)) die("MAX_EXCESS_SLOPE = %g", after.info[DPSM_INFO_MAX_EXCESS_SLOPE]);
+    compare_twin(s, &after);
+    unsnap(&after);
+    unsnap(&before);
+}
+
+static void op_getters(reader_t *r) {
+    g_op = "getters";
+    slot_t *s = pick_slot(r);
+    if (!s) return;
+    const unsigned b = u8(r);
+    snap_t before;
+    snap(s->g, s, &before);
+    double value = 0.0;
+    int st;
+    switch (b % 6) {
+        case 0: {
+            g_op = "dpsm_get_mass";
+            static const int quantities[] = {-1, 0, 1, 2, 3, 4, 1000, INT32_MIN};
+            const int q = quantities[u8(r) % COUNT(quantities)];
+            const int null_out = (b & 0x80) != 0;
+            st = dpsm_get_mass(s->g, q, null_out ? NULL : &value);
+            expect_status(st, null_out ? DPSM_ERR_NULL_POINTER : (q >= 0 && q <= 3) ? DPSM_OK : DPSM_ERR_UNKNOWN_ENUM,
+                          g_op, s->g);
+            break;
+        }
+        case 1: {
+            g_op = "dpsm_get_step_info";
+            static const int items[] = {-1, 0, 1, 2, 3, NINFO - 1, NINFO, 1000, INT32_MIN};
+            const int item = items[u8(r) % COUNT(items)];
+            const int null_out = (b & 0x80) != 0;
+            st = dpsm_get_step_info(s->g, item, null_out ? NULL : &value);
+            expect_status(st,
+                          null_out                         ? DPSM_ERR_NULL_POINTER
+                          : (item >= 0 && item < NINFO) ? DPSM_OK
+                                                           : DPSM_ERR_UNKNOWN_ENUM,
+                          g_op, s->g);
+            break;
+        }
+        case 2: {
+            g_op = "dpsm_get_shape";
+            int64_t nx, ny;
+            const unsigned which = u8(r) % 3;
+            st = dpsm_get_shape(s->g, which == 1 ? NULL : &nx, which == 2 ? NULL : &ny);
+            expect_status(st, which ? DPSM_ERR_NULL_POINTER : DPSM_OK, g_op, s->g);
+            break;
+        }
+        case 3:
+            g_op = "dpsm_stable_dt";
+            st = dpsm_stable_dt(s->g, NULL);
+            expect_status(st, DPSM_ERR_NULL_POINTER, g_op, s->g);
+            break;
+        case 4:
+            g_op = "dpsm_get_heights";
+            st = dpsm_get_heights(s->g, NULL);
+            expect_status(st, DPSM_ERR_NULL_POINTER, g_op, s->g);
+            break;
+        default:
+            g_op = "dpsm_get_heights_region";
+            st = dpsm_get_heights_region(s->g, 0, 0, 1, 1, NULL);
+            expect_status(st, DPSM_ERR_NULL_POINTER, g_op, s->g);
+            break;
+    }
+    if (st != DPSM_OK) check_failed(s, s->g, &before, st, g_op);
+    unsnap(&before);
+}
+
+/* Every function with a NULL grid; the version and status strings. */
+static void op_null_grid(reader_t *r) {
+    g_op = "NULL grid";
+    const unsigned b = u8(r);
+    double d = 0.0, h[1] = {0.0};
+    int64_t a, c;
+    int st;
+    const char *fn;
+    switch (b % 20) {
+        case 0: st = dpsm_set_repose_angle(NULL, 0.5), fn = "dpsm_set_repose_angle"; break;
+        case 1: st = dpsm_set_mobility(NULL, 1.0), fn = "dpsm_set_mobility"; break;
+        case 2: st = dpsm_set_scheme(NULL, 0), fn = "dpsm_set_scheme"; break;
+        case 3: st = dpsm_set_boundary(NULL, 0, 0), fn = "dpsm_set_boundary"; break;
+        case 4: st = dpsm_set_cell_kinds(NULL, NULL), fn = "dpsm_set_cell_kinds"; break;
+        case 5: st = dpsm_set_heights(NULL, h), fn = "dpsm_set_heights"; break;
+        case 6: st = dpsm_get_heights(NULL, h), fn = "dpsm_get_heights"; break;
+        case 7: st = dpsm_set_heights_region(NULL, 0, 0, 1, 1, h), fn = "dpsm_set_heights_region"; break;
+        case 8: st = dpsm_add_heights_region(NULL, 0, 0, 1, 1, h), fn = "dpsm_add_heights_region"; break;
+        case 9: st = dpsm_get_heights_region(NULL, 0, 0, 1, 1, h), fn = "dpsm_get_heights_region"; break;
+        case 10: st = dpsm_set_source(NULL, NULL), fn = "dpsm_set_source"; break;
+        case 11: st = dpsm_stable_dt(NULL, &d), fn = "dpsm_stable_dt"; break;
+        case 12: st = dpsm_step(NULL, 1.0), fn = "dpsm_step"; break;
+        case 13: st = dpsm_get_mass(NULL, 0, &d), fn = "dpsm_get_mass"; break;
+        case 14: st = dpsm_get_step_info(NULL, 0, &d), fn = "dpsm_get_step_info"; break;
+        case 15: st = dpsm_get_shape(NULL, &a, &c), fn = "dpsm_get_shape"; break;
+        case 16: st = dpsm_set_rest_tolerance(NULL, 1e-6), fn = "dpsm_set_rest_tolerance"; break;
+        case 17: st = dpsm_set_max_substeps(NULL, 10), fn = "dpsm_set_max_substeps"; break;
+        case 18: st = dpsm_set_threads(NULL, 1), fn = "dpsm_set_threads"; break;
+        default: {
+            dpsm_destroy(NULL);
+            const int code = (int)(int8_t)u8(r);
+            const char *name = dpsm_status_string(code);
+            if (!name || !*name) die("dpsm_status_string(%d) is empty", code);
+            if (!dpsm_version_string() || dpsm_version_number() != DPSM_VERSION_NUMBER) die("version mismatch");
+            return;
+        }
+    }
+    expect_status(st, DPSM_ERR_NULL_POINTER, fn, NULL);
+    check_failed(NULL, NULL, NULL, st, fn);
+}
+
+static void op_destroy(reader_t *r) {
+    g_op = "dpsm_destroy";
+    slot_t *s = pick_slot(r);
+    if (s) destroy_slot(s);
+}
+
+/* ------------------------------------------------------------------------ */
+
+int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
+    reader_t r = {data, size, 0};
+    g_work = 0.0;
+    g_opcount = 0;
+    memset(g_slots, 0, sizeof g_slots);
+    while (more(&r) && g_opcount < 400) {
+        ++g_opcount;
+        const unsigned op = u8(&r) % 24;
+        if (op < 2)
+            op_create(&r);
+        else if (op < 9)
+            op_parameter(&r, op - 2);
+        else if (op == 9)
+            op_kinds(&r);
+        else if (op < 12)
+            op_heights(&r);
+        else if (op < 15)
+            op_region(&r, op - 12);
+        else if (op == 15)
+            op_source(&r);
+        else if (op < 20)
+            op_step(&r);
+        else if (op == 20)
+            op_getters(&r);
+        else if (op == 21)
+            op_null_grid(&r);
+        else if (op == 22)
+            op_destroy(&r);
+        else
+            op_create(&r);
+        /* Every live grid: the state invariants and the twin. */
+        for (int k = 0; k < NSLOTS; ++k) {
+            slot_t *s = &g_slots[k];
+            if (!s->g) continue;
+            snap_t now;
+            snap(s->g, s, &now);
+            note_mass_scale(s, &now);
+            check_state(s, &now);
+            compare_twin(s, &now);
+            unsnap(&now);
+        }
+    }
+    for (int k = 0; k < NSLOTS; ++k)
+        if (g_slots[k].g) destroy_slot(&g_slots[k]);
+    return 0;
+}

@@ -1,0 +1,188 @@
+#!/usr/bin/env python3
+"""Writes the seed corpus of the API fuzzer (tests/fuzz/corpus/).
+
+Each seed is a small program in the byte code that fuzz_api.c reads (one
+opcode byte, then its arguments); the helpers below spell the operations out.
+Run it again after changing the byte code: python3 tests/fuzz/make_seeds.py
+"""
+import os
+import random
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+OUT = os.path.join(HERE, "corpus")
+
+# Opcodes (first byte of an operation, taken modulo 24 by the harness).
+CREATE, ANGLE, MOBILITY, SCHEME, BOUNDARY, TOLERANCE, MAX_SUBSTEPS, THREADS = 0, 2, 3, 4, 5, 6, 7, 8
+KINDS, HEIGHTS, SET_REGION, ADD_REGION, GET_REGION, SOURCE, STEP = 9, 10, 12, 13, 14, 15, 16
+GETTERS, NULL_GRID, DESTROY = 20, 21, 22
+GEOM = {"1d": 0, "2d": 1, "axi": 2}
+# kSpacings = {1.0, 0.5, 2.0, 0.1, 10.0, 0.25, 3.0, 1e-3, 1e3, 0.37}
+SPACING = {1.0: 0, 0.5: 1, 2.0: 2, 0.1: 3, 10.0: 4, 0.25: 5, 3.0: 6, 1e-3: 7, 1e3: 8, 0.37: 9}
+# kHeights indices
+H = {0.0: 0, 1.0: 1, -1.0: 2, 0.25: 3, 3.0: 4, 10.0: 5, 100.0: 6, 1e3: 7, 1e-9: 8, -1e3: 9, 1e6: 10,
+     "-0": 11, "denormal": 12, 0.5: 13, 2.0: 14, -3.0: 15, 7.0: 16, 1e-3: 17, 30.0: 18, -1e6: 19}
+# kSources indices
+Q = {0.0: 0, 1e-3: 1, -1e-3: 2, 0.1: 3, -0.1: 4, 1.0: 5, -1.0: 6, 10.0: 7, 1e-9: 8}
+# kDtFactors = {1e-12, 1e-6, 0.1, 0.5, 1.0, 1.5, 2.0, 4.0, 10.0, 100.0, 1000.0, 0.999, 3.7} (times stable_dt)
+DT = {1e-12: 0, 1e-6: 1, 0.1: 2, 0.5: 3, 1.0: 4, 1.5: 5, 2.0: 6, 4.0: 7, 10.0: 8, 100.0: 9, 1000.0: 10,
+      0.999: 11, 3.7: 12}
+DT_ABSOLUTE = {1e12: 0xc0, 1e300: 0xc1, "max": 0xc2, 1e-300: 0xc3, 1e-12: 0xc4}
+DT_BAD = 0xe0  # + 0..6: 0, -0, -1, NaN, Inf, -Inf, -1e-300
+
+
+def size(n):
+    if 1 <= n <= 9:
+        return n - 1
+    if 60 <= n <= 71:
+        return 160 + (n - 60 - 160 % 12) % 12
+    raise ValueError(n)
+
+
+def create(slot, geom, nx, ny=1, dx=1.0, dy=1.0, null_out=False):
+    b = [CREATE, slot, GEOM[geom], size(nx)]
+    if geom == "2d":
+        b.append(size(ny))
+    b.append(SPACING[dx])
+    if geom == "2d":
+        b.append(SPACING[dy])
+    b.append(0xFF if null_out else 0)
+    return b
+
+
+def create_bad(slot, geom, nx_byte, dx_byte, null_out=False):
+    b = [CREATE, slot, GEOM[geom], nx_byte]
+    if geom == "2d":
+        b.append(0)
+    b.append(dx_byte)
+    if geom == "2d":
+        b.append(0)
+    b.append(0xFF if null_out else 0)
+    return b
+
+
+def fill(mode, v, w, per_cell=(), plant=None):
+    """mode 0 const v, 1 checkerboard, 2 column of v on w, 3 ramp v + w*i, 4 per cell, 5 one cell"""
+    b = [mode | (0xC0 if plant is not None else 0), v, w] + list(per_cell)
+    if plant is not None:
+        b += [plant & 0xFF, plant >> 8, 0]
+    return b
+
+
+def heights(slot, mode, v, w, per_cell=(), plant=None, null=False):
+    return [HEIGHTS, slot] + fill(mode, H[v], H[w], per_cell, plant) + [0xFE if null else 0]
+
+
+def source(slot, mode, v, w, none=False):
+    if none:
+        return [SOURCE, slot, 0]
+    return [SOURCE, slot, 1] + fill(mode, Q[v], Q[w])
+
+
+def region(op, slot, i0, j0, ni_m1, nj_m1, mode, v, w, wild=None):
+    b = [op, slot, 0xC0 | wild[0] if wild else 0, i0, j0, ni_m1, nj_m1]
+    if wild:
+        b.append(wild[1])
+    return b + fill(mode, H[v], H[w]) + [0]
+
+
+def step(slot, factor):
+    return [STEP, slot, DT[factor]]
+
+
+def step_abs(slot, what):
+    return [STEP, slot, DT_ABSOLUTE[what]]
+
+
+def boundary(slot, side, open_):
+    return [BOUNDARY, slot, (side + 1) + 6 * (1 if open_ else 2)]
+
+
+def all_open(slot, geom):
+    sides = {"1d": [0, 1], "axi": [1], "2d": [0, 1, 2, 3]}[geom]
+    return sum((boundary(slot, s, True) for s in sides), [])
+
+
+def kinds(slot, mode):
+    return [KINDS, slot, mode]
+
+
+SEEDS = {}
+
+
+def seed(name, *ops):
+    SEEDS[name] = bytes(sum(ops, []))
+
+
+for geom, n in (("1d", 9), ("axi", 9), ("2d", 9)):
+    seed(f"collapse_{geom}", create(0, geom, n, n), heights(0, 2, 10.0, 0.0),
+         step(0, 1.0), step(0, 10.0), step(0, 1000.0), [GETTERS, 0, 0, 0])
+    seed(f"collapse_open_{geom}", create(0, geom, n, n, 0.5, 0.5), all_open(0, geom), heights(0, 2, 30.0, 1.0),
+         step(0, 4.0), step(0, 100.0), step(0, 1000.0))
+    seed(f"source_{geom}", create(0, geom, n, n), all_open(0, geom), source(0, 1, 0.1, -1e-3),
+         step(0, 1.0), step(0, 100.0), source(0, 0, 0, 0, none=True), step(0, 1000.0))
+    seed(f"work_limit_{geom}", create(0, geom, n, n), source(0, 0, 1e-3, 0.0), step_abs(0, 1e12),
+         step_abs(0, 1e300), [MAX_SUBSTEPS, 0, 1], step(0, 2.0), step(0, 0.5), step_abs(0, "max"))
+    cells = n * n if geom == "2d" else n
+    seed(f"masks_{geom}", create(0, geom, n, n),
+         heights(0, 4, 3.0, 0.0, per_cell=([4, 1, 5, 0, 14, 16, 2, 13, 4] * 9)[:cells]),
+         kinds(0, 3), step(0, 10.0), kinds(0, 5), step(0, 1000.0), kinds(0, 0), step(0, 100.0))
+    seed(f"ramp_{geom}", create(0, geom, n, n, 0.25, 0.25), heights(0, 3, 0.0, 1.0), step(0, 1000.0),
+         [TOLERANCE, 0, 3], step(0, 100.0), [ANGLE, 0, 3], step(0, 1000.0))
+    seed(f"bad_values_{geom}", create(0, geom, n, n), heights(0, 2, 3.0, 0.0, plant=4), source(0, 1, 1.0, 0.0),
+         [ANGLE, 0, 0x80, ANGLE, 0, 0x82, ANGLE, 0, 0x85, MOBILITY, 0, 0x80, MOBILITY, 0, 0x83,
+          SCHEME, 0, 4, SCHEME, 0, 6, BOUNDARY, 0, 0, BOUNDARY, 0, 3, BOUNDARY, 0, 5, BOUNDARY, 0, 27,
+          TOLERANCE, 0, 0x81, MAX_SUBSTEPS, 0, 7, MAX_SUBSTEPS, 0, 9, THREADS, 0, 6],
+         [STEP, 0, DT_BAD + 0, STEP, 0, DT_BAD + 3, STEP, 0, DT_BAD + 4, STEP, 0, DT_BAD + 6],
+         [KINDS, 0, 0xE2, 0, 0, 1], step(0, 1.0))
+
+seed("tile_edge_2d", create(0, "2d", 65, 63), all_open(0, "2d"), heights(0, 2, 10.0, 0.0),
+     [THREADS, 0, 2], step(0, 10.0), step(0, 100.0), [THREADS, 0, 1], step(0, 100.0))
+seed("long_thin_2d", create(0, "2d", 71, 2), heights(0, 1, 3.0, 0.0), step(0, 1000.0),
+     create(1, "2d", 2, 71), heights(1, 1, 3.0, 0.0), step(1, 1000.0))
+seed("one_cell", create(0, "2d", 1, 1), heights(0, 0, 10.0, 0.0), all_open(0, "2d"), step(0, 1.0),
+     create(1, "1d", 1), all_open(1, "1d"), heights(1, 0, 7.0, 0.0), step(1, 10.0),
+     create(2, "axi", 1), all_open(2, "axi"), heights(2, 0, 3.0, 0.0), step(2, 10.0))
+seed("pairwise_2d", create(0, "2d", 9, 9), [SCHEME, 0, 0], heights(0, 5, 1e3, 0.0, per_cell=[40] * 81),
+     step(0, 1000.0), [SCHEME, 0, 1], step(0, 1000.0))
+seed("regions_2d", create(0, "2d", 9, 7), region(SET_REGION, 0, 2, 1, 3, 2, 0, 10.0, 0.0),
+     region(ADD_REGION, 0, 0, 0, 8, 6, 1, 1.0, -1.0), region(GET_REGION, 0, 1, 1, 2, 2, 0, 0.0, 0.0),
+     step(0, 10.0), region(SET_REGION, 0, 0, 0, 0, 0, 0, 1.0, 0.0, wild=(0, 0)),
+     region(ADD_REGION, 0, 0, 0, 0, 0, 0, 1.0, 0.0, wild=(2, 3)),
+     region(GET_REGION, 0, 0, 0, 0, 0, 0, 1.0, 0.0, wild=(3, 4)), step(0, 100.0))
+seed("regions_1d", create(0, "1d", 9), region(SET_REGION, 0, 3, 0, 2, 0, 0, 100.0, 0.0),
+     region(ADD_REGION, 0, 4, 0, 0, 0, 0, 1e6, 0.0), step(0, 1000.0),
+     region(SET_REGION, 0, 0, 0, 0, 0, 0, 1.0, 0.0, wild=(1, 2)))
+seed("bad_creates", create_bad(0, "1d", 230, 0), create_bad(0, "2d", 232, 0), create_bad(0, "axi", 235, 0),
+     create_bad(0, "1d", 0, 0xC3), create_bad(0, "2d", 0, 0xC4), create(0, "1d", 3, null_out=True),
+     create(1, "2d", 3, 3), step(1, 1.0))
+seed("null_grid", sum(([NULL_GRID, k] for k in range(20)), []), [NULL_GRID, 19, 0x85])
+seed("getters", create(0, "2d", 5, 5), heights(0, 2, 3.0, 0.0), step(0, 1.0),
+     sum(([GETTERS, 0, b, c] for b in range(6) for c in range(9)), []), [GETTERS, 0, 0x80, 0, GETTERS, 0, 0x81, 2])
+seed("three_grids", create(0, "1d", 9), create(1, "2d", 8, 8), create(2, "axi", 7),
+     heights(0, 2, 10.0, 0.0), heights(1, 2, 10.0, 0.0), heights(2, 2, 10.0, 0.0),
+     step(0, 10.0), step(1, 10.0), step(2, 10.0), [DESTROY, 1], step(0, 10.0), create(1, "2d", 3, 3),
+     step(1, 1.0), [DESTROY, 0, DESTROY, 2])
+seed("sinks_levels_2d", create(0, "2d", 8, 8), heights(0, 3, 0.0, 1.0), kinds(0, 2), step(0, 10.0),
+     step_abs(0, 1e12), [MAX_SUBSTEPS, 0, 2], step(0, 4.0), step(0, 10.0))
+seed("steep_angles", create(0, "2d", 9, 9), [ANGLE, 0, 4], heights(0, 2, 1e3, 0.0), step(0, 1000.0),
+     [ANGLE, 0, 3], heights(0, 2, 1.0, 0.0), step(0, 1000.0), [ANGLE, 0, 6], step(0, 1.0))
+seed("mobility", create(0, "1d", 9), heights(0, 2, 100.0, 0.0), [MOBILITY, 0, 3], step(0, 100.0),
+     [MOBILITY, 0, 4], step(0, 100.0), [MOBILITY, 0, 0x80], step(0, 1.0))
+seed("anisotropic_2d", create(0, "2d", 9, 9, 0.1, 10.0), heights(0, 4, 3.0, 0.0, per_cell=range(81)),
+     step(0, 1000.0), create(1, "2d", 9, 9, 10.0, 0.1), heights(1, 1, 100.0, 0.0), step(1, 1000.0))
+seed("tiny_dt", create(0, "2d", 5, 5), heights(0, 2, 10.0, 0.0), step_abs(0, 1e-300), step_abs(0, 1e-12),
+     step(0, 1e-12), step(0, 1.0))
+seed("negative_below_open", create(0, "1d", 9), all_open(0, "1d"), heights(0, 0, -1e3, 0.0), step(0, 1000.0),
+     create(1, "2d", 6, 6), all_open(1, "2d"), heights(1, 1, -3.0, -1.0), step(1, 1000.0))
+
+rng = random.Random(20240611)
+for k in range(8):
+    SEEDS[f"random_{k}"] = bytes(rng.randrange(256) for _ in range(rng.choice((16, 40, 100, 300))))
+
+os.makedirs(OUT, exist_ok=True)
+for name in os.listdir(OUT):
+    os.remove(os.path.join(OUT, name))
+for name, data in sorted(SEEDS.items()):
+    with open(os.path.join(OUT, name), "wb") as f:
+        f.write(data)
+print(f"{len(SEEDS)} seeds in {OUT}")

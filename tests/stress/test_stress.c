@@ -1,0 +1,516 @@
+/* The numerical stress suite: the library driven far from the comfortable
+ * middle, with every invariant of stress_support.h checked after every step
+ * (finite heights, the ledger closing to 1e-12, no new extremum without a
+ * source, held cells unchanged, no face steeper than the angle of repose at
+ * rest):
+ *
+ *   time steps from 1e-12 to 1e12, with and without a source;
+ *   height jumps from 1e-9 to 1e6 (vertical walls of sand);
+ *   angles of repose from 0.5 to 89.5 degrees;
+ *   random rough terrains, above and below the level of open sides;
+ *   grids of 1x1, 1xN, Nx1 and long thin ones, 1D, 2D and axisymmetric;
+ *   walls, obstacles, open cells and sources mixed;
+ *   requests no method can finish in bounded work (DPSM_ERR_WORK_LIMIT, the
+ *   grid unchanged);
+ *   100 000 small steps.
+ *
+ * Each test prints its worst figures; the last prints the worst over all.
+ * DPSM_STRESS_SCALE (environment, default from the build: 1, smaller under
+ * sanitizers) scales the grid sizes and step counts. */
+#include <float.h>
+#include <math.h>
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <cmocka.h>
+
+#include "stress_support.h"
+
+static const double kPi = 3.14159265358979323846;
+static double deg(double d) { return d * kPi / 180.0; }
+
+static void require_at(int cond, const char *file, int line, const char *fmt, ...) CMOCKA_PRINTF_ATTRIBUTE(4, 5);
+static void require_at(int cond, const char *file, int line, const char *fmt, ...) {
+    if (cond) return;
+    va_list ap;
+    va_start(ap, fmt);
+    vprint_error(fmt, ap);
+    va_end(ap);
+    print_error("\n");
+    _fail(file, line);
+}
+#define REQUIRE(cond, ...) require_at((cond) != 0, __FILE__, __LINE__, __VA_ARGS__)
+
+static const char *geom_name(int geom, int scheme) {
+    if (geom == GEOM_1D) return "1D";
+    if (geom == GEOM_AXI) return "axisym";
+    return scheme == DPSM_SCHEME_PAIRWISE ? "2D pairwise" : "2D isotropic";
+}
+
+/* The four kinds of grid the suites go through. */
+typedef struct {
+    int geom, scheme;
+} flavour_t;
+static const flavour_t kFlavours[] = {
+    {GEOM_1D, DPSM_SCHEME_PAIRWISE},
+    {GEOM_AXI, DPSM_SCHEME_PAIRWISE},
+    {GEOM_2D, DPSM_SCHEME_PAIRWISE},
+    {GEOM_2D, DPSM_SCHEME_ISOTROPIC},
+};
+#define NFLAVOURS ((int)(sizeof kFlavours / sizeof kFlavours[0]))
+
+/* A scene on cells of dx by dx (by dy in make_scene_dy). */
+static void make_scene_dy(scene_t *s, const flavour_t *f, int64_t nx, int64_t ny, double dx, double dy,
+                          const char *fmt, ...) CMOCKA_PRINTF_ATTRIBUTE(7, 8);
+static void vmake_scene(scene_t *s, const flavour_t *f, int64_t nx, int64_t ny, double dx, double dy, const char *fmt,
+                        va_list ap) {
+    char what[120], name[160];
+    vsnprintf(what, sizeof what, fmt, ap);
+    snprintf(name, sizeof name, "%s %lldx%lld: %s", geom_name(f->geom, f->scheme), (long long)nx,
+             (long long)(f->geom == GEOM_2D ? ny : 1), what);
+    scene_create(s, name, f->geom, nx, ny, dx, dy);
+    if (f->geom == GEOM_2D) scene_set_scheme(s, f->scheme);
+}
+static void make_scene_dy(scene_t *s, const flavour_t *f, int64_t nx, int64_t ny, double dx, double dy,
+                          const char *fmt, ...) {
+    va_list ap;
+    va_start(ap, fmt);
+    vmake_scene(s, f, nx, ny, dx, dy, fmt, ap);
+    va_end(ap);
+}
+static void make_scene(scene_t *s, const flavour_t *f, int64_t nx, int64_t ny, double dx, const char *fmt, ...)
+    CMOCKA_PRINTF_ATTRIBUTE(6, 7);
+static void make_scene(scene_t *s, const flavour_t *f, int64_t nx, int64_t ny, double dx, const char *fmt, ...) {
+    va_list ap;
+    va_start(ap, fmt);
+    vmake_scene(s, f, nx, ny, dx, dx, fmt, ap);
+    va_end(ap);
+}
+
+/* Heights: a rough terrain (uniform noise of amplitude amp around offset)
+ * plus a column of height top over the middle third. */
+static double *terrain(const scene_t *s, double offset, double amp, double top, uint64_t seed) {
+    double *h = malloc(sizeof(double) * (size_t)s->n);
+    REQUIRE(h != NULL, "out of memory");
+    for (int64_t j = 0; j < s->ny; ++j)
+        for (int64_t i = 0; i < s->nx; ++i) {
+            const int64_t c = i + s->nx * j;
+            h[c] = offset + amp * (2.0 * rng_uniform(&seed) - 1.0);
+            const int in_x = 3 * i >= s->nx && 3 * i < 2 * s->nx;
+            const int in_y = s->ny == 1 || (3 * j >= s->ny && 3 * j < 2 * s->ny);
+            if (s->geom == GEOM_AXI ? 3 * i < s->nx : in_x && in_y) h[c] += top;
+        }
+    return h;
+}
+
+static double stable(const scene_t *s) {
+    double dt = 0.0;
+    REQUIRE(dpsm_stable_dt(s->g, &dt) == DPSM_OK && dt > 0.0 && isfinite(dt), "[%s] stable_dt = %g", s->name, dt);
+    return dt;
+}
+
+/* Everything dpsm shows of a grid, to compare bit for bit. */
+typedef struct {
+    double *h;
+    double mass[4], info[4], stable_dt;
+} snap_t;
+
+static void snap(const scene_t *s, snap_t *out) {
+    out->h = malloc(sizeof(double) * (size_t)s->n);
+    REQUIRE(out->h != NULL, "out of memory");
+    REQUIRE(dpsm_get_heights(s->g, out->h) == DPSM_OK, "get_heights");
+    for (int q = 0; q < 4; ++q) REQUIRE(dpsm_get_mass(s->g, q, &out->mass[q]) == DPSM_OK, "get_mass");
+    for (int i = 0; i < 4; ++i) REQUIRE(dpsm_get_step_info(s->g, i, &out->info[i]) == DPSM_OK, "get_step_info");
+    REQUIRE(dpsm_stable_dt(s->g, &out->stable_dt) == DPSM_OK, "stable_dt");
+}
+
+static void same_snap(const scene_t *s, const snap_t *a, const snap_t *b, const char *what) {
+    REQUIRE(memcmp(a->h, b->h, sizeof(double) * (size_t)s->n) == 0, "[%s] %s: heights changed", s->name, what);
+    REQUIRE(memcmp(a->mass, b->mass, sizeof a->mass) == 0, "[%s] %s: the ledger changed", s->name, what);
+    REQUIRE(memcmp(a->info, b->info, sizeof a->info) == 0, "[%s] %s: the step information changed", s->name, what);
+    REQUIRE(memcmp(&a->stable_dt, &b->stable_dt, sizeof(double)) == 0, "[%s] %s: stable_dt changed", s->name, what);
+}
+
+/* dpsm_step(dt) must fail with DPSM_ERR_WORK_LIMIT, say why, and change nothing. */
+static void expect_work_limit(scene_t *s, double dt) {
+    snap_t before, after;
+    snap(s, &before);
+    const int st = dpsm_step(s->g, dt);
+    const char *msg = dpsm_last_error(s->g);
+    REQUIRE(st == DPSM_ERR_WORK_LIMIT, "[%s] dpsm_step(%g) returned %s, expected DPSM_ERR_WORK_LIMIT (%s)", s->name, dt,
+            dpsm_status_string(st), msg);
+    REQUIRE(strstr(msg, "dpsm_step") && strstr(msg, "dt") && strstr(msg, "dpsm_set_max_substeps"),
+            "[%s] the work-limit message does not say what to do: \"%s\"", s->name, msg);
+    snap(s, &after);
+    same_snap(s, &before, &after, "after DPSM_ERR_WORK_LIMIT");
+    free(before.h);
+    free(after.h);
+}
+
+static void finish_test(const char *title, const stress_worst_t *w) {
+    stress_worst_print(title, w);
+    stress_worst_merge(w);
+}
+
+/* ------------------------------------------------------------------------ */
+
+/* Every decade of dt from 1e-12 to 1e12 on a collapsing pile over a rough
+ * bed: without a source each step must finish (it stops at rest); with one,
+ * each step either fits under the sub-step limit or fails at once. */
+static void test_time_steps(void **state) {
+    (void)state;
+    stress_worst_t w;
+    stress_worst_reset(&w);
+    const int64_t n1 = scaled(48, 8), n2 = scaled(24, 6);
+    for (int f = 0; f < NFLAVOURS; ++f)
+        for (int open = 0; open < 2; ++open)
+            for (int with_source = 0; with_source < 2; ++with_source)
+                for (int e = -12; e <= 12; ++e) {
+                    const double dt = pow(10.0, e);
+                    const flavour_t *fl = &kFlavours[f];
+                    const int64_t nx = fl->geom == GEOM_2D ? n2 : n1, ny = fl->geom == GEOM_2D ? n2 - 3 : 1;
+                    scene_t s;
+                    make_scene(&s, fl, nx, ny, 1.0, "dt = 1e%d, %s sides%s", e, open ? "open" : "wall",
+                               with_source ? ", source" : "");
+                    scene_set_all_sides(&s, open);
+                    double *h = terrain(&s, 1.0, 0.5, 4.0, 1000u + (uint64_t)(e + 100 * f));
+                    scene_set_heights(&s, h);
+                    REQUIRE(dpsm_set_max_substeps(s.g, 20000) == DPSM_OK, "set_max_substeps");
+                    if (with_source) {
+                        for (int64_t c = 0; c < s.n; ++c) h[c] = (c % 3 == 0) ? 1e-3 : (c % 3 == 1 ? -2e-4 : 0.0);
+                        scene_set_source(&s, h);
+                    }
+                    const double needed = ceil(dt / stable(&s));
+                    for (int k = 0; k < 3; ++k) {
+                        if (with_source && needed > 20000.0)
+                            expect_work_limit(&s, dt);
+                        else
+                            scene_step(&s, dt, &w);
+                    }
+                    free(h);
+                    scene_destroy(&s);
+                }
+    finish_test("time steps 1e-12 .. 1e12", &w);
+}
+
+/* A vertical wall of sand of height J (from 1e-9 to 1e6) next to a bed at 0,
+ * on cells of 1 and on cells of J (the same slopes at every scale). Up to
+ * 1e3 (cells of 1) it runs to rest in one call; higher walls are mobility
+ * bound (a flux of at most nu) and take J * L / nu to fall, so they are
+ * stepped a bounded time. */
+static void test_height_jumps(void **state) {
+    (void)state;
+    stress_worst_t w;
+    stress_worst_reset(&w);
+    const double jumps[] = {1e-9, 1e-6, 1e-3, 1.0, 1e3, 1e6};
+    const int64_t n1 = scaled(40, 8), n2 = scaled(20, 6);
+    for (int f = 0; f < NFLAVOURS; ++f)
+        for (size_t k = 0; k < sizeof jumps / sizeof jumps[0]; ++k)
+            for (int cells_of_j = 0; cells_of_j < 2; ++cells_of_j)
+                for (int open = 0; open < 2; ++open) {
+                    const double J = jumps[k], dx = cells_of_j ? J : 1.0;
+                    const flavour_t *fl = &kFlavours[f];
+                    const int64_t nx = fl->geom == GEOM_2D ? n2 : n1, ny = fl->geom == GEOM_2D ? n2 : 1;
+                    scene_t s;
+                    make_scene(&s, fl, nx, ny, dx, "wall of sand J = %g, dx = %g, %s", J, dx,
+                               open ? "open x max" : "walls");
+                    scene_set_side(&s, DPSM_XMAX, open);
+                    double *h = calloc((size_t)s.n, sizeof(double));
+                    for (int64_t j = 0; j < s.ny; ++j)
+                        for (int64_t i = 0; i < s.nx; ++i)
+                            if (2 * i < s.nx && (s.ny == 1 || 2 * j < s.ny)) h[i + s.nx * j] = J;
+                    scene_set_heights(&s, h);
+                    if (J / dx <= 1e3) {
+                        /* One call of a huge dt (time scales as dx^2): it must stop at rest. */
+                        scene_run_to_rest(&s, 1e12 * fmax(1.0, dx * dx), 2, &w);
+                    } else {
+                        const double dt = 50.0 * stable(&s);
+                        for (int n = 0; n < (int)scaled(20, 4); ++n) scene_step(&s, dt, &w);
+                    }
+                    free(h);
+                    scene_destroy(&s);
+                }
+    finish_test("height jumps 1e-9 .. 1e6", &w);
+}
+
+/* Angles of repose from 0.5 to 89.5 degrees: a column some times tan(theta)
+ * high collapses to rest; at 0.5 degrees it spreads over the whole grid, at
+ * 89.5 it barely moves. Two rest tolerances. */
+static void test_repose_angles(void **state) {
+    (void)state;
+    stress_worst_t w;
+    stress_worst_reset(&w);
+    const double angles[] = {0.5, 1.0, 2.0, 5.0, 15.0, 30.0, 45.0, 60.0, 75.0, 85.0, 88.0, 89.0, 89.5};
+    const int64_t n1 = scaled(40, 8), n2 = scaled(24, 6);
+    for (int f = 0; f < NFLAVOURS; ++f)
+        for (size_t k = 0; k < sizeof angles / sizeof angles[0]; ++k)
+            for (int variant = 0; variant < 2; ++variant) {
+                const flavour_t *fl = &kFlavours[f];
+                const double theta = deg(angles[k]), tol = variant ? 1e-9 : 1e-6;
+                const int64_t nx = fl->geom == GEOM_2D ? n2 : n1, ny = fl->geom == GEOM_2D ? n2 + 1 : 1;
+                scene_t s;
+                make_scene(&s, fl, nx, ny, 1.0, "theta = %g deg, tol %g, %s", angles[k], tol,
+                           variant ? "open" : "walls");
+                scene_set_angle(&s, theta);
+                scene_set_tolerance(&s, tol);
+                scene_set_all_sides(&s, variant);
+                const double top = fmax(1.0, 6.0 * tan(theta));
+                double *h = terrain(&s, 0.0, 0.1 * top, top, 77u + k);
+                if (variant)
+                    for (int64_t c = 0; c < s.n; ++c) h[c] += 0.2 * top; /* above the outside */
+                scene_set_heights(&s, h);
+                scene_run_to_rest(&s, 1e12, 2, &w);
+                free(h);
+                scene_destroy(&s);
+            }
+    finish_test("angles of repose 0.5 .. 89.5 degrees", &w);
+}
+
+/* Random rough terrains: white noise of amplitude 1 and 10, a smooth field
+ * with noise, above the level of open sides and below it (sand then comes in
+ * from outside), a checkerboard of +-amp and lone spikes; on square cells and
+ * on cells ten times wider or narrower in y. */
+static void test_rough_terrains(void **state) {
+    (void)state;
+    stress_worst_t w;
+    stress_worst_reset(&w);
+    const int64_t n1 = scaled(200, 16), n2 = scaled(48, 8);
+    const double aspects[] = {1.0, 0.1, 10.0};
+    for (int f = 0; f < NFLAVOURS; ++f)
+        for (size_t a = 0; a < (kFlavours[f].geom == GEOM_2D ? 3u : 1u); ++a)
+            for (int seed = 0; seed < 8; ++seed) {
+                const flavour_t *fl = &kFlavours[f];
+                const int64_t nx = fl->geom == GEOM_2D ? n2 : n1, ny = fl->geom == GEOM_2D ? n2 - 5 : 1;
+                const int open = seed & 1, below = seed == 5;
+                const double amp = seed < 2 ? 1.0 : seed < 4 ? 10.0 : 3.0;
+                const char *kind = seed < 4 ? "noise" : seed < 6 ? "hills and noise" : seed == 6 ? "checkerboard" : "spikes";
+                scene_t s;
+                make_scene_dy(&s, fl, nx, ny, 0.5, 0.5 * aspects[a], "%s seed %d amp %g, dy/dx %g, %s%s", kind, seed,
+                              amp, aspects[a], open ? "open" : "walls", below ? ", below the outside" : "");
+                scene_set_all_sides(&s, open);
+                uint64_t r = 4242u + (uint64_t)(seed + 10 * f);
+                double *h = terrain(&s, below ? -2.0 * amp : 0.0, amp, 0.0, r);
+                for (int64_t j = 0; j < s.ny; ++j)
+                    for (int64_t i = 0; i < s.nx; ++i) {
+                        double *hc = &h[i + s.nx * j];
+                        if (seed == 4 || seed == 5) *hc += 5.0 * sin(0.3 * (double)i) * cos(0.2 * (double)j + 1.0);
+                        if (seed == 6) *hc = (i + j) % 2 ? amp : -amp;
+                        if (seed == 7) *hc = rng_uniform(&r) < 0.05 ? 20.0 * amp * rng_uniform(&r) : 0.0;
+                    }
+                scene_set_heights(&s, h);
+                /* Single sub-steps first (the maximum principle step by step), then to rest. */
+                const double dt = stable(&s);
+                for (int k = 0; k < 20; ++k) scene_step(&s, dt, &w);
+                scene_run_to_rest(&s, 1e12, 2, &w);
+                free(h);
+                scene_destroy(&s);
+            }
+    finish_test("rough terrains", &w);
+}
+
+/* 1x1, 1xN, Nx1, 2xN, long thin grids, tile edges (64), each side open or
+ * not, with a pile to collapse, then a few steps with a source. */
+static void test_grid_shapes(void **state) {
+    (void)state;
+    stress_worst_t w;
+    stress_worst_reset(&w);
+    const int64_t L = scaled(3000, 100);
+    const int64_t shapes2d[][2] = {{1, 1}, {1, 2}, {2, 1}, {1, 300}, {300, 1}, {2, 500}, {500, 2},
+                                   {3, L},  {L, 3}, {64, 1}, {65, 1},  {1, 65},   {65, 65}, {130, 67}};
+    const int64_t lengths1d[] = {1, 2, 3, 1000};
+    for (int open_mask = 0; open_mask < 4; ++open_mask) {
+        for (size_t k = 0; k < sizeof shapes2d / sizeof shapes2d[0]; ++k)
+            for (int scheme = 0; scheme < 2; ++scheme) {
+                const flavour_t fl = {GEOM_2D, scheme};
+                scene_t s;
+                make_scene(&s, &fl, shapes2d[k][0], shapes2d[k][1], 1.0, "sides %d", open_mask);
+                scene_set_side(&s, DPSM_XMIN, open_mask & 1);
+                scene_set_side(&s, DPSM_YMAX, (open_mask >> 1) & 1);
+                double *h = terrain(&s, 2.0, 0.5, 3.0, 99u + k);
+                scene_set_heights(&s, h);
+                scene_run_to_rest(&s, 1e12, 2, &w);
+                for (int64_t c = 0; c < s.n; ++c) h[c] = c % 2 ? 0.01 : -0.005;
+                scene_set_source(&s, h);
+                for (int n = 0; n < 5; ++n) scene_step(&s, 10.0, &w);
+                scene_set_source(&s, NULL);
+                scene_run_to_rest(&s, 1e12, 2, &w);
+                free(h);
+                scene_destroy(&s);
+            }
+        for (size_t k = 0; k < sizeof lengths1d / sizeof lengths1d[0]; ++k)
+            for (int geom = GEOM_1D; geom <= GEOM_AXI; geom += 2) {
+                const flavour_t fl = {geom, 0};
+                scene_t s;
+                make_scene(&s, &fl, lengths1d[k], 1, 1.0, "sides %d", open_mask);
+                if (geom == GEOM_1D) scene_set_side(&s, DPSM_XMIN, open_mask & 1);
+                scene_set_side(&s, DPSM_XMAX, (open_mask >> 1) & 1);
+                double *h = terrain(&s, 2.0, 0.5, 3.0, 7u + k);
+                scene_set_heights(&s, h);
+                scene_run_to_rest(&s, 1e12, 2, &w);
+                for (int64_t c = 0; c < s.n; ++c) h[c] = c % 2 ? 0.01 : -0.005;
+                scene_set_source(&s, h);
+                for (int n = 0; n < 5; ++n) scene_step(&s, 10.0, &w);
+                scene_set_source(&s, NULL);
+                scene_run_to_rest(&s, 1e12, 2, &w);
+                free(h);
+                scene_destroy(&s);
+            }
+    }
+    finish_test("grid shapes", &w);
+}
+
+/* Walls, obstacles, open cells (sinks at random levels) and sources mixed.
+ * Driven (a source, or sinks at different levels): bounded steps. Then the
+ * sinks all at 0 and no source: it must come to rest by itself. */
+static void test_masks_and_sources(void **state) {
+    (void)state;
+    stress_worst_t w;
+    stress_worst_reset(&w);
+    const int64_t n1 = scaled(120, 12), n2 = scaled(70, 10);
+    for (int f = 0; f < NFLAVOURS; ++f)
+        for (int seed = 0; seed < 4; ++seed) {
+            const flavour_t *fl = &kFlavours[f];
+            const int64_t nx = fl->geom == GEOM_2D ? n2 : n1, ny = fl->geom == GEOM_2D ? n2 - 7 : 1;
+            scene_t s;
+            make_scene(&s, fl, nx, ny, 1.0, "masks and sources seed %d", seed);
+            uint64_t r = 31337u + (uint64_t)(seed + 10 * f);
+            scene_set_side(&s, DPSM_XMAX, seed & 1);
+            if (fl->geom == GEOM_2D) scene_set_side(&s, DPSM_YMIN, (seed >> 1) & 1);
+            uint8_t *kinds = malloc((size_t)s.n);
+            double *h = terrain(&s, 3.0, 2.0, 6.0, r);
+            double *q = malloc(sizeof(double) * (size_t)s.n);
+            for (int64_t c = 0; c < s.n; ++c) {
+                const double u = rng_uniform(&r);
+                kinds[c] = u < 0.7 ? DPSM_CELL_SAND : u < 0.85 ? DPSM_CELL_WALL : DPSM_CELL_OPEN;
+                q[c] = rng_uniform(&r) < 0.2 ? 0.05 * (rng_uniform(&r) - 0.3) : 0.0;
+            }
+            scene_set_heights(&s, h);
+            scene_set_kinds(&s, kinds);
+            scene_set_source(&s, q);
+            const double dt = 3.0 * stable(&s);
+            for (int n = 0; n < (int)scaled(60, 10); ++n) scene_step(&s, dt, &w);
+            scene_set_source(&s, NULL); /* sinks at different levels: still driven */
+            for (int n = 0; n < (int)scaled(30, 5); ++n) scene_step(&s, dt, &w);
+            REQUIRE(dpsm_get_heights(s.g, h) == DPSM_OK, "get_heights");
+            for (int64_t c = 0; c < s.n; ++c)
+                if (kinds[c] == DPSM_CELL_OPEN) h[c] = 0.0;
+            scene_set_heights(&s, h);
+            scene_run_to_rest(&s, 1e12, 2, &w);
+            /* Obstacles become sand again (bringing their heights on), then rest. */
+            scene_set_kinds(&s, NULL);
+            scene_run_to_rest(&s, 1e12, 2, &w);
+            free(kinds);
+            free(h);
+            free(q);
+            scene_destroy(&s);
+        }
+    finish_test("walls, obstacles, open cells and sources", &w);
+}
+
+/* A request no method here can finish in bounded work fails at once with
+ * DPSM_ERR_WORK_LIMIT and a clear message, and changes nothing: a source
+ * over dt = 1e12 or 1e300, sinks at different levels, a dt one sub-step over
+ * the limit; a step that fits still works afterwards. */
+static void test_work_limit(void **state) {
+    (void)state;
+    stress_worst_t w;
+    stress_worst_reset(&w);
+    const int64_t sizes[][2] = {{1, 1}, {7, 5}, {100, 3}};
+    for (int f = 0; f < NFLAVOURS; ++f)
+        for (size_t k = 0; k < sizeof sizes / sizeof sizes[0]; ++k)
+            for (int driver = 0; driver < 3; ++driver) {
+                const flavour_t *fl = &kFlavours[f];
+                scene_t s;
+                make_scene(&s, fl, sizes[k][0], sizes[k][1], 1.0, "work limit, %s",
+                           driver == 0 ? "source" : driver == 1 ? "sinks at two levels" : "sink above an open side");
+                double *h = terrain(&s, 1.0, 0.5, 2.0, 5u + k);
+                scene_set_heights(&s, h);
+                if (driver == 0) {
+                    for (int64_t c = 0; c < s.n; ++c) h[c] = 1e-3;
+                    scene_set_source(&s, h);
+                } else {
+                    uint8_t *kinds = calloc((size_t)s.n, 1);
+                    if (driver == 1 && s.n >= 2) {
+                        kinds[0] = kinds[s.n - 1] = DPSM_CELL_OPEN;
+                        h[0] = 5.0;
+                        h[s.n - 1] = -5.0;
+                    } else {
+                        kinds[0] = DPSM_CELL_OPEN;
+                        h[0] = 3.0;
+                        scene_set_side(&s, DPSM_XMAX, 1);
+                    }
+                    scene_set_heights(&s, h);
+                    scene_set_kinds(&s, kinds);
+                    free(kinds);
+                }
+                scene_step(&s, 0.5, &w);
+                const double sdt = stable(&s);
+                expect_work_limit(&s, 1e12);
+                expect_work_limit(&s, 1e300);
+                expect_work_limit(&s, DBL_MAX);
+                REQUIRE(dpsm_set_max_substeps(s.g, 10) == DPSM_OK, "set_max_substeps");
+                expect_work_limit(&s, 11.5 * sdt);
+                scene_step(&s, 9.5 * sdt, &w);
+                REQUIRE(dpsm_set_max_substeps(s.g, 1) == DPSM_OK, "set_max_substeps");
+                expect_work_limit(&s, 2.0 * sdt);
+                scene_step(&s, 0.999 * sdt, &w);
+                free(h);
+                scene_destroy(&s);
+            }
+    finish_test("work limit", &w);
+}
+
+/* 100 000 small steps with a source, sinks and open sides: the ledger must
+ * still close to 1e-12 (it is checked after every step). */
+static void test_many_small_steps(void **state) {
+    (void)state;
+    stress_worst_t w;
+    stress_worst_reset(&w);
+    const int64_t steps = scaled(100000, 2000);
+    for (int f = 0; f < NFLAVOURS; ++f) {
+        const flavour_t *fl = &kFlavours[f];
+        const int64_t nx = fl->geom == GEOM_2D ? 20 : 60, ny = fl->geom == GEOM_2D ? 16 : 1;
+        scene_t s;
+        make_scene(&s, fl, nx, ny, 0.25, "%lld small steps", (long long)steps);
+        scene_set_side(&s, DPSM_XMAX, 1);
+        uint8_t *kinds = calloc((size_t)s.n, 1);
+        kinds[s.n / 3] = DPSM_CELL_WALL;
+        kinds[s.n / 2] = DPSM_CELL_OPEN;
+        double *h = terrain(&s, 1.0, 0.3, 1.0, 123u + (uint64_t)f);
+        scene_set_heights(&s, h);
+        scene_set_kinds(&s, kinds);
+        for (int64_t c = 0; c < s.n; ++c) h[c] = (c % 5 == 0) ? 0.02 : (c % 7 == 0 ? -0.004 : 0.0);
+        scene_set_source(&s, h);
+        const double dt = 0.37 * stable(&s);
+        for (int64_t n = 0; n < steps; ++n) scene_step(&s, dt, &w);
+        free(kinds);
+        free(h);
+        scene_destroy(&s);
+    }
+    finish_test("100 000 small steps", &w);
+}
+
+static void test_summary(void **state) {
+    (void)state;
+    stress_worst_print("stress suite, worst over all tests", &stress_worst);
+    assert_int_equal(stress_worst.nonfinite, 0);
+}
+
+int main(int argc, char **argv) {
+    if (argc > 1) cmocka_set_test_filter(argv[1]);
+    stress_worst_reset(&stress_worst);
+    print_message("stress scale %g (DPSM_STRESS_SCALE)\n", stress_scale());
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_time_steps),     cmocka_unit_test(test_height_jumps),
+        cmocka_unit_test(test_repose_angles),  cmocka_unit_test(test_rough_terrains),
+        cmocka_unit_test(test_grid_shapes),    cmocka_unit_test(test_masks_and_sources),
+        cmocka_unit_test(test_work_limit),     cmocka_unit_test(test_many_small_steps),
+        cmocka_unit_test(test_summary),
+    };
+    return cmocka_run_group_tests_name("stress", tests, NULL, NULL);
+}
