@@ -52,39 +52,31 @@ static double flux(const reference_grid *r, double normal, double transverse, do
     return r->nu * (g - r->tan_theta) / sqrt(1.0 + g * g) * normal / g;
 }
 
+/* dh/dt of cell (i, j): the fluxes of its four faces. */
+static double cell_rate(const reference_grid *r, int64_t i, int64_t j, double *excess) {
+    const double hc = AT(r, r->h, i, j);
+    const double west = flux(r, (AT(r, r->h, i - 1, j) - hc) / r->dx, 0.5 * (slope_y(r, i - 1, j) + slope_y(r, i, j)),
+                             excess);
+    const double east = flux(r, (hc - AT(r, r->h, i + 1, j)) / r->dx, 0.5 * (slope_y(r, i, j) + slope_y(r, i + 1, j)),
+                             excess);
+    const double south = flux(r, (AT(r, r->h, i, j - 1) - hc) / r->dy, 0.5 * (slope_x(r, i, j - 1) + slope_x(r, i, j)),
+                              excess);
+    const double north = flux(r, (hc - AT(r, r->h, i, j + 1)) / r->dy, 0.5 * (slope_x(r, i, j) + slope_x(r, i, j + 1)),
+                              excess);
+    return (west - east) / r->dx + (south - north) / r->dy;
+}
+
 double reference_rates(const reference_grid *r, double *rate) {
     double excess = 0.0;
     for (int64_t j = 0; j < r->ny; ++j)
-        for (int64_t i = 0; i < r->nx; ++i) {
-            const double hc = AT(r, r->h, i, j);
-            const double west = flux(r, (AT(r, r->h, i - 1, j) - hc) / r->dx,
-                                     0.5 * (slope_y(r, i - 1, j) + slope_y(r, i, j)), &excess);
-            const double east = flux(r, (hc - AT(r, r->h, i + 1, j)) / r->dx,
-                                     0.5 * (slope_y(r, i, j) + slope_y(r, i + 1, j)), &excess);
-            const double south = flux(r, (AT(r, r->h, i, j - 1) - hc) / r->dy,
-                                      0.5 * (slope_x(r, i, j - 1) + slope_x(r, i, j)), &excess);
-            const double north = flux(r, (hc - AT(r, r->h, i, j + 1)) / r->dy,
-                                      0.5 * (slope_x(r, i, j) + slope_x(r, i, j + 1)), &excess);
-            rate[i + r->nx * j] = (west - east) / r->dx + (south - north) / r->dy;
-        }
+        for (int64_t i = 0; i < r->nx; ++i) rate[i + r->nx * j] = cell_rate(r, i, j, &excess);
     return excess;
 }
 
 double reference_substep(reference_grid *r, double dt) {
     double excess = 0.0;
     for (int64_t j = 0; j < r->ny; ++j)
-        for (int64_t i = 0; i < r->nx; ++i) {
-            const double hc = AT(r, r->h, i, j);
-            const double west = flux(r, (AT(r, r->h, i - 1, j) - hc) / r->dx,
-                                     0.5 * (slope_y(r, i - 1, j) + slope_y(r, i, j)), &excess);
-            const double east = flux(r, (hc - AT(r, r->h, i + 1, j)) / r->dx,
-                                     0.5 * (slope_y(r, i, j) + slope_y(r, i + 1, j)), &excess);
-            const double south = flux(r, (AT(r, r->h, i, j - 1) - hc) / r->dy,
-                                      0.5 * (slope_x(r, i, j - 1) + slope_x(r, i, j)), &excess);
-            const double north = flux(r, (hc - AT(r, r->h, i, j + 1)) / r->dy,
-                                      0.5 * (slope_x(r, i, j) + slope_x(r, i, j + 1)), &excess);
-            AT(r, r->next, i, j) = hc + dt * ((west - east) / r->dx + (south - north) / r->dy);
-        }
+        for (int64_t i = 0; i < r->nx; ++i) AT(r, r->next, i, j) = AT(r, r->h, i, j) + dt * cell_rate(r, i, j, &excess);
     double *t = r->h;
     r->h = r->next;
     r->next = t;

@@ -47,18 +47,6 @@ static int contains_word(const char *s, const char *word) {
     return 0;
 }
 
-/* Fails at file:line with a formatted explanation unless cond holds. */
-static void require_at(int cond, const char *file, int line, const char *fmt, ...) CMOCKA_PRINTF_ATTRIBUTE(4, 5);
-static void require_at(int cond, const char *file, int line, const char *fmt, ...) {
-    if (cond) return;
-    va_list ap;
-    va_start(ap, fmt);
-    vprint_error(fmt, ap);
-    va_end(ap);
-    print_error("\n");
-    _fail(file, line);
-}
-#define REQUIRE(cond, ...) require_at((cond) != 0, __FILE__, __LINE__, __VA_ARGS__)
 
 /* |got - want| <= tol * |want| (or <= tol when want is 0). */
 static int close_rel(double got, double want, double tol) {

@@ -14,6 +14,16 @@ void check_ok_(const dpsm_grid *g, int status, const char *text, const char *fil
     }
 }
 
+void require_at(int cond, const char *file, int line, const char *fmt, ...) {
+    if (cond) return;
+    va_list ap;
+    va_start(ap, fmt);
+    vprint_error(fmt, ap);
+    va_end(ap);
+    print_error("\n");
+    _fail(file, line);
+}
+
 ledger_t read_ledger(const dpsm_grid *g) {
     ledger_t l;
     CHECK_OK(g, dpsm_get_mass(g, DPSM_MASS_TOTAL, &l.total));

@@ -19,6 +19,13 @@ ledger_t read_ledger(const dpsm_grid *g);
 /* |total - (sourced + external - outflow)| relative to the largest figure. */
 double ledger_residual(const dpsm_grid *g);
 
+/* Fails the test at file:line with a formatted explanation unless cond holds. */
+#if defined(__GNUC__)
+__attribute__((format(printf, 4, 5)))
+#endif
+void require_at(int cond, const char *file, int line, const char *fmt, ...);
+#define REQUIRE(cond, ...) require_at((cond) != 0, __FILE__, __LINE__, __VA_ARGS__)
+
 double max_of(const double *v, size_t n);
 double min_of(const double *v, size_t n);
 

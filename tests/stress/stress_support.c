@@ -10,6 +10,8 @@
 
 #include <cmocka.h>
 
+#include "test_support.h"
+
 #ifndef DPSM_STRESS_SCALE_DEFAULT
 #define DPSM_STRESS_SCALE_DEFAULT 1.0
 #endif
@@ -18,18 +20,6 @@ static const double kTwoPi = 6.283185307179586476925;
 
 stress_worst_t stress_worst;
 
-/* Fails at file:line with a formatted explanation unless cond holds. */
-static void require_at(int cond, const char *file, int line, const char *fmt, ...) CMOCKA_PRINTF_ATTRIBUTE(4, 5);
-static void require_at(int cond, const char *file, int line, const char *fmt, ...) {
-    if (cond) return;
-    va_list ap;
-    va_start(ap, fmt);
-    vprint_error(fmt, ap);
-    va_end(ap);
-    print_error("\n");
-    _fail(file, line);
-}
-#define REQUIRE(cond, ...) require_at((cond) != 0, __FILE__, __LINE__, __VA_ARGS__)
 #define OK(s, call)                                                                                            \
     do {                                                                                                       \
         const int st_ = (call);                                                                                \

@@ -29,22 +29,13 @@
 
 #include <cmocka.h>
 
+#include "test_support.h"
+
 #include "stress_support.h"
 
 static const double kPi = 3.14159265358979323846;
 static double deg(double d) { return d * kPi / 180.0; }
 
-static void require_at(int cond, const char *file, int line, const char *fmt, ...) CMOCKA_PRINTF_ATTRIBUTE(4, 5);
-static void require_at(int cond, const char *file, int line, const char *fmt, ...) {
-    if (cond) return;
-    va_list ap;
-    va_start(ap, fmt);
-    vprint_error(fmt, ap);
-    va_end(ap);
-    print_error("\n");
-    _fail(file, line);
-}
-#define REQUIRE(cond, ...) require_at((cond) != 0, __FILE__, __LINE__, __VA_ARGS__)
 
 static const char *geom_name(int geom, int scheme) {
     if (geom == GEOM_1D) return "1D";
