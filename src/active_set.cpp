@@ -93,9 +93,11 @@ bool ActiveSet::may_move() const {
 
 void ActiveSet::tiles_to_visit(int levels, std::vector<std::int64_t> &tiles,
                                std::vector<CellBox> &boxes) const {
-    // Within `levels` sub-steps motion spreads `levels` cells, and a face
-    // reads one cell beyond its own two: a hot box reaches levels + 2 cells.
-    const std::int64_t reach = levels + 2;
+    // A face carries sand in a sub-step only if it did in the one before or a
+    // cell within one of it changed: the cells touching moving faces spread by
+    // at most one cell a sub-step. A hot box (grown by one cell when stored)
+    // therefore reaches `levels` cells within a sweep.
+    const std::int64_t reach = levels;
     tiles.clear();
     boxes.clear();
     // DPSM_VISIT_ALL_TILES=1 turns the active set off, for tests that show it

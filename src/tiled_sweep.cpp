@@ -180,8 +180,8 @@ std::int64_t tiled_sweep(Grid &grid, int levels, double dt, std::vector<LevelSum
         }
     }
 
-    // New hot boxes: where sand moved in any level, grown by the two cells a
-    // last move can make steep. Sums in tile order, whatever the threads.
+    // New hot boxes: the cells touching moving faces in any level, grown by the
+    // one cell a last move can make steep. Sums in tile order, whatever the threads.
     summaries.assign(static_cast<std::size_t>(levels), LevelSummary{});
     for (std::int64_t k = 0; k < visits; ++k) {
         CellBox moved;
@@ -192,8 +192,8 @@ std::int64_t tiled_sweep(Grid &grid, int levels, double dt, std::vector<LevelSum
             sum.outflow_rate += st.outflow_rate;
             sum.max_excess = std::max(sum.max_excess, st.max_excess);
             if (st.hot_r0 < st.hot_r1)
-                moved.add(ws.origin[2 * k] + st.hot_c0 - 2, ws.origin[2 * k] + st.hot_c1 + 2,
-                          ws.origin[2 * k + 1] + st.hot_r0 - 2, ws.origin[2 * k + 1] + st.hot_r1 + 2);
+                moved.add(ws.origin[2 * k] + st.hot_c0 - 1, ws.origin[2 * k] + st.hot_c1 + 1,
+                          ws.origin[2 * k + 1] + st.hot_r0 - 1, ws.origin[2 * k + 1] + st.hot_r1 + 1);
         }
         active.hot(ws.visit[k]) = moved;
     }
