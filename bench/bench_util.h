@@ -6,6 +6,7 @@
 
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 #include <time.h>
 
 #include <dpsm/dpsm.h>
@@ -37,6 +38,32 @@ static inline void *xcalloc(size_t n, size_t size) {
         exit(1);
     }
     return p;
+}
+
+/* A subcommand: its name, what runs it (argv holds the arguments after the
+ * name) and a line of help. */
+typedef struct {
+    const char *name;
+    int (*run)(int argc, char **argv);
+    const char *help;
+} command;
+
+static inline void print_usage(FILE *out, const command *commands, size_t count) {
+    fprintf(out, "usage: " DPSM_TOOL_NAME " COMMAND ARGS...   (dpsm %s)\n", dpsm_version_string());
+    for (size_t k = 0; k < count; ++k) fprintf(out, "  %-15s %s\n", commands[k].name, commands[k].help);
+}
+
+/* The whole main() of a tool made of subcommands. */
+static inline int run_command(const command *commands, size_t count, int argc, char **argv) {
+    if (argc < 2 || !strcmp(argv[1], "-h") || !strcmp(argv[1], "--help")) {
+        print_usage(argc < 2 ? stderr : stdout, commands, count);
+        return argc < 2 ? 2 : 0;
+    }
+    for (size_t k = 0; k < count; ++k)
+        if (!strcmp(argv[1], commands[k].name)) return commands[k].run(argc - 2, argv + 2);
+    fprintf(stderr, DPSM_TOOL_NAME ": unknown command '%s'\n", argv[1]);
+    print_usage(stderr, commands, count);
+    return 2;
 }
 
 /* The speed subcommands (speed.c). */

@@ -198,12 +198,6 @@ static int cmd_work_precision(int argc, char **argv) {
 
 /* ---- dispatch ---------------------------------------------------------------- */
 
-typedef struct {
-    const char *name;
-    int (*run)(int argc, char **argv);
-    const char *help;
-} command;
-
 static const command kCommands[] = {
     {"throughput", cmd_throughput, "[n ...]  fully active surfaces; CSV n,threads,mcells_per_s,reference_mcells_per_s,ratio"},
     {"sparse", cmd_sparse, "[n [fraction]]  ~1 % of cells on slip faces; cost of a sub-step against a fully active one"},
@@ -215,20 +209,4 @@ static const command kCommands[] = {
      " and axisymmetric; threads default 1; CSV scene,scheme,n,seconds,l1_error"},
 };
 
-static void usage(FILE *out) {
-    fprintf(out, "usage: dpsm-bench COMMAND ARGS...   (dpsm %s)\n", dpsm_version_string());
-    for (size_t k = 0; k < sizeof kCommands / sizeof kCommands[0]; ++k)
-        fprintf(out, "  %-15s %s\n", kCommands[k].name, kCommands[k].help);
-}
-
-int main(int argc, char **argv) {
-    if (argc < 2 || !strcmp(argv[1], "-h") || !strcmp(argv[1], "--help")) {
-        usage(argc < 2 ? stderr : stdout);
-        return argc < 2 ? 2 : 0;
-    }
-    for (size_t k = 0; k < sizeof kCommands / sizeof kCommands[0]; ++k)
-        if (!strcmp(argv[1], kCommands[k].name)) return kCommands[k].run(argc - 2, argv + 2);
-    fprintf(stderr, "dpsm-bench: unknown command '%s'\n", argv[1]);
-    usage(stderr);
-    return 2;
-}
+int main(int argc, char **argv) { return run_command(kCommands, sizeof kCommands / sizeof kCommands[0], argc, argv); }

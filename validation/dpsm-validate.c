@@ -413,12 +413,6 @@ static int cmd_table_2d(int argc, char **argv) {
 
 static int cmd_all(int argc, char **argv);
 
-typedef struct {
-    const char *name;
-    int (*run)(int argc, char **argv);
-    const char *help;
-} command;
-
 static const command kCommands[] = {
     {"column-sweep", cmd_column_sweep, "OUTDIR [rings_per_r0]  axisymmetric column collapse -> column_sweep.csv"},
     {"table-1d", cmd_table_1d, "OUTDIR                  the paper's Figs. 2-3 -> table_1d.csv"},
@@ -438,20 +432,4 @@ static int cmd_all(int argc, char **argv) {
     return 0;
 }
 
-static void usage(FILE *out) {
-    fprintf(out, "usage: dpsm-validate COMMAND ARGS...   (dpsm %s)\n", dpsm_version_string());
-    for (size_t k = 0; k < sizeof kCommands / sizeof kCommands[0]; ++k)
-        fprintf(out, "  %-13s %s\n", kCommands[k].name, kCommands[k].help);
-}
-
-int main(int argc, char **argv) {
-    if (argc < 2 || !strcmp(argv[1], "-h") || !strcmp(argv[1], "--help")) {
-        usage(argc < 2 ? stderr : stdout);
-        return argc < 2 ? 2 : 0;
-    }
-    for (size_t k = 0; k < sizeof kCommands / sizeof kCommands[0]; ++k)
-        if (!strcmp(argv[1], kCommands[k].name)) return kCommands[k].run(argc - 2, argv + 2);
-    fprintf(stderr, "dpsm-validate: unknown command '%s'\n", argv[1]);
-    usage(stderr);
-    return 2;
-}
+int main(int argc, char **argv) { return run_command(kCommands, sizeof kCommands / sizeof kCommands[0], argc, argv); }
