@@ -61,6 +61,7 @@ void Grid::write_heights(const Block &block, const double *values, bool add) {
             residuals_[c] = 0.0f;
         }
     ledger_.external.add(change.value());
+    if (open_cells_ > 0) update_open_levels();
     if (active_) active_->mark_block(block.i0, block.j0, block.ni, block.nj);
 }
 
@@ -87,6 +88,7 @@ void Grid::set_cell_kinds(const std::uint8_t *kinds) {
     open_cells_ = opens;
     ledger_.external.add(change.value());
     update_source_summary();
+    update_open_levels();
     if (active_) {
         active_->refresh_masks(*this);
         active_->mark_all();
@@ -99,6 +101,19 @@ void Grid::set_source(const double *q) {
     else
         source_.clear();
     update_source_summary();
+}
+
+void Grid::update_open_levels() {
+    double lo = 0.0, hi = 0.0;
+    bool first = true;
+    for (std::size_t c = 0; c < kinds_.size(); ++c) {
+        if (kinds_[c] != kOpen) continue;
+        lo = first || heights_[c] < lo ? heights_[c] : lo;
+        hi = first || heights_[c] > hi ? heights_[c] : hi;
+        first = false;
+    }
+    open_level_min_ = lo;
+    open_level_max_ = hi;
 }
 
 void Grid::update_source_summary() {

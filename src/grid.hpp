@@ -100,6 +100,10 @@ public:
     const std::vector<double> &source() const { return source_; }  // empty: none
     bool has_obstacles() const { return wall_cells_ > 0 || open_cells_ > 0; }
     bool has_open_cells() const { return open_cells_ > 0; }
+    // The lowest and highest level held by open cells (kept up to date by the
+    // host's calls, the only ones that change them).
+    double open_level_min() const { return open_level_min_; }
+    double open_level_max() const { return open_level_max_; }
     bool source_active() const { return source_rate_nonzero_; }
     double source_mass_rate() const { return source_mass_rate_; }
 
@@ -133,6 +137,7 @@ public:
 
 private:
     void update_source_summary();
+    void update_open_levels();
     // Something that may make any face steep changed: every tile is looked at again.
     void touched_everywhere() {
         if (active_) active_->mark_all();
@@ -157,6 +162,7 @@ private:
     int threads_ = 0;
     std::int64_t wall_cells_ = 0;
     std::int64_t open_cells_ = 0;
+    double open_level_min_ = 0.0, open_level_max_ = 0.0;
     bool source_rate_nonzero_ = false;
     double source_mass_rate_ = 0.0;
 

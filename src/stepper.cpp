@@ -38,17 +38,8 @@ bool can_flow_forever(const Grid &grid) {
     const Geometry &geo = grid.geometry();
     bool any_side_open = grid.side_open(kXMin) || grid.side_open(kXMax);
     if (geo.dim == 2) any_side_open = any_side_open || grid.side_open(kYMin) || grid.side_open(kYMax);
-    bool have_level = any_side_open;
-    double level = 0.0;
-    const std::vector<double> &h = grid.heights();
-    const std::vector<std::uint8_t> &kind = grid.kinds();
-    for (std::size_t c = 0; c < h.size(); ++c) {
-        if (kind[c] != kOpen) continue;
-        if (have_level && h[c] != level) return true;
-        level = h[c];
-        have_level = true;
-    }
-    return false;
+    if (grid.open_level_min() != grid.open_level_max()) return true;
+    return any_side_open && grid.open_level_min() != 0.0;
 }
 
 }  // namespace
