@@ -147,6 +147,29 @@ void require_scale(double value, const char *function, const char *name) {
         fail(DPSM_ERR_INVALID_VALUE, function, name, " = ", value, " is outside the supported range [1e-50, 1e50]");
 }
 
+// With a bed, the host may not put a cell below it: names the first such cell.
+// `values` are the block's new heights (add = false) or changes (add = true).
+void require_above_bed(const dpsm_grid *g, const dpsm::Grid::Block &b, const double *values, bool add,
+                       const char *function, const char *name) {
+    const std::vector<double> &zb = g->core.bed();
+    if (zb.empty()) return;
+    const std::vector<double> &h = g->core.heights();
+    const std::int64_t nx = g->core.geometry().nx;
+    for (std::int64_t k = 0; k < b.ni * b.nj; ++k) {
+        const std::int64_t c = (b.i0 + k % b.ni) + nx * (b.j0 + k / b.ni);
+        const double next = add ? h[c] + values[k] : values[k];
+        if (next < zb[c])
+            fail(DPSM_ERR_INVALID_VALUE, function, name, "[", k, "] puts cell i = ", c % nx, ", j = ", c / nx,
+                 " at ", next, ", below its bed zb = ", zb[c], " (see dpsm_set_bedrock)");
+    }
+}
+
+void require_angle(double theta, const char *function, const char *name) {
+    require_finite(theta, function, name);
+    if (!(theta > 0.0 && theta < 0.5 * M_PI))
+        fail(DPSM_ERR_INVALID_VALUE, function, name, " = ", theta, " radians is outside (0, pi/2)");
+}
+
 // The largest number of cells we agree to address: every per-cell array must
 // fit in memory indices with room to spare.
 constexpr std::int64_t kMaxCells = std::numeric_limits<std::int64_t>::max() / 64;
@@ -189,9 +212,7 @@ int dpsm_set_repose_angle(dpsm_grid *g, double theta) {
     const char *fn = "dpsm_set_repose_angle";
     return guarded(g, fn, [&] {
         require_grid(g, fn);
-        require_finite(theta, fn, "theta");
-        if (!(theta > 0.0 && theta < 0.5 * M_PI))
-            fail(DPSM_ERR_INVALID_VALUE, fn, "theta = ", theta, " radians is outside (0, pi/2)");
+        require_angle(theta, fn, "theta");
         g->core.set_repose_angle(theta);
     });
 }
@@ -254,6 +275,7 @@ int dpsm_set_heights(dpsm_grid *g, const double *h) {
     return guarded(g, fn, [&] {
         require_grid(g, fn);
         require_finite_array(g, h, fn, "h");
+        require_above_bed(g, g->core.whole(), h, false, fn, "h");
         g->core.write_heights(g->core.whole(), h, false);
     });
 }
@@ -264,6 +286,7 @@ int dpsm_set_heights_region(dpsm_grid *g, int64_t i0, int64_t j0, int64_t ni, in
         require_grid(g, fn);
         const dpsm::Grid::Block block = require_block(g, i0, j0, ni, nj, fn);
         require_finite_block(h, block, fn, "h");
+        require_above_bed(g, block, h, false, fn, "h");
         g->core.write_heights(block, h, false);
     });
 }
@@ -282,6 +305,7 @@ int dpsm_add_heights_region(dpsm_grid *g, int64_t i0, int64_t j0, int64_t ni, in
                 fail(DPSM_ERR_INVALID_VALUE, fn, "dh[", k, "] = ", dh[k], " added to cell i = ", c % nx, ", j = ", c / nx,
                      " of height ", h[c], " leaves the supported range [-1e50, 1e50]");
         }
+        require_above_bed(g, block, dh, true, fn, "dh");
         g->core.write_heights(block, dh, true);
     });
 }
@@ -343,9 +367,11 @@ int dpsm_get_mass(const dpsm_grid *g, int quantity, double *value) {
             case DPSM_MASS_SOURCED: *value = ledger.sourced.value(); break;
             case DPSM_MASS_EXTERNAL: *value = ledger.external.value(); break;
             case DPSM_MASS_OUTFLOW: *value = ledger.outflow.value(); break;
+            case DPSM_MASS_UNMET: *value = ledger.unmet.value(); break;
             default:
                 fail(DPSM_ERR_UNKNOWN_ENUM, fn, "quantity = ", quantity,
-                     " is not DPSM_MASS_TOTAL, DPSM_MASS_SOURCED, DPSM_MASS_EXTERNAL or DPSM_MASS_OUTFLOW");
+                     " is not DPSM_MASS_TOTAL, DPSM_MASS_SOURCED, DPSM_MASS_EXTERNAL, DPSM_MASS_OUTFLOW"
+                     " or DPSM_MASS_UNMET");
         }
     });
 }
@@ -408,6 +434,59 @@ int dpsm_set_threads(dpsm_grid *g, int n) {
     });
 }
 
+int dpsm_set_bedrock(dpsm_grid *g, const double *zb) {
+    const char *fn = "dpsm_set_bedrock";
+    return guarded(g, fn, [&] {
+        require_grid(g, fn);
+        if (zb) {
+            require_finite_array(g, zb, fn, "zb");
+            const dpsm::Geometry &geo = g->core.geometry();
+            const std::vector<double> &h = g->core.heights();
+            for (std::int64_t c = 0; c < geo.cells(); ++c)
+                if (zb[c] > h[c])
+                    fail(DPSM_ERR_INVALID_VALUE, fn, "zb[", c, "] (cell i = ", c % geo.nx, ", j = ", c / geo.nx,
+                         ") = ", zb[c], " lies above the cell's height ", h[c]);
+        }
+        g->core.set_bed(zb);
+    });
+}
+
+int dpsm_set_repose_angle_field(dpsm_grid *g, const double *theta) {
+    const char *fn = "dpsm_set_repose_angle_field";
+    return guarded(g, fn, [&] {
+        require_grid(g, fn);
+        if (theta) {
+            const dpsm::Geometry &geo = g->core.geometry();
+            for (std::int64_t c = 0; c < geo.cells(); ++c)
+                if (!(theta[c] > 0.0 && theta[c] < 0.5 * M_PI))  // also NaN
+                    fail(DPSM_ERR_INVALID_VALUE, fn, "theta_radians[", c, "] (cell i = ", c % geo.nx,
+                         ", j = ", c / geo.nx, ") = ", theta[c], " is outside (0, pi/2)");
+        }
+        g->core.set_angle_field(theta);
+    });
+}
+
+int dpsm_set_flux_exponent(dpsm_grid *g, double p) {
+    const char *fn = "dpsm_set_flux_exponent";
+    return guarded(g, fn, [&] {
+        require_grid(g, fn);
+        require_finite(p, fn, "p");
+        if (!(p >= 1.0 && p <= DPSM_MAX_FLUX_EXPONENT))
+            fail(DPSM_ERR_INVALID_VALUE, fn, "p = ", p, " is outside [1, ", DPSM_MAX_FLUX_EXPONENT,
+                 "] (below 1 the law has no finite stable step, above 2 its slope grows without bound)");
+        g->core.set_flux_exponent(p);
+    });
+}
+
+int dpsm_set_static_angle(dpsm_grid *g, double radians) {
+    const char *fn = "dpsm_set_static_angle";
+    return guarded(g, fn, [&] {
+        require_grid(g, fn);
+        require_angle(radians, fn, "radians");
+        g->core.set_static_angle(radians);
+    });
+}
+
 const char *dpsm_last_error(const dpsm_grid *g) {
     return g ? g->last_error.c_str() : error_without_grid.c_str();
 }
@@ -423,6 +502,8 @@ const char *dpsm_status_string(int status) {
         case DPSM_ERR_WORK_LIMIT: return "DPSM_ERR_WORK_LIMIT";
         case DPSM_ERR_OUT_OF_MEMORY: return "DPSM_ERR_OUT_OF_MEMORY";
         case DPSM_ERR_INTERNAL: return "DPSM_ERR_INTERNAL";
+        case DPSM_ERR_IO: return "DPSM_ERR_IO";
+        case DPSM_ERR_BAD_FILE: return "DPSM_ERR_BAD_FILE";
         default: return "unknown status";
     }
 }

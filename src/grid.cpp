@@ -103,6 +103,39 @@ void Grid::set_source(const double *q) {
     update_source_summary();
 }
 
+void Grid::set_bed(const double *zb) {
+    if (zb)
+        bed_.assign(zb, zb + heights_.size());
+    else
+        bed_.clear();
+    touched_everywhere();
+}
+
+void Grid::set_angle_field(const double *theta) {
+    if (theta) {
+        angle_field_.assign(theta, theta + heights_.size());
+        tan_field_.resize(angle_field_.size());
+        double lowest = angle_field_[0];
+        for (std::size_t c = 0; c < angle_field_.size(); ++c) {
+            tan_field_[c] = std::tan(angle_field_[c]);
+            lowest = angle_field_[c] < lowest ? angle_field_[c] : lowest;
+        }
+        min_angle_field_ = lowest;
+    } else {
+        angle_field_.clear();
+        tan_field_.clear();
+    }
+    touched_everywhere();
+}
+
+void Grid::set_static_angle(double theta) {
+    static_angle_ = theta;
+    tan_static_ = std::tan(theta);
+    // Every cell starts at rest: sand moves first where the static angle is exceeded.
+    moving_.assign(heights_.size(), 0);
+    touched_everywhere();
+}
+
 void Grid::update_open_levels() {
     double lo = 0.0, hi = 0.0;
     bool first = true;

@@ -78,6 +78,33 @@ public:
         scheme_ = scheme;
         touched_everywhere();
     }
+    // The physics of real scenes (dpsm_set_bedrock and friends); each is empty
+    // or at its default when a scene does not use it, and a scene that uses
+    // none of them is stepped by the vectorised kernels.
+    const std::vector<double> &bed() const { return bed_; }  // empty: none
+    void set_bed(const double *zb);                           // NULL: none
+    const std::vector<double> &angle_field() const { return angle_field_; }  // radians; empty: uniform
+    const std::vector<double> &tan_field() const { return tan_field_; }      // tan of angle_field
+    void set_angle_field(const double *theta);                               // NULL: uniform
+    // The smallest angle of repose of any cell: it sets the stable sub-step.
+    double min_repose_angle() const { return angle_field_.empty() ? repose_angle_ : min_angle_field_; }
+    double flux_exponent() const { return flux_exponent_; }
+    void set_flux_exponent(double p) {
+        flux_exponent_ = p;
+        touched_everywhere();
+    }
+    // Hysteresis: on once a static angle is set; moving() then holds, per
+    // cell, whether one of its faces carried sand in the last sub-step.
+    bool hysteresis() const { return static_angle_ > 0.0; }
+    double static_angle() const { return static_angle_; }
+    double tan_static() const { return tan_static_; }
+    void set_static_angle(double theta);
+    const std::vector<std::uint8_t> &moving() const { return moving_; }
+    std::vector<std::uint8_t> &moving_for_stepping() { return moving_; }
+    bool uses_physics() const {
+        return !bed_.empty() || !tan_field_.empty() || flux_exponent_ != 1.0 || hysteresis();
+    }
+
     bool side_open(int side) const { return side_open_[side]; }
     void set_side_open(int side, bool open) {
         side_open_[side] = open;
@@ -155,6 +182,12 @@ private:
     std::vector<float> residuals_;
     std::vector<std::uint8_t> kinds_;
     std::vector<double> source_;
+    std::vector<double> bed_;
+    std::vector<double> angle_field_, tan_field_;
+    double min_angle_field_ = 0.0;
+    double flux_exponent_ = 1.0;
+    double static_angle_ = 0.0, tan_static_ = 0.0;  // 0: no hysteresis
+    std::vector<std::uint8_t> moving_;
     std::vector<double> rate_;
     std::unique_ptr<ActiveSet> active_;
     std::unique_ptr<TiledWorkspace> tiled_;

@@ -14,20 +14,37 @@ namespace {
 // apart; weight_a and weight_b turn a flux per unit face length into dh/dt of
 // each cell (face length / cell area); len turns it into mass per unit time.
 // The outside of an open side is a cell held at 0.
+//
+// The physics of real scenes enter here only when the grid uses them: a
+// face's angle from its cells' (angle field), the static threshold between
+// cells at rest (hysteresis), the flux exponent, and the bed, which caps what
+// a face takes from its upstream cell at a share of the sand that cell holds.
 class FaceSweep {
 public:
-    FaceSweep(const Grid &grid, std::vector<double> &rate)
-        : h_(grid.heights().data()),
+    FaceSweep(Grid &grid, std::vector<double> &rate, double dt)
+        : grid_(grid),
+          h_(grid.heights().data()),
           kind_(grid.kinds().data()),
           rate_(rate.data()),
           nu_(grid.mobility()),
           tan_theta_(grid.tan_repose()),
-          threshold_(grid.tan_repose() * (1.0 + grid.rest_tolerance())) {}
+          threshold_(grid.tan_repose() * (1.0 + grid.rest_tolerance())),
+          physics_(grid.uses_physics()),
+          dt_(dt) {
+        if (!physics_) return;
+        const std::size_t n = grid.heights().size();
+        if (grid.hysteresis()) moving_next_.assign(n, 0);
+        if (!grid.bed().empty()) prepare_bed(grid, n);
+    }
 
     void interior_face(std::int64_t a, std::int64_t b, double d, double weight_a, double weight_b, double len) {
         const std::uint8_t ka = kind_[a], kb = kind_[b];
         if (ka == kWall || kb == kWall || (ka != kSand && kb != kSand)) return;
-        const double flux = flux_from_to(h_[a], h_[b], d);
+        double flux = flux_from_to(a, b, h_[a], h_[b], d);
+        if (flux == 0.0) return;
+        if (!available_.empty()) flux = capped(flux, flux > 0.0 ? a : b, flux > 0.0 ? weight_a : weight_b);
+        if (flux == 0.0) return;
+        carried(a, b);
         if (ka == kSand)
             rate_[a] -= flux * weight_a;
         else
@@ -40,39 +57,115 @@ public:
 
     void open_side_face(std::int64_t a, double d, double weight_a, double len) {
         if (kind_[a] != kSand) return;
-        const double flux = flux_from_to(h_[a], 0.0, d);
+        double flux = flux_from_to(a, -1, h_[a], 0.0, d);
+        if (flux == 0.0) return;
+        if (!available_.empty() && flux > 0.0) flux = capped(flux, a, weight_a);
+        if (flux == 0.0) return;
+        carried(a, -1);
         rate_[a] -= flux * weight_a;
         result.outflow_rate += flux * len;
+    }
+
+    // Hands the new moving cells to the grid (hysteresis) once every face is done.
+    void finish() {
+        if (!moving_next_.empty()) grid_.moving_for_stepping().swap(moving_next_);
     }
 
     SweepResult result;
 
 private:
-    // Flux per unit length from a to b (negative when b is the higher).
-    double flux_from_to(double ha, double hb, double d) {
+    // Flux per unit length from a to b (negative when b is the higher); b < 0
+    // is the outside of an open side.
+    double flux_from_to(std::int64_t a, std::int64_t b, double ha, double hb, double d) {
         const double slope = (ha - hb) / d;
         const double magnitude = std::fabs(slope);
-        if (!(magnitude > threshold_)) return 0.0;
-        result.moved = true;
-        result.max_excess_slope = std::max(result.max_excess_slope, magnitude - tan_theta_);
-        const double flux = slide_flux(nu_, tan_theta_, magnitude);
+        double tan_face = tan_theta_, threshold = threshold_, p = 1.0;
+        if (physics_) face_law(a, b, tan_face, threshold, p);
+        if (!(magnitude > threshold)) return 0.0;
+        excess_ = magnitude - tan_face;
+        const double flux = slide_flux(nu_, tan_face, magnitude, p);
         return slope > 0.0 ? flux : -flux;
     }
 
+    void face_law(std::int64_t a, std::int64_t b, double &tan_face, double &threshold, double &p) const {
+        const bool b_sand = b >= 0 && kind_[b] == kSand;
+        const std::vector<double> &tan_field = grid_.tan_field();
+        if (!tan_field.empty()) {
+            const double ta = kind_[a] == kSand ? tan_field[a] : tan_field[b];
+            const double tb = b_sand ? tan_field[b] : ta;
+            tan_face = 0.5 * (ta + tb);
+            threshold = tan_face * (1.0 + grid_.rest_tolerance());
+        }
+        if (grid_.hysteresis()) {
+            const std::vector<std::uint8_t> &moving = grid_.moving();
+            const bool at_rest = !moving[a] && !(b >= 0 && moving[b]);
+            if (at_rest) threshold = std::max(threshold, grid_.tan_static());
+        }
+        p = grid_.flux_exponent();
+    }
+
+    // A face takes from its sand cell `up` at most its share of the sand there.
+    double capped(double flux, std::int64_t up, double weight_up) const {
+        if (kind_[up] != kSand) return flux;
+        const double cap = available_[up] / (kFaces * dt_ * weight_up);
+        return flux > 0.0 ? std::min(flux, cap) : std::max(flux, -cap);
+    }
+
+    void carried(std::int64_t a, std::int64_t b) {
+        result.moved = true;
+        result.max_excess_slope = std::max(result.max_excess_slope, excess_);
+        if (moving_next_.empty()) return;
+        if (kind_[a] == kSand) moving_next_[a] = 1;
+        if (b >= 0 && kind_[b] == kSand) moving_next_[b] = 1;
+    }
+
+    // The sand above the bed that exchanges may take this sub-step: what the
+    // cell holds after its own erosion, which takes what it asks for first.
+    // The applied source goes into the rate, so apply_rates adds no more.
+    void prepare_bed(const Grid &grid, std::size_t n) {
+        const std::vector<double> &zb = grid.bed();
+        const std::vector<double> &q = grid.source();
+        const Geometry &geo = grid.geometry();
+        available_.assign(n, 0.0);
+        CompensatedSum unmet;
+        for (std::size_t c = 0; c < n; ++c) {
+            if (kind_[c] != kSand) continue;
+            double sand = std::max(0.0, h_[c] - zb[c]);
+            const double asked = q.empty() ? 0.0 : q[c] * dt_;
+            double applied = asked;
+            if (asked < 0.0) {
+                applied = -std::min(-asked, sand);
+                unmet.add((applied - asked) * geo.cell_area(static_cast<std::int64_t>(c)));
+                sand += applied;
+            }
+            rate_[c] += applied / dt_;
+            available_[c] = sand;
+        }
+        result.unmet_mass = unmet.value();
+    }
+
+    static constexpr double kFaces = 2.0;  // faces of a cell on a line or a radius
+
+    Grid &grid_;
     const double *h_;
     const std::uint8_t *kind_;
     double *rate_;
     double nu_, tan_theta_, threshold_;
+    bool physics_;
+    double dt_;
+    double excess_ = 0.0;
+    std::vector<std::uint8_t> moving_next_;
+    std::vector<double> available_;  // empty: no bed
 };
 
 }  // namespace
 
-SweepResult slide_rates_1d(Grid &grid) {
+SweepResult slide_rates_1d(Grid &grid, double dt) {
     const Geometry &geo = grid.geometry();
     const std::int64_t nx = geo.nx;
     std::vector<double> &rate = grid.rate_workspace();
     std::fill(rate.begin(), rate.end(), 0.0);
-    FaceSweep sweep(grid, rate);
+    FaceSweep sweep(grid, rate, dt);
     // Along a line or a radius: weights are face length over cell area.
     for (std::int64_t i = 0; i + 1 < nx; ++i) {
         const double len = geo.x_face_length(i);
@@ -83,6 +176,7 @@ SweepResult slide_rates_1d(Grid &grid) {
         const double len = geo.x_face_length(nx - 1);
         sweep.open_side_face(nx - 1, geo.dx, len / geo.cell_area(nx - 1), len);
     }
+    sweep.finish();
     return sweep.result;
 }
 
@@ -92,6 +186,7 @@ void apply_rates(Grid &grid, double dt) {
     std::vector<float> &residual = grid.residuals_for_stepping();
     const std::vector<std::uint8_t> &kind = grid.kinds();
     const std::vector<double> &q = grid.source();
+    const std::vector<double> &zb = grid.bed();
     const std::size_t n = h.size();
     // h += increment as a TwoSum: what rounding drops is kept in residual and
     // added back next time, so mass is not lost one half-ulp at a time.
@@ -103,6 +198,19 @@ void apply_rates(Grid &grid, double dt) {
         residual[c] = static_cast<float>((h[c] - (s - b_virtual)) + (b - b_virtual));
         h[c] = s;
     };
+    if (!zb.empty()) {
+        // The rate holds the applied source already. Rounding may leave a
+        // drained cell an ulp below its bed: it is lifted to the bed and the
+        // lift is taken from the rounding it carries.
+        for (std::size_t c = 0; c < n; ++c) {
+            add(c, dt * rate[c]);
+            if (kind[c] == kSand && h[c] < zb[c]) {
+                residual[c] = static_cast<float>(static_cast<double>(residual[c]) - (zb[c] - h[c]));
+                h[c] = zb[c];
+            }
+        }
+        return;
+    }
     // rate is 0 on wall and open cells, so only the source needs the mask.
     if (q.empty()) {
         for (std::size_t c = 0; c < n; ++c) add(c, dt * rate[c]);

@@ -17,11 +17,14 @@ struct SweepResult {
     bool moved = false;             // some face carried sand
     double max_excess_slope = 0.0;  // max over faces that carried sand of |slope| - tan(theta)
     double outflow_rate = 0.0;      // mass per unit time leaving through open sides and cells
+    double unmet_mass = 0.0;        // erosion asked for in this sub-step where no sand lay above the bed
 };
 
-// Fills the grid's rate workspace with dh/dt from the slide fluxes (sources
-// not included) for every sand cell, 0 for wall and open cells.
-SweepResult slide_rates_1d(Grid &grid);
+// Fills the grid's rate workspace with dh/dt from the slide fluxes for every
+// sand cell, 0 for wall and open cells, for a sub-step of dt. Sources are not
+// included, except on a grid with a bed, where the rate holds the part of the
+// source that finds sand. Updates which cells are moving (hysteresis).
+SweepResult slide_rates_1d(Grid &grid, double dt);
 
 // h += dt * (rate + q) on sand cells.
 void apply_rates(Grid &grid, double dt);

@@ -30,6 +30,7 @@ struct MassLedger {
     CompensatedSum sourced;   // mass added by sources
     CompensatedSum external;  // mass added by the host's own calls
     CompensatedSum outflow;   // mass that left through open sides and cells
+    CompensatedSum unmet;     // erosion asked for where no sand lay above the bed
 };
 
 }  // namespace dpsm

@@ -14,7 +14,8 @@ namespace dpsm {
 
 double stable_dt(const Grid &grid) {
     const Geometry &geo = grid.geometry();
-    const double stiffness = slide_flux_max_derivative(grid.mobility(), grid.repose_angle());
+    const double stiffness =
+        slide_flux_max_derivative(grid.mobility(), grid.min_repose_angle(), grid.flux_exponent());
     // No face may take more than its share of the excess: a cell's faces
     // together at most all of it (monotone), a pair at most what brings it to
     // the angle of repose (the paper's bound). On the axisymmetric grid the
@@ -71,7 +72,7 @@ void step(Grid &grid, double dt) {
     // Books one sub-step; false once the surface is found at rest (nothing
     // moved and no source acts: no later sub-step can change anything).
     StepInfo info;
-    auto book = [&](bool moved, double outflow_rate, double max_excess) {
+    auto book = [&](bool moved, double outflow_rate, double max_excess, double unmet_mass) {
         info.max_excess_slope = max_excess;
         if (!moved && !source_active) {
             info.at_rest = true;
@@ -79,6 +80,10 @@ void step(Grid &grid, double dt) {
         }
         ledger.outflow.add(outflow_rate * sub_dt);
         if (source_active) ledger.sourced.add(grid.source_mass_rate() * sub_dt);
+        if (unmet_mass != 0.0) {  // erosion that found no sand above the bed was not applied
+            ledger.sourced.add(-unmet_mass);
+            ledger.unmet.add(unmet_mass);
+        }
         ++info.substeps;
         return true;
     };
@@ -93,15 +98,15 @@ void step(Grid &grid, double dt) {
                 const int count = static_cast<int>(std::min<std::int64_t>(ActiveSet::kMaxLevels, substeps - k));
                 const double visited = static_cast<double>(tiled_sweep(grid, count, sub_dt, levels));
                 for (const LevelSummary &level : levels) {
-                    if (!book(level.moved, level.outflow_rate, level.max_excess)) break;
+                    if (!book(level.moved, level.outflow_rate, level.max_excess, level.unmet_mass)) break;
                     info.cell_updates += visited;
                 }
             }
         }
     } else {
         for (std::int64_t k = 0; k < substeps; ++k) {
-            const SweepResult sweep = slide_rates_1d(grid);
-            if (!book(sweep.moved, sweep.outflow_rate, sweep.max_excess_slope)) break;
+            const SweepResult sweep = slide_rates_1d(grid, sub_dt);
+            if (!book(sweep.moved, sweep.outflow_rate, sweep.max_excess_slope, sweep.unmet_mass)) break;
             apply_rates(grid, sub_dt);
             info.cell_updates += static_cast<double>(grid.geometry().cells());
         }

@@ -24,6 +24,12 @@ struct TileLevelParams {
     double inv_dx, inv_dy, half_inv_dx, half_inv_dy;
     double dt;
     double x_face_length, y_face_length;  // dy and dx: flux per unit length to mass per unit time
+    // Read by the physics kernel only (tile_kernel_physics.cpp).
+    double rest_factor = 1.0;  // 1 + tol: a face's threshold is tan(theta) times this
+    double flux_exponent = 1.0;
+    double tan_static = 0.0;  // hysteresis: the threshold between cells at rest
+    bool hysteresis = false, bed = false, angle_field = false;
+    double cell_area = 1.0;  // dx dy
 };
 
 // What one level did, over the tile itself (moved and max_excess also over
@@ -32,6 +38,7 @@ struct TileLevelStats {
     bool moved = false;         // some face carried sand
     double max_excess = 0.0;    // largest |grad h| - tan(theta) over faces that carried sand
     double outflow_rate = 0.0;  // mass per unit time into sinks from the tile's sand cells
+    double unmet_mass = 0.0;    // erosion asked for on the tile's cells where no sand lay above the bed
     int hot_r0 = 1 << 30, hot_r1 = -1, hot_c0 = 1 << 30, hot_c1 = -1;  // cells of the tile touching moving faces
 };
 
@@ -41,7 +48,12 @@ struct TileBuffers {
     std::vector<double> h[2], residual[2], source;
     std::vector<std::uint8_t> kind;
     std::vector<double> rows;  // scratch rows for faces and transverse slopes
+    // The physics kernel's inputs and scratch, sized only when a grid uses it.
+    std::vector<double> bed, tan_theta;
+    std::vector<std::uint8_t> moving[2];
+    std::vector<double> available, applied, x_faces, y_faces;
     void resize(int w, int h_);
+    void resize_physics();
 };
 
 // Advances the cells of `region` by one level, from slot `in` to slot 1 - in.
@@ -52,5 +64,11 @@ using TileLevelFunction = void (*)(TileBuffers &buffers, int in, const TileRect 
 // The kernel for a tile: masked (walls, sinks or ghosts in reach), isotropic
 // or pairwise, with or without a source. The widest lanes this CPU has.
 TileLevelFunction select_tile_kernel(bool masked, bool isotropic, bool source);
+
+// The kernel of a grid that uses a bed, an angle field, a flux exponent or
+// hysteresis (tile_kernel_physics.cpp): plain scalar code, used for every tile
+// of such a grid (it reads cell kinds always), so that every face of the grid
+// is computed by the same arithmetic.
+TileLevelFunction select_physics_tile_kernel(bool isotropic, bool source);
 
 }  // namespace dpsm

@@ -75,6 +75,24 @@ void gather(const Grid &grid, TileBuffers &b, std::int64_t gi0, std::int64_t gj0
     }
 }
 
+// Copies what the physics kernel reads besides heights: bed, angles and which
+// cells are moving; ghost cells are never moving and have no bed or angle.
+void gather_physics(const Grid &grid, TileBuffers &b, std::int64_t gi0, std::int64_t gj0) {
+    const Geometry &geo = grid.geometry();
+    const std::vector<double> &zb = grid.bed(), &tan_theta = grid.tan_field();
+    const std::vector<std::uint8_t> &moving = grid.moving();
+    for (int r = 0; r < b.height; ++r)
+        for (int c = 0; c < b.width; ++c) {
+            const std::int64_t i = gi0 + c, j = gj0 + r;
+            const bool in = i >= 0 && j >= 0 && i < geo.nx && j < geo.ny;
+            const std::size_t at = static_cast<std::size_t>(r) * b.width + c;
+            const std::size_t cell = in ? static_cast<std::size_t>(i + geo.nx * j) : 0;
+            if (!zb.empty()) b.bed[at] = in ? zb[cell] : 0.0;
+            if (!tan_theta.empty()) b.tan_theta[at] = in ? tan_theta[cell] : 0.0;
+            if (!moving.empty()) b.moving[0][at] = in ? moving[cell] : 0;
+        }
+}
+
 }  // namespace
 
 void prepare_tiled_sweep(Grid &grid, int threads) {
@@ -89,6 +107,9 @@ void prepare_tiled_sweep(Grid &grid, int threads) {
         ws.buffers.emplace_back();
         ws.buffers.back().resize(kBufferSide, kBufferSide);
     }
+    if (grid.uses_physics())
+        for (TileBuffers &b : ws.buffers) b.resize_physics();
+    if (grid.hysteresis() && ws.moving.size() != cells) ws.moving.assign(cells, 0);
     const std::size_t tiles = static_cast<std::size_t>(grid.active_set().tiles());
     ws.visit.reserve(tiles);
     ws.boxes.reserve(tiles);
@@ -107,9 +128,19 @@ std::int64_t tiled_sweep(Grid &grid, int levels, double dt, std::vector<LevelSum
 
     const double tan_theta = grid.tan_repose();
     const double threshold = tan_theta * (1.0 + grid.rest_tolerance());
-    const TileLevelParams params{grid.mobility(), tan_theta,       threshold * threshold, 1.0 / geo.dx,
-                                 1.0 / geo.dy,    0.5 / geo.dx,    0.5 / geo.dy,          dt,
-                                 geo.dy,          geo.dx};
+    TileLevelParams params{grid.mobility(), tan_theta,       threshold * threshold, 1.0 / geo.dx,
+                           1.0 / geo.dy,    0.5 / geo.dx,    0.5 / geo.dy,          dt,
+                           geo.dy,          geo.dx};
+    const bool physics = grid.uses_physics(), hysteresis = grid.hysteresis();
+    if (physics) {
+        params.rest_factor = 1.0 + grid.rest_tolerance();
+        params.flux_exponent = grid.flux_exponent();
+        params.tan_static = grid.tan_static();
+        params.hysteresis = hysteresis;
+        params.bed = !grid.bed().empty();
+        params.angle_field = !grid.tan_field().empty();
+        params.cell_area = geo.dx * geo.dy;
+    }
     const bool isotropic = grid.scheme() == kIsotropic;
     const int threads = thread_count(grid.threads());
     std::int64_t visited_cells = 0;
@@ -126,8 +157,11 @@ std::int64_t tiled_sweep(Grid &grid, int levels, double dt, std::vector<LevelSum
         const std::int64_t gi0 = cells.i0 - halo, gj0 = cells.j0 - halo;
         b.width = static_cast<int>(cells.i1 - cells.i0) + 2 * halo;
         b.height = static_cast<int>(cells.j1 - cells.j0) + 2 * halo;
-        gather(grid, b, gi0, gj0, masked, source);
-        const TileLevelFunction kernel = select_tile_kernel(masked, isotropic, source);
+        // The physics kernel reads cell kinds on every tile.
+        gather(grid, b, gi0, gj0, masked || physics, source);
+        if (physics) gather_physics(grid, b, gi0, gj0);
+        const TileLevelFunction kernel =
+            physics ? select_physics_tile_kernel(isotropic, source) : select_tile_kernel(masked, isotropic, source);
         const TileRect tile{halo, b.height - halo, halo, b.width - halo};
         int in = 0;
         for (int s = 1; s <= levels; ++s) {
@@ -142,6 +176,7 @@ std::int64_t tiled_sweep(Grid &grid, int levels, double dt, std::vector<LevelSum
             const int count = tile.c1 - tile.c0;
             std::memcpy(ws.heights.data() + to, b.h[in].data() + from, sizeof(double) * count);
             for (int c = 0; c < count; ++c) ws.residuals[to + c] = static_cast<float>(b.residual[in][from + c]);
+            if (hysteresis) std::memcpy(ws.moving.data() + to, b.moving[in].data() + from, count);
         }
         ws.origin[2 * k] = gi0;
         ws.origin[2 * k + 1] = gj0;
@@ -163,9 +198,11 @@ std::int64_t tiled_sweep(Grid &grid, int levels, double dt, std::vector<LevelSum
     // Write back; when every tile was visited whole the output is the whole grid.
     if (visited_cells == geo.cells()) {
         grid.swap_heights(ws.heights, ws.residuals);
+        if (hysteresis) grid.moving_for_stepping().swap(ws.moving);
     } else {
         std::vector<double> &h = grid.heights_for_stepping();
         std::vector<float> &res = grid.residuals_for_stepping();
+        std::vector<std::uint8_t> &moving = grid.moving_for_stepping();
 #if defined(_OPENMP)
 #pragma omp parallel for num_threads(threads) schedule(static) if (parallel)
 #endif
@@ -176,6 +213,7 @@ std::int64_t tiled_sweep(Grid &grid, int levels, double dt, std::vector<LevelSum
                 const std::size_t count = static_cast<std::size_t>(cells.i1 - cells.i0);
                 std::memcpy(h.data() + at, ws.heights.data() + at, sizeof(double) * count);
                 std::memcpy(res.data() + at, ws.residuals.data() + at, sizeof(float) * count);
+                if (hysteresis) std::memcpy(moving.data() + at, ws.moving.data() + at, count);
             }
         }
     }
@@ -190,6 +228,7 @@ std::int64_t tiled_sweep(Grid &grid, int levels, double dt, std::vector<LevelSum
             LevelSummary &sum = summaries[static_cast<std::size_t>(s)];
             sum.moved = sum.moved || st.moved;
             sum.outflow_rate += st.outflow_rate;
+            sum.unmet_mass += st.unmet_mass;
             sum.max_excess = std::max(sum.max_excess, st.max_excess);
             if (st.hot_r0 < st.hot_r1)
                 moved.add(ws.origin[2 * k] + st.hot_c0 - 1, ws.origin[2 * k] + st.hot_c1 + 1,

@@ -19,12 +19,14 @@ struct LevelSummary {
     bool moved = false;         // some face carried sand in this sub-step
     double outflow_rate = 0.0;  // mass per unit time into sinks
     double max_excess = 0.0;    // largest |grad h| - tan(theta) over faces that carried sand
+    double unmet_mass = 0.0;    // erosion asked for where no sand lay above the bed
 };
 
 // Scratch of the 2D sweep, kept by the grid between steps.
 struct TiledWorkspace {
     std::vector<double> heights;     // the new heights of visited tiles
     std::vector<float> residuals;
+    std::vector<std::uint8_t> moving;  // the new moving cells (hysteresis)
     std::vector<TileBuffers> buffers;  // one per thread
     std::vector<std::int64_t> visit;
     std::vector<CellBox> boxes;         // per visited tile: the cells that can change

@@ -984,13 +984,15 @@ static void test_status_string(void **state) {
                  {DPSM_ERR_NOT_APPLICABLE, "DPSM_ERR_NOT_APPLICABLE"},
                  {DPSM_ERR_WORK_LIMIT, "DPSM_ERR_WORK_LIMIT"},
                  {DPSM_ERR_OUT_OF_MEMORY, "DPSM_ERR_OUT_OF_MEMORY"},
-                 {DPSM_ERR_INTERNAL, "DPSM_ERR_INTERNAL"}};
+                 {DPSM_ERR_INTERNAL, "DPSM_ERR_INTERNAL"},
+                 {DPSM_ERR_IO, "DPSM_ERR_IO"},
+                 {DPSM_ERR_BAD_FILE, "DPSM_ERR_BAD_FILE"}};
     for (size_t k = 0; k < sizeof known / sizeof *known; ++k) {
         const char *s = dpsm_status_string(known[k].code);
         assert_non_null(s);
         assert_string_equal(s, known[k].name);
     }
-    const int unknown[] = {-1, 9, 12345, INT_MIN, INT_MAX, 100};
+    const int unknown[] = {-1, 11, 12345, INT_MIN, INT_MAX, 100};
     for (size_t k = 0; k < sizeof unknown / sizeof *unknown; ++k) {
         const char *s = dpsm_status_string(unknown[k]);
         assert_non_null(s);
@@ -1863,10 +1865,10 @@ static void test_bad_step(void **state) {
 static void test_bad_get_mass(void **state) {
     fixture_t *fx = *state;
     double v = 0.0;
-    const int bad[] = {-1, 4, 5, 255, INT_MAX, INT_MIN};
+    const int bad[] = {-1, 5, 6, 255, INT_MAX, INT_MIN};
     for (size_t k = 0; k < sizeof bad / sizeof *bad; ++k)
         EXPECT_FAIL(fx, dpsm_get_mass(fx->g, bad[k], &v), DPSM_ERR_UNKNOWN_ENUM, "dpsm_get_mass", "quantity");
-    for (int q = DPSM_MASS_TOTAL; q <= DPSM_MASS_OUTFLOW; ++q)
+    for (int q = DPSM_MASS_TOTAL; q <= DPSM_MASS_UNMET; ++q)
         EXPECT_FAIL(fx, dpsm_get_mass(fx->g, q, NULL), DPSM_ERR_NULL_POINTER, "dpsm_get_mass", "value");
 }
 

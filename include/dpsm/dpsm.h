@@ -75,6 +75,11 @@ typedef struct dpsm_grid dpsm_grid;
 #define DPSM_ERR_OUT_OF_MEMORY 7
 /** An internal error; please report it. */
 #define DPSM_ERR_INTERNAL 8
+/** A file could not be opened, read or written (dpsm_save(), dpsm_load()). */
+#define DPSM_ERR_IO 9
+/** A file is not a complete, intact dpsm restart file of a version this
+ *  library reads: truncated, corrupted (checksum mismatch), or of another format. */
+#define DPSM_ERR_BAD_FILE 10
 /** @} */
 
 /** @name Sides of the domain
@@ -124,7 +129,9 @@ typedef struct dpsm_grid dpsm_grid;
 /** @name Mass quantities
  *  For dpsm_get_mass(). Mass is `sum h*dx` in 1D and `sum h*dx*dy` in 2D over
  *  sand cells (unit density). After any sequence of calls,
- *  `TOTAL == SOURCED + EXTERNAL - OUTFLOW` to round-off. @{ */
+ *  `TOTAL == SOURCED + EXTERNAL - OUTFLOW` to round-off. Heights count from
+ *  the same datum as a bed (dpsm_set_bedrock()), so the sand above a bed is
+ *  `TOTAL - sum zb*dx*dy`. @{ */
 /** The mass on the grid now. */
 #define DPSM_MASS_TOTAL 0
 /** Net mass added by sources (negative where erosion dominated). */
@@ -134,6 +141,11 @@ typedef struct dpsm_grid dpsm_grid;
 #define DPSM_MASS_EXTERNAL 2
 /** Net mass that left through open sides and open cells. */
 #define DPSM_MASS_OUTFLOW 3
+/** Erosion that found no sand above the bed (see dpsm_set_bedrock()) and was
+ *  therefore not applied: the mass a host should give back to its flow. Never
+ *  negative. ::DPSM_MASS_SOURCED counts only what was applied, so the source
+ *  the host asked for is `SOURCED - UNMET`. */
+#define DPSM_MASS_UNMET 4
 /** @} */
 
 /** @name Step information
@@ -165,6 +177,10 @@ typedef struct dpsm_grid dpsm_grid;
 #define DPSM_DEFAULT_REST_TOLERANCE 1e-6
 /** The default limit on sub-steps per dpsm_step() of a driven scene; see dpsm_set_max_substeps(). */
 #define DPSM_DEFAULT_MAX_SUBSTEPS 10000000
+/** The default flux exponent: the paper's law, linear in the excess slope; see dpsm_set_flux_exponent(). */
+#define DPSM_DEFAULT_FLUX_EXPONENT 1.0
+/** The largest flux exponent accepted by dpsm_set_flux_exponent(). */
+#define DPSM_MAX_FLUX_EXPONENT 2.0
 
 /**
  * @brief Creates a 1D grid of `nx` cells of width `dx`.
@@ -405,7 +421,7 @@ DPSM_API int dpsm_step(dpsm_grid *g, double dt);
  * @brief Reads one figure of the mass ledger.
  * @param g         the grid.
  * @param quantity  ::DPSM_MASS_TOTAL, ::DPSM_MASS_SOURCED,
- *                  ::DPSM_MASS_EXTERNAL or ::DPSM_MASS_OUTFLOW.
+ *                  ::DPSM_MASS_EXTERNAL, ::DPSM_MASS_OUTFLOW or ::DPSM_MASS_UNMET.
  * @param value     receives the figure.
  * @return ::DPSM_OK, ::DPSM_ERR_NULL_POINTER or ::DPSM_ERR_UNKNOWN_ENUM.
  */
@@ -473,6 +489,90 @@ DPSM_API int dpsm_set_max_substeps(dpsm_grid *g, int64_t n);
  * @return ::DPSM_OK, ::DPSM_ERR_NULL_POINTER or ::DPSM_ERR_INVALID_VALUE.
  */
 DPSM_API int dpsm_set_threads(dpsm_grid *g, int n);
+
+/** @name Physics for real scenes
+ *  A bed that cannot erode, angles that vary, other flow laws and
+ *  hysteresis. Each costs nothing when a scene does not use it; a scene that
+ *  uses any of them is stepped by a plain (not vectorised) kernel. @{ */
+
+/**
+ * @brief Sets a non-erodible bed `zb` under the sand, or removes it.
+ *
+ * Sand above the bed moves as usual; the surface never goes below it. A face
+ * takes from its upstream cell at most a quarter (a half in 1D) of the sand
+ * that cell holds above its bed in a sub-step, after that cell's own erosion,
+ * so the exchanges of a cell together take at most the sand that is there.
+ * A negative source erodes only the sand there is: what it asked for beyond
+ * that is not applied and is counted as ::DPSM_MASS_UNMET. A bare bed steeper
+ * than the angle of repose does not move and is at rest.
+ *
+ * While a bed is set, dpsm_set_heights(), dpsm_set_heights_region() and
+ * dpsm_add_heights_region() refuse heights below it (any cell kind).
+ *
+ * @param g   the grid.
+ * @param zb  `nx*ny` finite values within the supported range, each at or
+ *            below the current height of its cell; NULL removes the bed.
+ * @return ::DPSM_OK, ::DPSM_ERR_NULL_POINTER or ::DPSM_ERR_INVALID_VALUE (a
+ *         value not finite, outside the range, or above its cell's height).
+ */
+DPSM_API int dpsm_set_bedrock(dpsm_grid *g, const double *zb);
+
+/**
+ * @brief Sets an angle of repose per cell, or returns to the uniform angle of
+ *        dpsm_set_repose_angle().
+ *
+ * For wet and dry sand, vegetated patches. A face between two sand cells uses
+ * the mean of their two `tan(theta)`; a face between a sand cell and a wall,
+ * an open cell or the outside uses the sand cell's. The stable sub-step
+ * (dpsm_stable_dt()) follows the smallest angle.
+ *
+ * @param g              the grid.
+ * @param theta_radians  `nx*ny` angles, each strictly between 0 and pi/2;
+ *                       NULL returns to the uniform angle.
+ * @return ::DPSM_OK, ::DPSM_ERR_NULL_POINTER or ::DPSM_ERR_INVALID_VALUE.
+ */
+DPSM_API int dpsm_set_repose_angle_field(dpsm_grid *g, const double *theta_radians);
+
+/**
+ * @brief Sets the exponent `p` of the flux law: sand moves at
+ *        `nu * (|grad h| - tan(theta))_+^p / sqrt(1 + |grad h|^2)`.
+ *
+ * `p = 1` (::DPSM_DEFAULT_FLUX_EXPONENT) is the paper's law; `p = 2` the
+ * Bingham closure the paper names, `1 + 1/n` a Herschel-Bulkley fluid of index
+ * `n >= 1`. Rest states are the same (slopes at the angle of repose); a larger
+ * `p` moves slightly supercritical slopes more slowly (the excess decays like a
+ * power of time instead of exponentially) and very steep ones faster.
+ * Exponents above ::DPSM_MAX_FLUX_EXPONENT are refused: the law's largest
+ * slope, which sets the stable sub-step, would grow without bound with the
+ * slope. dpsm_stable_dt() follows the law.
+ *
+ * @param g  the grid.
+ * @param p  within [1, ::DPSM_MAX_FLUX_EXPONENT].
+ * @return ::DPSM_OK, ::DPSM_ERR_NULL_POINTER or ::DPSM_ERR_INVALID_VALUE.
+ */
+DPSM_API int dpsm_set_flux_exponent(dpsm_grid *g, double p);
+
+/**
+ * @brief Sets the static angle: sand at rest starts to move only where the
+ *        slope is steeper than it, and once moving stops at the angle of repose.
+ *
+ * As on dune slip faces: a slope between the two angles holds; one steeper
+ * than the static angle avalanches down to the angle of repose. A cell is
+ * moving while one of its faces carried sand in the last sub-step; a face with
+ * a moving cell on either side uses the angle of repose, a face between two
+ * cells at rest the larger of the static angle and the angle of repose. By
+ * default the static angle equals the angle of repose (and follows it), which
+ * is the paper's model. Which cells are moving is part of the state, kept
+ * between steps; setting the static angle puts every cell at rest.
+ *
+ * @param g        the grid.
+ * @param radians  strictly between 0 and pi/2; a value below the angle of
+ *                 repose acts as the angle of repose.
+ * @return ::DPSM_OK, ::DPSM_ERR_NULL_POINTER or ::DPSM_ERR_INVALID_VALUE.
+ */
+DPSM_API int dpsm_set_static_angle(dpsm_grid *g, double radians);
+/** @} */
+
 
 /**
  * @brief The message of the last failed call on `g`, or `""` if its last call

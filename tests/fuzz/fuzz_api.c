@@ -276,7 +276,7 @@ static void compare_twin(slot_t *s, const snap_t *main_snap) {
  * nothing changed. */
 static void check_failed(slot_t *s, const dpsm_grid *g, const snap_t *before, int status, const char *fn) {
     if (status == DPSM_ERR_INTERNAL) die("%s: DPSM_ERR_INTERNAL: %s", fn, dpsm_last_error(g));
-    if (status < 0 || status > DPSM_ERR_INTERNAL) die("%s: unknown status %d", fn, status);
+    if (status < 0 || status > DPSM_ERR_BAD_FILE) die("%s: unknown status %d", fn, status);
     const char *msg = dpsm_last_error(g);
     if (!msg || !*msg) die("%s failed with %s and no message", fn, dpsm_status_string(status));
     if (!strstr(msg, fn)) die("%s failed with the message \"%s\", which does not name it", fn, msg);
@@ -777,7 +777,7 @@ static void op_getters(reader_t *r) {
             const int q = quantities[u8(r) % COUNT(quantities)];
             const int null_out = (b & 0x80) != 0;
             st = dpsm_get_mass(s->g, q, null_out ? NULL : &value);
-            expect_status(st, null_out ? DPSM_ERR_NULL_POINTER : (q >= 0 && q <= 3) ? DPSM_OK : DPSM_ERR_UNKNOWN_ENUM,
+            expect_status(st, null_out ? DPSM_ERR_NULL_POINTER : (q >= 0 && q <= DPSM_MASS_UNMET) ? DPSM_OK : DPSM_ERR_UNKNOWN_ENUM,
                           g_op, s->g);
             break;
         }
