@@ -81,7 +81,7 @@ void step(Grid &grid, double dt) {
         ledger.outflow.add(outflow_rate * sub_dt);
         if (source_active) ledger.sourced.add(grid.source_mass_rate() * sub_dt);
         if (unmet_mass != 0.0) {  // erosion that found no sand above the bed was not applied
-            ledger.sourced.add(-unmet_mass);
+            ledger.sourced.add(unmet_mass);
             ledger.unmet.add(unmet_mass);
         }
         ++info.substeps;
