@@ -573,7 +573,8 @@ DPSM_API int dpsm_set_flux_exponent(dpsm_grid *g, double p);
 DPSM_API int dpsm_set_static_angle(dpsm_grid *g, double radians);
 /** @} */
 
-/** @name Restart files @{ */
+/** @name Restart files
+ *  Saving a grid and continuing it bit for bit (see \ref guide_restart). @{ */
 
 /**
  * @brief Writes everything needed to continue a run bit for bit to a file.
