@@ -5,13 +5,16 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <memory>
 #include <new>
 #include <sstream>
 #include <string>
+#include <utility>
 
 #include "dpsm/dpsm.h"
 #include "error.hpp"
 #include "grid.hpp"
+#include "restart.hpp"
 #include "stepper.hpp"
 
 struct dpsm_grid {
@@ -484,6 +487,31 @@ int dpsm_set_static_angle(dpsm_grid *g, double radians) {
         require_grid(g, fn);
         require_angle(radians, fn, "radians");
         g->core.set_static_angle(radians);
+    });
+}
+
+int dpsm_save(const dpsm_grid *g, const char *path) {
+    const char *fn = "dpsm_save";
+    return guarded(g, fn, [&] {
+        require_grid(g, fn);
+        require_pointer(path, fn, "path");
+        dpsm::save_restart(g->core, path, fn);
+    });
+}
+
+int dpsm_load(const char *path, dpsm_grid **out) {
+    const char *fn = "dpsm_load";
+    if (out) *out = nullptr;
+    return guarded(nullptr, fn, [&] {
+        require_pointer(path, fn, "path");
+        require_pointer(out, fn, "out");
+        dpsm::Geometry geometry{};
+        dpsm::GridState state;
+        dpsm::load_restart(path, geometry, state, fn);
+        // Built completely before it is handed out: a failure leaves *out NULL.
+        auto grid = std::make_unique<dpsm_grid>(geometry);
+        grid->core.restore(std::move(state));
+        *out = grid.release();
     });
 }
 

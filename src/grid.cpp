@@ -1,6 +1,7 @@
 #include "grid.hpp"
 
 #include <cmath>
+#include <utility>
 
 #include "dpsm/dpsm.h"
 #include "tiled_sweep.hpp"
@@ -89,6 +90,45 @@ void Grid::set_cell_kinds(const std::uint8_t *kinds) {
     ledger_.external.add(change.value());
     update_source_summary();
     update_open_levels();
+    if (active_) {
+        active_->refresh_masks(*this);
+        active_->mark_all();
+    }
+}
+
+void Grid::restore(GridState &&s) {
+    repose_angle_ = s.repose_angle;
+    tan_repose_ = std::tan(s.repose_angle);
+    mobility_ = s.mobility;
+    rest_tolerance_ = s.rest_tolerance;
+    max_substeps_ = s.max_substeps;
+    threads_ = s.threads;
+    scheme_ = s.scheme;
+    side_open_ = s.side_open;
+    heights_ = std::move(s.heights);
+    residuals_ = std::move(s.residuals);
+    kinds_ = std::move(s.kinds);
+    source_ = std::move(s.source);
+    bed_ = std::move(s.bed);
+    // The tangents and the smallest angle exactly as the setter computes them.
+    set_angle_field(s.angle_field.empty() ? nullptr : s.angle_field.data());
+    flux_exponent_ = s.flux_exponent;
+    static_angle_ = s.static_angle;
+    tan_static_ = s.static_angle > 0.0 ? std::tan(s.static_angle) : 0.0;
+    moving_ = std::move(s.moving);
+    std::int64_t walls = 0, opens = 0;
+    for (const std::uint8_t k : kinds_) {
+        walls += k == kWall;
+        opens += k == kOpen;
+    }
+    wall_cells_ = walls;
+    open_cells_ = opens;
+    ledger_ = s.ledger;
+    last_step_ = s.last_step;
+    update_source_summary();
+    update_open_levels();
+    // Every tile is looked at again: a sweep over a tile at rest changes
+    // nothing, so the results are those of the saved grid.
     if (active_) {
         active_->refresh_masks(*this);
         active_->mark_all();

@@ -49,6 +49,26 @@ struct StepInfo {
     double cell_updates = 0.0;
 };
 
+// Everything of a grid besides its geometry that later results depend on, as
+// a restart file holds it (restart.cpp); what Grid derives from these fields
+// (tangents, counts, summaries, the active set) is not in it.
+struct GridState {
+    double repose_angle = 0.0, mobility = 0.0, rest_tolerance = 0.0;
+    std::int64_t max_substeps = 0;
+    int threads = 0;
+    Scheme scheme = kPairwise;
+    std::array<bool, 4> side_open{};
+    std::vector<double> heights;
+    std::vector<float> residuals;
+    std::vector<std::uint8_t> kinds;
+    std::vector<double> source, bed, angle_field;  // empty: none
+    double flux_exponent = 1.0;
+    double static_angle = 0.0;          // 0: no hysteresis
+    std::vector<std::uint8_t> moving;   // empty unless static_angle > 0
+    MassLedger ledger;
+    StepInfo last_step;
+};
+
 class Grid {
 public:
     explicit Grid(const Geometry &geometry);
@@ -144,6 +164,10 @@ public:
     void write_heights(const Block &block, const double *values, bool add);
     void read_heights(const Block &block, double *values) const;
     void set_cell_kinds(const std::uint8_t *kinds);   // NULL: all sand; books mass that comes or goes
+    // Takes every field of a checked state read from a restart file, on a
+    // new grid of the same geometry. Unlike the setters it books nothing in
+    // the ledger (the state carries its ledger); it recomputes what is derived.
+    void restore(GridState &&state);
     void set_source(const double *q);                 // NULL: none
 
     // Mass on sand cells now, a compensated sum.

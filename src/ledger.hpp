@@ -11,6 +11,10 @@ namespace dpsm {
 
 class CompensatedSum {
 public:
+    CompensatedSum() = default;
+    // A sum as it was (a restart file keeps both parts, so that later
+    // additions round exactly as they would have).
+    CompensatedSum(double sum, double correction) noexcept : sum_(sum), correction_(correction) {}
     void add(double x) noexcept {
         const double t = sum_ + x;
         if (std::fabs(sum_) >= std::fabs(x))
@@ -20,6 +24,8 @@ public:
         sum_ = t;
     }
     double value() const noexcept { return sum_ + correction_; }
+    double sum() const noexcept { return sum_; }
+    double correction() const noexcept { return correction_; }
 
 private:
     double sum_ = 0.0;

@@ -20,13 +20,15 @@
 !>    axisymmetric grids), real(c_double); cell kinds integer(c_int8_t). Their
 !>    shape is checked against the grid (dpsm_get_shape) before C is called; a
 !>    mismatch fails with DPSM_ERR_INVALID_SIZE and a message naming both shapes.
+!>  - Paths (dpsm_save, dpsm_load) are default character strings; trailing
+!>    blanks are dropped, so a path held in a longer variable may be passed.
 !>  - Every #define constant of dpsm.h is a parameter of the same name.
 !>
 !> tests/fortran/check_module.py fails the test suite when a function declared
 !> with DPSM_API or a constant of dpsm.h has no counterpart here.
 module dpsm
   use, intrinsic :: iso_c_binding, only: c_ptr, c_null_ptr, c_associated, c_f_pointer, c_int, c_int8_t, &
-                                         c_int32_t, c_int64_t, c_double, c_char, c_size_t
+                                         c_int32_t, c_int64_t, c_double, c_char, c_size_t, c_null_char
   implicit none
   private
 
@@ -41,6 +43,8 @@ module dpsm
   integer(c_int), parameter, public :: DPSM_ERR_WORK_LIMIT = 6
   integer(c_int), parameter, public :: DPSM_ERR_OUT_OF_MEMORY = 7
   integer(c_int), parameter, public :: DPSM_ERR_INTERNAL = 8
+  integer(c_int), parameter, public :: DPSM_ERR_IO = 9
+  integer(c_int), parameter, public :: DPSM_ERR_BAD_FILE = 10
   ! Sides of the domain.
   integer(c_int), parameter, public :: DPSM_XMIN = 0
   integer(c_int), parameter, public :: DPSM_XMAX = 1
@@ -61,6 +65,7 @@ module dpsm
   integer(c_int), parameter, public :: DPSM_MASS_SOURCED = 1
   integer(c_int), parameter, public :: DPSM_MASS_EXTERNAL = 2
   integer(c_int), parameter, public :: DPSM_MASS_OUTFLOW = 3
+  integer(c_int), parameter, public :: DPSM_MASS_UNMET = 4
   ! Step information.
   integer(c_int), parameter, public :: DPSM_INFO_SUBSTEPS = 0
   integer(c_int), parameter, public :: DPSM_INFO_TIME_INTEGRATED = 1
@@ -72,6 +77,8 @@ module dpsm
   real(c_double), parameter, public :: DPSM_DEFAULT_MOBILITY = 1.0_c_double
   real(c_double), parameter, public :: DPSM_DEFAULT_REST_TOLERANCE = 1e-6_c_double
   integer(c_int64_t), parameter, public :: DPSM_DEFAULT_MAX_SUBSTEPS = 10000000_c_int64_t
+  real(c_double), parameter, public :: DPSM_DEFAULT_FLUX_EXPONENT = 1.0_c_double
+  real(c_double), parameter, public :: DPSM_MAX_FLUX_EXPONENT = 2.0_c_double
 
   ! The version of the headers this module was built against (dpsm_version.h).
   ! DPSM_VERSION_NUMBER and DPSM_VERSION_STRING are DPSM_HEADER_VERSION_NUMBER
@@ -100,6 +107,8 @@ module dpsm
   public :: dpsm_set_heights_region, dpsm_add_heights_region, dpsm_get_heights_region
   public :: dpsm_set_source, dpsm_stable_dt, dpsm_step, dpsm_get_mass, dpsm_get_step_info
   public :: dpsm_get_shape, dpsm_set_rest_tolerance, dpsm_set_max_substeps, dpsm_set_threads
+  public :: dpsm_set_bedrock, dpsm_set_repose_angle_field, dpsm_set_flux_exponent, dpsm_set_static_angle
+  public :: dpsm_save, dpsm_load
   public :: dpsm_last_error, dpsm_status_string, dpsm_version_string, dpsm_version_number
   ! Not in C: .true. when g holds a grid (its handle is not NULL).
   public :: dpsm_associated
@@ -137,6 +146,12 @@ module dpsm
   interface dpsm_set_source
     module procedure set_source_r1, set_source_r2, set_source_none
   end interface dpsm_set_source
+  interface dpsm_set_bedrock
+    module procedure set_bedrock_r1, set_bedrock_r2, set_bedrock_none
+  end interface dpsm_set_bedrock
+  interface dpsm_set_repose_angle_field
+    module procedure set_repose_angle_field_r1, set_repose_angle_field_r2, set_repose_angle_field_none
+  end interface dpsm_set_repose_angle_field
   interface dpsm_get_shape
     module procedure get_shape_i64, get_shape_i32
   end interface dpsm_get_shape
@@ -290,6 +305,43 @@ module dpsm
       type(c_ptr), value :: g
       integer(c_int), value :: n
     end function c_dpsm_set_threads
+
+    integer(c_int) function c_dpsm_set_bedrock(g, zb) bind(C, name='dpsm_set_bedrock')
+      import :: c_int, c_double, c_ptr
+      type(c_ptr), value :: g
+      real(c_double), intent(in), optional :: zb(*) ! absent: NULL
+    end function c_dpsm_set_bedrock
+
+    integer(c_int) function c_dpsm_set_repose_angle_field(g, theta_radians) &
+        bind(C, name='dpsm_set_repose_angle_field')
+      import :: c_int, c_double, c_ptr
+      type(c_ptr), value :: g
+      real(c_double), intent(in), optional :: theta_radians(*) ! absent: NULL
+    end function c_dpsm_set_repose_angle_field
+
+    integer(c_int) function c_dpsm_set_flux_exponent(g, p) bind(C, name='dpsm_set_flux_exponent')
+      import :: c_int, c_double, c_ptr
+      type(c_ptr), value :: g
+      real(c_double), value :: p
+    end function c_dpsm_set_flux_exponent
+
+    integer(c_int) function c_dpsm_set_static_angle(g, radians) bind(C, name='dpsm_set_static_angle')
+      import :: c_int, c_double, c_ptr
+      type(c_ptr), value :: g
+      real(c_double), value :: radians
+    end function c_dpsm_set_static_angle
+
+    integer(c_int) function c_dpsm_save(g, path) bind(C, name='dpsm_save')
+      import :: c_int, c_char, c_ptr
+      type(c_ptr), value :: g
+      character(kind=c_char), intent(in) :: path(*) ! NUL-terminated
+    end function c_dpsm_save
+
+    integer(c_int) function c_dpsm_load(path, out) bind(C, name='dpsm_load')
+      import :: c_int, c_char, c_ptr
+      character(kind=c_char), intent(in) :: path(*) ! NUL-terminated
+      type(c_ptr), intent(out) :: out
+    end function c_dpsm_load
 
     type(c_ptr) function c_dpsm_last_error(g) bind(C, name='dpsm_last_error')
       import :: c_ptr
@@ -874,7 +926,7 @@ contains
 
   ! ==== reading back =========================================================
 
-  !> dpsm_get_mass(g, quantity, value[, ierr]): DPSM_MASS_TOTAL, _SOURCED, _EXTERNAL or _OUTFLOW.
+  !> dpsm_get_mass(g, quantity, value[, ierr]): DPSM_MASS_TOTAL, _SOURCED, _EXTERNAL, _OUTFLOW or _UNMET.
   subroutine dpsm_get_mass(g, quantity, value, ierr)
     type(dpsm_grid), intent(in) :: g
     integer(c_int), intent(in) :: quantity
@@ -925,6 +977,121 @@ contains
     end if
     call finish(status, ierr, 'dpsm_get_shape', g)
   end subroutine get_shape_i32
+
+  ! ==== physics for real scenes =============================================
+
+  !> dpsm_set_bedrock(g, zb[, ierr]): zb(nx, ny) or zb(nx*ny), a bed the sand
+  !> cannot erode, each value at or below its cell's height; without zb no bed.
+  subroutine set_bedrock_r1(g, zb, ierr)
+    type(dpsm_grid), intent(in) :: g
+    real(c_double), intent(in), contiguous :: zb(:)
+    integer, intent(out), optional :: ierr
+    integer(c_int) :: status
+    call clear_message(g)
+    status = check_grid_shape(g, 'dpsm_set_bedrock', 'zb', shape(zb))
+    if (status == DPSM_OK) status = c_dpsm_set_bedrock(g%ptr, zb)
+    call finish(status, ierr, 'dpsm_set_bedrock', g)
+  end subroutine set_bedrock_r1
+
+  subroutine set_bedrock_r2(g, zb, ierr)
+    type(dpsm_grid), intent(in) :: g
+    real(c_double), intent(in), contiguous :: zb(:, :)
+    integer, intent(out), optional :: ierr
+    integer(c_int) :: status
+    call clear_message(g)
+    status = check_grid_shape(g, 'dpsm_set_bedrock', 'zb', shape(zb))
+    if (status == DPSM_OK) status = c_dpsm_set_bedrock(g%ptr, zb)
+    call finish(status, ierr, 'dpsm_set_bedrock', g)
+  end subroutine set_bedrock_r2
+
+  subroutine set_bedrock_none(g, ierr)
+    type(dpsm_grid), intent(in) :: g
+    integer, intent(out), optional :: ierr
+    call clear_message(g)
+    call finish(c_dpsm_set_bedrock(g%ptr), ierr, 'dpsm_set_bedrock', g)
+  end subroutine set_bedrock_none
+
+  !> dpsm_set_repose_angle_field(g, theta_radians[, ierr]): an angle of repose
+  !> per cell, theta_radians(nx, ny) or (nx*ny); without it the uniform angle.
+  subroutine set_repose_angle_field_r1(g, theta_radians, ierr)
+    type(dpsm_grid), intent(in) :: g
+    real(c_double), intent(in), contiguous :: theta_radians(:)
+    integer, intent(out), optional :: ierr
+    integer(c_int) :: status
+    call clear_message(g)
+    status = check_grid_shape(g, 'dpsm_set_repose_angle_field', 'theta_radians', shape(theta_radians))
+    if (status == DPSM_OK) status = c_dpsm_set_repose_angle_field(g%ptr, theta_radians)
+    call finish(status, ierr, 'dpsm_set_repose_angle_field', g)
+  end subroutine set_repose_angle_field_r1
+
+  subroutine set_repose_angle_field_r2(g, theta_radians, ierr)
+    type(dpsm_grid), intent(in) :: g
+    real(c_double), intent(in), contiguous :: theta_radians(:, :)
+    integer, intent(out), optional :: ierr
+    integer(c_int) :: status
+    call clear_message(g)
+    status = check_grid_shape(g, 'dpsm_set_repose_angle_field', 'theta_radians', shape(theta_radians))
+    if (status == DPSM_OK) status = c_dpsm_set_repose_angle_field(g%ptr, theta_radians)
+    call finish(status, ierr, 'dpsm_set_repose_angle_field', g)
+  end subroutine set_repose_angle_field_r2
+
+  subroutine set_repose_angle_field_none(g, ierr)
+    type(dpsm_grid), intent(in) :: g
+    integer, intent(out), optional :: ierr
+    call clear_message(g)
+    call finish(c_dpsm_set_repose_angle_field(g%ptr), ierr, 'dpsm_set_repose_angle_field', g)
+  end subroutine set_repose_angle_field_none
+
+  !> dpsm_set_flux_exponent(g, p[, ierr]): p within [1, DPSM_MAX_FLUX_EXPONENT].
+  subroutine dpsm_set_flux_exponent(g, p, ierr)
+    type(dpsm_grid), intent(in) :: g
+    real(c_double), intent(in) :: p
+    integer, intent(out), optional :: ierr
+    call clear_message(g)
+    call finish(c_dpsm_set_flux_exponent(g%ptr, p), ierr, 'dpsm_set_flux_exponent', g)
+  end subroutine dpsm_set_flux_exponent
+
+  !> dpsm_set_static_angle(g, radians[, ierr]): the angle at which sand at rest starts to move.
+  subroutine dpsm_set_static_angle(g, radians, ierr)
+    type(dpsm_grid), intent(in) :: g
+    real(c_double), intent(in) :: radians
+    integer, intent(out), optional :: ierr
+    call clear_message(g)
+    call finish(c_dpsm_set_static_angle(g%ptr, radians), ierr, 'dpsm_set_static_angle', g)
+  end subroutine dpsm_set_static_angle
+
+  ! ==== restart files ========================================================
+
+  !> A path as C wants it: without trailing blanks, NUL-terminated.
+  function c_path(path) result(s)
+    character(len=*), intent(in) :: path
+    character(kind=c_char, len=:), allocatable :: s
+    s = trim(path)//c_null_char
+  end function c_path
+
+  !> dpsm_save(g, path[, ierr]): writes everything needed to continue the run
+  !> bit for bit to the file path (through path//'.tmp').
+  subroutine dpsm_save(g, path, ierr)
+    type(dpsm_grid), intent(in) :: g
+    character(len=*), intent(in) :: path
+    integer, intent(out), optional :: ierr
+    call clear_message(g)
+    call finish(c_dpsm_save(g%ptr, c_path(path)), ierr, 'dpsm_save', g)
+  end subroutine dpsm_save
+
+  !> dpsm_load(g, path[, ierr]): a new grid in g from a file written by
+  !> dpsm_save (release it with dpsm_destroy). On failure g holds no grid and
+  !> the message is dpsm_last_error() (without a grid), as for a failed create.
+  subroutine dpsm_load(g, path, ierr)
+    type(dpsm_grid), intent(out) :: g
+    character(len=*), intent(in) :: path
+    integer, intent(out), optional :: ierr
+    type(c_ptr) :: ptr
+    integer(c_int) :: status
+    status = c_dpsm_load(c_path(path), ptr)
+    call adopt(g, ptr, status)
+    call finish(status, ierr, 'dpsm_load')
+  end subroutine dpsm_load
 
   ! ==== messages and versions ================================================
 

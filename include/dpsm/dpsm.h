@@ -573,6 +573,43 @@ DPSM_API int dpsm_set_flux_exponent(dpsm_grid *g, double p);
 DPSM_API int dpsm_set_static_angle(dpsm_grid *g, double radians);
 /** @} */
 
+/** @name Restart files
+ *  Saving a grid and continuing it bit for bit (see \ref guide_restart). @{ */
+
+/**
+ * @brief Writes everything needed to continue a run bit for bit to a file.
+ *
+ * Geometry, parameters, sides, cell kinds, bed, angle field, source, heights
+ * (with the rounding each cell carries), which cells are moving, the mass
+ * ledger and the last step's information. The format is versioned, portable
+ * (little-endian, IEEE doubles, independent of the machine) and ends with a
+ * CRC-32 checksum. The file is written to `path` through a temporary file
+ * that replaces it only when complete.
+ *
+ * @param g     the grid.
+ * @param path  the file to write.
+ * @return ::DPSM_OK, ::DPSM_ERR_NULL_POINTER or ::DPSM_ERR_IO (the message
+ *         names the path and the system's reason).
+ */
+DPSM_API int dpsm_save(const dpsm_grid *g, const char *path);
+
+/**
+ * @brief Reads a file written by dpsm_save() into a new grid.
+ *
+ * The new grid continues exactly as the saved one would have: the same calls
+ * give bit-identical heights and ledger. A file that is truncated, corrupted
+ * (any byte changed), of another format or of a newer version is refused with
+ * a message that says which; no grid is made.
+ *
+ * @param path  the file to read.
+ * @param out   receives the new grid, or NULL on failure.
+ * @return ::DPSM_OK, ::DPSM_ERR_NULL_POINTER, ::DPSM_ERR_IO,
+ *         ::DPSM_ERR_BAD_FILE or ::DPSM_ERR_OUT_OF_MEMORY. On failure the
+ *         message is read with `dpsm_last_error(NULL)`.
+ */
+DPSM_API int dpsm_load(const char *path, dpsm_grid **out);
+/** @} */
+
 
 /**
  * @brief The message of the last failed call on `g`, or `""` if its last call

@@ -20,6 +20,8 @@ program test_fortran
   call test_open_sides()
   call test_1d()
   call test_axisymmetric()
+  call test_physics()
+  call test_restart()
   call test_destroyed()
 
   if (failures > 0) then
@@ -75,6 +77,8 @@ contains
     call expect(dpsm_status_string(DPSM_ERR_WORK_LIMIT) == 'DPSM_ERR_WORK_LIMIT', 'status WORK_LIMIT')
     call expect(dpsm_status_string(DPSM_ERR_OUT_OF_MEMORY) == 'DPSM_ERR_OUT_OF_MEMORY', 'status OUT_OF_MEMORY')
     call expect(dpsm_status_string(DPSM_ERR_INTERNAL) == 'DPSM_ERR_INTERNAL', 'status INTERNAL')
+    call expect(dpsm_status_string(DPSM_ERR_IO) == 'DPSM_ERR_IO', 'status IO')
+    call expect(dpsm_status_string(DPSM_ERR_BAD_FILE) == 'DPSM_ERR_BAD_FILE', 'status BAD_FILE')
     call expect(dpsm_status_string(12345_c_int) == 'unknown status', 'dpsm_status_string(12345)')
   end subroutine test_versions_and_status
 
@@ -434,6 +438,144 @@ contains
     call expect_ledger(g, 'axisymmetric')
     call dpsm_destroy(g)
   end subroutine test_axisymmetric
+
+  !> The physics of real scenes: a bed, an angle field, the flux exponent and
+  !> the static angle, with good and bad arguments.
+  subroutine test_physics()
+    integer, parameter :: nx = 12, ny = 10
+    type(dpsm_grid) :: g
+    real(c_double) :: h(nx, ny), zb(nx, ny), theta(nx, ny), q(nx, ny), wrong(ny, nx), h2(nx, ny)
+    real(c_double) :: unmet
+    integer :: ierr
+    call dpsm_create_2d(g, nx, ny, 0.1_c_double, 0.1_c_double)
+    h = 1
+    h(4:8, 4:7) = 2
+    call dpsm_set_heights(g, h)
+
+    zb = h - 0.01_c_double
+    call dpsm_set_bedrock(g, zb, ierr)
+    call expect(ierr == DPSM_OK, 'dpsm_set_bedrock(zb(nx, ny))')
+    call dpsm_set_bedrock(g, reshape(zb, [nx*ny]), ierr)
+    call expect(ierr == DPSM_OK, 'dpsm_set_bedrock(zb(nx*ny))')
+    zb(2, 3) = h(2, 3) + 1
+    call dpsm_set_bedrock(g, zb, ierr)
+    call expect(ierr == DPSM_ERR_INVALID_VALUE, 'dpsm_set_bedrock above a height fails with INVALID_VALUE')
+    call expect(index(dpsm_last_error(g), 'zb[') > 0, 'the message names the cell: '//dpsm_last_error(g))
+    wrong = 0
+    call dpsm_set_bedrock(g, wrong, ierr)
+    call expect(ierr == DPSM_ERR_INVALID_SIZE, 'dpsm_set_bedrock(zb(ny, nx)) fails with INVALID_SIZE')
+    h2 = h - 1
+    call dpsm_set_heights(g, h2, ierr)
+    call expect(ierr == DPSM_ERR_INVALID_VALUE, 'heights below the bed are refused')
+
+    theta = 0.5_c_double
+    theta(1:6, :) = 0.6_c_double
+    call dpsm_set_repose_angle_field(g, theta, ierr)
+    call expect(ierr == DPSM_OK, 'dpsm_set_repose_angle_field(theta(nx, ny))')
+    call dpsm_set_repose_angle_field(g, reshape(theta, [nx*ny]), ierr)
+    call expect(ierr == DPSM_OK, 'dpsm_set_repose_angle_field(theta(nx*ny))')
+    theta(3, 3) = 2
+    call dpsm_set_repose_angle_field(g, theta, ierr)
+    call expect(ierr == DPSM_ERR_INVALID_VALUE, 'dpsm_set_repose_angle_field with 2 radians fails')
+    call dpsm_set_repose_angle_field(g, theta(1:nx, 1:ny - 1), ierr)
+    call expect(ierr == DPSM_ERR_INVALID_SIZE, 'dpsm_set_repose_angle_field(theta(nx, ny-1)) fails')
+
+    call dpsm_set_flux_exponent(g, DPSM_MAX_FLUX_EXPONENT + 0.5_c_double, ierr)
+    call expect(ierr == DPSM_ERR_INVALID_VALUE, 'dpsm_set_flux_exponent above the maximum fails')
+    call dpsm_set_flux_exponent(g, 0.5_c_double, ierr)
+    call expect(ierr == DPSM_ERR_INVALID_VALUE, 'dpsm_set_flux_exponent(0.5) fails')
+    call dpsm_set_flux_exponent(g, DPSM_DEFAULT_FLUX_EXPONENT, ierr)
+    call expect(ierr == DPSM_OK, 'dpsm_set_flux_exponent(DPSM_DEFAULT_FLUX_EXPONENT)')
+    call dpsm_set_flux_exponent(g, 1.5_c_double, ierr)
+    call expect(ierr == DPSM_OK, 'dpsm_set_flux_exponent(1.5)')
+    call dpsm_set_static_angle(g, 2.0_c_double, ierr)
+    call expect(ierr == DPSM_ERR_INVALID_VALUE, 'dpsm_set_static_angle(2) fails')
+    call dpsm_set_static_angle(g, 0.65_c_double, ierr)
+    call expect(ierr == DPSM_OK, 'dpsm_set_static_angle(0.65)')
+
+    ! Erosion on a thin layer over the bed: what finds no sand is UNMET.
+    q = -1
+    call dpsm_set_source(g, q)
+    call dpsm_step(g, 0.1_c_double, ierr)
+    call expect(ierr == DPSM_OK, 'dpsm_step with every physics feature')
+    call dpsm_get_mass(g, DPSM_MASS_UNMET, unmet, ierr)
+    call expect(ierr == DPSM_OK .and. unmet > 0, 'DPSM_MASS_UNMET counts erosion that found no sand')
+    call expect(unmet <= 0.1_c_double*nx*ny*0.01_c_double, 'UNMET is at most the erosion asked for')
+    call dpsm_get_heights(g, h2)
+    call expect(all(h2 >= h - 0.01_c_double), 'the surface never goes below the bed')
+
+    call dpsm_set_bedrock(g, ierr=ierr)
+    call expect(ierr == DPSM_OK, 'dpsm_set_bedrock without zb removes the bed')
+    call dpsm_set_repose_angle_field(g, ierr=ierr)
+    call expect(ierr == DPSM_OK, 'dpsm_set_repose_angle_field without theta returns to the uniform angle')
+    call dpsm_destroy(g)
+  end subroutine test_physics
+
+  !> Restart files: a saved and loaded grid continues bit for bit; missing,
+  !> unwritable and damaged files fail with IO or BAD_FILE and no grid.
+  subroutine test_restart()
+    integer, parameter :: nx = 16, ny = 12
+    character(len=*), parameter :: path = 'test_fortran_restart.dpsm'
+    character(len=64) :: padded
+    type(dpsm_grid) :: g, loaded
+    real(c_double) :: h(nx, ny), h2(nx, ny), q(nx, ny), a, b
+    integer :: ierr, i, j, unit, quantity
+    logical :: same
+    call dpsm_create_2d(g, nx, ny, 0.1_c_double, 0.1_c_double)
+    do j = 1, ny
+      do i = 1, nx
+        h(i, j) = max(0.0_c_double, 1.2_c_double - 2*hypot((i - 8)*0.1_c_double, (j - 6)*0.1_c_double))
+      end do
+    end do
+    call dpsm_set_heights(g, h)
+    call dpsm_set_boundary(g, DPSM_XMAX, DPSM_OPEN)
+    q = 0.01_c_double
+    call dpsm_set_source(g, q)
+    call dpsm_set_static_angle(g, 0.6_c_double)
+    call dpsm_step(g, 0.05_c_double)
+
+    padded = path ! trailing blanks are dropped
+    call dpsm_save(g, padded, ierr)
+    call expect(ierr == DPSM_OK, 'dpsm_save: '//dpsm_last_error(g))
+    call dpsm_load(loaded, path, ierr)
+    call expect(ierr == DPSM_OK .and. dpsm_associated(loaded), 'dpsm_load: '//dpsm_last_error())
+    do i = 1, 3
+      call dpsm_step(g, 0.05_c_double)
+      call dpsm_step(loaded, 0.05_c_double)
+    end do
+    call dpsm_get_heights(g, h)
+    call dpsm_get_heights(loaded, h2)
+    call expect(all(h == h2), 'the loaded grid continues with the same heights')
+    same = .true.
+    do quantity = DPSM_MASS_TOTAL, DPSM_MASS_UNMET
+      call dpsm_get_mass(g, quantity, a)
+      call dpsm_get_mass(loaded, quantity, b)
+      same = same .and. a == b
+    end do
+    call expect(same, 'and the same ledger')
+    call dpsm_destroy(loaded)
+
+    call dpsm_load(loaded, 'no-such-file.dpsm', ierr)
+    call expect(ierr == DPSM_ERR_IO .and. .not. dpsm_associated(loaded), 'dpsm_load of a missing file fails with IO')
+    call expect(index(dpsm_last_error(), 'no-such-file.dpsm') > 0, 'the message names the file: '//dpsm_last_error())
+    call dpsm_save(g, '/nonexistent-dir/x', ierr)
+    call expect(ierr == DPSM_ERR_IO, 'dpsm_save into a missing directory fails with IO')
+    call expect(index(dpsm_last_error(g), '/nonexistent-dir/x') > 0, 'the message names the path')
+    call dpsm_save(loaded, path, ierr)
+    call expect(ierr == DPSM_ERR_NULL_POINTER, 'dpsm_save of no grid fails with NULL_POINTER')
+
+    ! Not a restart file.
+    open (newunit=unit, file=path, access='stream', form='unformatted', status='replace')
+    write (unit) 'not a restart file'
+    close (unit)
+    call dpsm_load(loaded, path, ierr)
+    call expect(ierr == DPSM_ERR_BAD_FILE .and. .not. dpsm_associated(loaded), &
+                'dpsm_load of another file fails with BAD_FILE')
+    call expect(index(dpsm_last_error(), 'not a dpsm restart file') > 0, 'and says so: '//dpsm_last_error())
+    open (newunit=unit, file=path, status='old')
+    close (unit, status='delete')
+    call dpsm_destroy(g)
+  end subroutine test_restart
 
   subroutine test_destroyed()
     type(dpsm_grid) :: g, empty

@@ -19,7 +19,11 @@
  *     figure; the grid and its twin are bit-identical;
  *   - after a step without a source: no new extremum (sand, held levels of
  *     open cells, 0 beyond an open side), held cells unchanged; at rest (and
- *     not driven): no face steeper than tan(theta) (1 + tol).
+ *     not driven): no face steeper than tan(theta) (1 + tol);
+ *   - every fourth operation, when it is a step: the grid saved before it
+ *     (dpsm_save) and loaded (dpsm_load) reads back bit for bit, and after the
+ *     same step matches the grid bit for bit (all but the cell updates, which
+ *     count the work of looking at every tile once more after a load).
  * A violated check prints what it saw and calls abort(), which libFuzzer (or
  * the replay driver, fuzz_replay.c) reports with the input.
  *
@@ -37,6 +41,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include <dpsm/dpsm.h>
 
@@ -665,6 +670,43 @@ static double rest_excess(const slot_t *s, const double *h) {
     return worst;
 }
 
+/* The restart file of this process: one at a time, replaced by each save. */
+static const char *restart_path(void) {
+    static char path[512];
+    if (!path[0]) {
+        const char *dir = getenv("TMPDIR");
+        snprintf(path, sizeof path, "%s/dpsm-fuzz-%ld.dpsm", dir && *dir ? dir : "/tmp", (long)getpid());
+    }
+    return path;
+}
+
+/* The slot's grid through a restart file: it must read back exactly as
+ * `before`, step information included. */
+static dpsm_grid *restart_copy(slot_t *s, const snap_t *before) {
+    const char *path = restart_path();
+    if (dpsm_save(s->g, path) != DPSM_OK) die("dpsm_save(%s) failed: %s", path, dpsm_last_error(s->g));
+    if (*dpsm_last_error(s->g)) die("dpsm_save succeeded but left a message");
+    dpsm_grid *copy = NULL;
+    if (dpsm_load(path, &copy) != DPSM_OK || !copy) die("dpsm_load(%s) failed: %s", path, dpsm_last_error(NULL));
+    snap_t loaded;
+    snap(copy, s, &loaded);
+    same(s, before, &loaded, "a grid loaded from a restart file");
+    unsnap(&loaded);
+    return copy;
+}
+
+/* The loaded grid after the same step as the slot's grid. */
+static void check_restart_continues(slot_t *s, dpsm_grid *copy, double dt, const snap_t *after) {
+    if (dpsm_step(copy, dt) != DPSM_OK) die("the loaded grid's step failed: %s", dpsm_last_error(copy));
+    snap_t stepped;
+    snap(copy, s, &stepped);
+#ifdef DPSM_INFO_CELL_UPDATES
+    stepped.info[DPSM_INFO_CELL_UPDATES] = after->info[DPSM_INFO_CELL_UPDATES];
+#endif
+    same(s, after, &stepped, "a grid loaded from a restart file, after a step");
+    unsnap(&stepped);
+}
+
 static void op_step(reader_t *r) {
     g_op = "dpsm_step";
     slot_t *s = pick_slot(r);
@@ -714,6 +756,7 @@ static void op_step(reader_t *r) {
         lo = fmin(lo, 0.0);
     }
 
+    dpsm_grid *restored = g_opcount % 4 == 1 && want == DPSM_OK ? restart_copy(s, &before) : NULL;
     const int st = dpsm_step(s->g, dt);
     trace("dpsm_step(%g = %g stable steps) on %lld x %lld, %s", dt, dt / before.stable_dt, (long long)s->nx,
           (long long)s->ny, drives ? "driven" : "not driven");
@@ -723,6 +766,7 @@ static void op_step(reader_t *r) {
         if (st == DPSM_ERR_WORK_LIMIT && !strstr(dpsm_last_error(s->g), "dpsm_set_max_substeps"))
             die("the work-limit message does not say how to raise the limit: %s", dpsm_last_error(s->g));
         check_failed(s, s->g, &before, st, g_op);
+        dpsm_destroy(restored);
         unsnap(&before);
         return;
     }
@@ -757,6 +801,10 @@ static void op_step(reader_t *r) {
         die("TIME_INTEGRATED = %.17g, dt = %.17g, not at rest", after.info[DPSM_INFO_TIME_INTEGRATED], dt);
     if (!(after.info[DPSM_INFO_MAX_EXCESS_SLOPE] >= 0.0)) die("MAX_EXCESS_SLOPE = %g", after.info[DPSM_INFO_MAX_EXCESS_SLOPE]);
     compare_twin(s, &after);
+    if (restored) {
+        check_restart_continues(s, restored, dt, &after);
+        dpsm_destroy(restored);
+    }
     unsnap(&after);
     unsnap(&before);
 }
@@ -915,5 +963,6 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
     }
     for (int k = 0; k < NSLOTS; ++k)
         if (g_slots[k].g) destroy_slot(&g_slots[k]);
+    remove(restart_path());
     return 0;
 }

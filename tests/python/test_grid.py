@@ -6,7 +6,11 @@ runs it both ways. test_coverage.py checks that every C function is called here.
 
 import array
 import math
+import os
+import pathlib
+import tempfile
 import unittest
+import zlib
 
 import dpsm
 
@@ -53,7 +57,8 @@ class TestModule(LedgerMixin, unittest.TestCase):
 
     def test_status_string(self):
         names = ["OK", "ERR_NULL_POINTER", "ERR_INVALID_VALUE", "ERR_INVALID_SIZE", "ERR_UNKNOWN_ENUM",
-                 "ERR_NOT_APPLICABLE", "ERR_WORK_LIMIT", "ERR_OUT_OF_MEMORY", "ERR_INTERNAL"]
+                 "ERR_NOT_APPLICABLE", "ERR_WORK_LIMIT", "ERR_OUT_OF_MEMORY", "ERR_INTERNAL", "ERR_IO",
+                 "ERR_BAD_FILE"]
         for name in names:
             self.assertEqual(dpsm.status_string(getattr(dpsm, name)), "DPSM_" + name)
         self.assertEqual(dpsm.status_string(12345), "unknown status")
@@ -354,6 +359,155 @@ class TestOtherGrids(LedgerMixin, unittest.TestCase):
         for k, g in enumerate(grids):
             self.assertEqual(g.get_shape(), (8 + k, 1))
         del grids
+
+
+def cone(nx, ny, d, height, slope):
+    return [[max(0.0, height - slope * math.hypot((i - nx / 2) * d, (j - ny / 2) * d)) for i in range(nx)]
+            for j in range(ny)]
+
+
+class TestPhysics(LedgerMixin, unittest.TestCase):
+    def test_bedrock(self):
+        with dpsm.Grid.create_2d(8, 6, 0.1, 0.1) as g:
+            h = [[1.0 + 0.1 * i for i in range(8)] for j in range(6)]
+            g.set_heights(h)
+            zb = [[v - 0.01 for v in row] for row in h]
+            g.set_bedrock(zb)
+            g.set_bedrock(flat(zb))
+            e = self.assertFails(dpsm.ERR_INVALID_VALUE, g.set_bedrock, [[v + 1 for v in row] for row in h])
+            self.assertIn("zb[", e.message)
+            self.assertFails(dpsm.ERR_INVALID_SIZE, g.set_bedrock, flat(zb)[:-1])
+            self.assertFails(dpsm.ERR_INVALID_VALUE, g.set_heights, [[0.0] * 8 for _ in range(6)])
+            # Erosion on a layer of 0.01: what finds no sand is UNMET.
+            g.set_source([[-1.0] * 8 for _ in range(6)])
+            g.step(0.1)
+            unmet = g.get_mass(dpsm.MASS_UNMET)
+            self.assertGreater(unmet, 0.0)
+            self.assertLessEqual(unmet, 0.1 * 48 * 0.01 * (1 + 1e-12))
+            after = flat(g.get_heights())
+            self.assertTrue(all(a >= b for a, b in zip(after, flat(zb))), "the surface stays on the bed")
+            g.set_bedrock(None)
+            g.set_bedrock()
+
+    def test_repose_angle_field(self):
+        with dpsm.Grid.create_1d(10, 0.1) as g:
+            g.set_repose_angle_field([0.4 + 0.01 * i for i in range(10)])
+            self.assertAlmostEqual(g.stable_dt(), 0.01 / (2 * math.cos(0.4)), delta=1e-15)
+            e = self.assertFails(dpsm.ERR_INVALID_VALUE, g.set_repose_angle_field, [2.0] * 10)
+            self.assertIn("theta_radians[0]", e.message)
+            self.assertFails(dpsm.ERR_INVALID_SIZE, g.set_repose_angle_field, [0.5] * 9)
+            g.set_repose_angle_field(None)
+            self.assertAlmostEqual(g.stable_dt(), 0.01 / (2 * math.cos(dpsm.DEFAULT_REPOSE_ANGLE)), delta=1e-15)
+
+    def test_flux_exponent_and_static_angle(self):
+        with dpsm.Grid.create_2d(6, 6, 0.1, 0.1) as g:
+            g.set_flux_exponent(dpsm.DEFAULT_FLUX_EXPONENT)
+            g.set_flux_exponent(dpsm.MAX_FLUX_EXPONENT)
+            g.set_flux_exponent(1.5)
+            self.assertFails(dpsm.ERR_INVALID_VALUE, g.set_flux_exponent, dpsm.MAX_FLUX_EXPONENT + 0.1)
+            self.assertFails(dpsm.ERR_INVALID_VALUE, g.set_flux_exponent, 0.9)
+            self.assertFails(dpsm.ERR_INVALID_VALUE, g.set_flux_exponent, float("nan"))
+            g.set_static_angle(0.7)
+            self.assertFails(dpsm.ERR_INVALID_VALUE, g.set_static_angle, 0.0)
+            self.assertFails(dpsm.ERR_INVALID_VALUE, g.set_static_angle, 2.0)
+            # A slope between the angle of repose (30 degrees) and the static
+            # angle holds: nothing moves.
+            ramp = [[0.7 * 0.1 * i for i in range(6)] for _ in range(6)]  # slope 0.7: 35 degrees
+            g.set_heights(ramp)
+            g.step(1.0)
+            self.assertEqual(flat(g.get_heights()), flat(ramp))
+
+
+class TestRestart(LedgerMixin, unittest.TestCase):
+    def setUp(self):
+        self.dir = tempfile.TemporaryDirectory()
+        self.path = os.path.join(self.dir.name, "grid.dpsm")
+
+    def tearDown(self):
+        self.dir.cleanup()
+
+    def assertSame(self, a, b):
+        self.assertEqual(flat(a.get_heights()), flat(b.get_heights()))
+        for q in (dpsm.MASS_TOTAL, dpsm.MASS_SOURCED, dpsm.MASS_EXTERNAL, dpsm.MASS_OUTFLOW, dpsm.MASS_UNMET):
+            self.assertEqual(a.get_mass(q).hex(), b.get_mass(q).hex(), q)
+
+    def test_continues_bit_for_bit(self):
+        g = dpsm.Grid.create_2d(20, 16, 0.1, 0.1)
+        g.set_heights(cone(20, 16, 0.1, 1.5, 2.0))
+        g.set_boundary(dpsm.XMAX, dpsm.OPEN)
+        g.set_source([[0.01] * 20 for _ in range(16)])
+        g.set_flux_exponent(1.5)
+        g.set_static_angle(0.6)
+        g.step(0.05)
+        g.save(self.path)
+        loaded = dpsm.Grid.load(self.path)
+        self.assertEqual(loaded.kind, "2d")
+        self.assertEqual(loaded.shape, g.shape)
+        self.assertEqual(loaded.get_step_info(dpsm.INFO_SUBSTEPS), g.get_step_info(dpsm.INFO_SUBSTEPS))
+        for _ in range(3):
+            g.step(0.05)
+            loaded.step(0.05)
+            self.assertSame(g, loaded)
+        self.assertLedger(loaded)
+        g.close()
+        loaded.close()
+
+    def test_every_kind_of_grid(self):
+        for make, kind in ((lambda: dpsm.Grid.create_1d(12, 0.1), "1d"),
+                           (lambda: dpsm.Grid.create_axisymmetric(12, 0.1), "axisymmetric"),
+                           (lambda: dpsm.Grid.create_2d(12, 1, 0.1, 0.1), "2d")):
+            with make() as g:
+                g.set_heights(cone(12, 1, 0.1, 1.0, 3.0)[0] if kind != "2d" else cone(12, 1, 0.1, 1.0, 3.0))
+                g.step(0.01)
+                path = pathlib.Path(self.path)  # os.PathLike works too
+                g.save(path)
+                with dpsm.Grid.load(path) as loaded:
+                    self.assertEqual(loaded.kind, kind)
+                    self.assertEqual(loaded.shape, g.shape)
+                    g.step(1.0)
+                    loaded.step(1.0)
+                    self.assertSame(g, loaded)
+
+    def test_the_format(self):
+        with dpsm.Grid.create_2d(5, 4, 0.1, 0.1) as g:
+            g.save(self.path)
+        with open(self.path, "rb") as f:
+            data = f.read()
+        self.assertEqual(data[:8], b"\x89DPSM\r\n\x1a")
+        self.assertEqual(int.from_bytes(data[8:12], "little"), 1)  # the format version
+        self.assertEqual(len(data), 220 + 20 * 13 + 4)
+        # Standard CRC-32s (zlib's): of the header, and of everything before the last 4 bytes.
+        self.assertEqual(int.from_bytes(data[216:220], "little"), zlib.crc32(data[:216]))
+        self.assertEqual(int.from_bytes(data[-4:], "little"), zlib.crc32(data[:-4]))
+        self.assertFalse(os.path.exists(self.path + ".tmp"))
+
+    def test_damaged_and_missing_files(self):
+        with dpsm.Grid.create_2d(5, 4, 0.1, 0.1) as g:
+            g.set_heights([[0.1 * (i + j) for i in range(5)] for j in range(4)])
+            g.save(self.path)
+            with open(self.path, "rb") as f:
+                data = f.read()
+            bad = os.path.join(self.dir.name, "bad.dpsm")
+            for at in (0, 10, 30, 230, len(data) - 1):
+                changed = bytearray(data)
+                changed[at] ^= 0x01
+                with open(bad, "wb") as f:
+                    f.write(changed)
+                e = self.assertFails(dpsm.ERR_BAD_FILE, dpsm.Grid.load, bad)
+                self.assertIn(bad, e.message)
+            with open(bad, "wb") as f:
+                f.write(data[:-10])
+            e = self.assertFails(dpsm.ERR_BAD_FILE, dpsm.Grid.load, bad)
+            self.assertIn("truncated", e.message)
+            e = self.assertFails(dpsm.ERR_IO, dpsm.Grid.load, os.path.join(self.dir.name, "missing.dpsm"))
+            self.assertIn("missing.dpsm", e.message)
+            self.assertEqual(e.function, "dpsm_load")
+            e = self.assertFails(dpsm.ERR_IO, g.save, "/nonexistent-dir/x")
+            self.assertIn("/nonexistent-dir/x", e.message)
+            self.assertEqual(g.last_error(), e.message)
+            self.assertFails(dpsm.ERR_IO, g.save, "nul\0byte")
+            g.step(0.1)  # the grid is as it was
+        self.assertFails(dpsm.ERR_NULL_POINTER, g.save, self.path)
 
 
 if __name__ == "__main__":

@@ -22,6 +22,9 @@ np = _import_numpy()
 HAVE_NUMPY = np is not None
 
 _INT_RANGE = (-(2**31), 2**31 - 1)
+# Where a restart file says what kind of grid it holds (docs/guide_restart.md):
+# dim and axisymmetric, little-endian uint32 each.
+_RESTART_KIND_OFFSET = 12
 _INT64_RANGE = (-(2**63), 2**63 - 1)
 _P_DOUBLE = ctypes.POINTER(ctypes.c_double)
 _P_UINT8 = ctypes.POINTER(ctypes.c_uint8)
@@ -73,6 +76,36 @@ class Error(Exception):
         self.status_name = status_string(status)
         where = function + ": " if function else ""
         super().__init__("%s%s: %s" % (where, self.status_name, message))
+
+
+def _c_path(path, function):
+    """A str, bytes or os.PathLike path as the bytes C gets."""
+    raw = os.fsencode(path)
+    if b"\0" in raw:
+        raise Error(C.DPSM_ERR_IO, "the path %r holds a NUL byte" % (path,), function)
+    return raw
+
+
+def _restart_kind(raw_path, ny):
+    """The kind of grid a restart file holds, from its header (which dpsm_load
+    has just checked): "2d", "1d" or "axisymmetric"."""
+    if ny > 1:
+        return "2d"
+    try:
+        with open(raw_path, "rb") as f:
+            f.seek(_RESTART_KIND_OFFSET)
+            fields = f.read(8)
+    except OSError:
+        fields = b""
+    if len(fields) != 8:
+        # The file went away since dpsm_load read it: with ny == 1 the arrays
+        # of every kind hold nx values, so take the 1D view of them.
+        return "1d"
+    dim = int.from_bytes(fields[:4], "little")
+    axisymmetric = int.from_bytes(fields[4:], "little")
+    if dim == 2:
+        return "2d"
+    return "axisymmetric" if axisymmetric else "1d"
 
 
 def _check(status, function, handle=None, created=False):
@@ -131,7 +164,8 @@ def _raise_shape(function, name, got, shape):
 
 class Grid:
     """A dpsm grid (``dpsm_grid *``): create one with ``Grid.create_1d``,
-    ``Grid.create_2d`` or ``Grid.create_axisymmetric``.
+    ``Grid.create_2d`` or ``Grid.create_axisymmetric``, or read one from a
+    restart file with ``Grid.load``.
 
     Arrays of heights, sources and cell kinds have the grid's ``shape``:
     ``(ny, nx)`` on a 2D grid (row ``j`` holds cells ``(0..nx-1, j)``, as a C
@@ -173,6 +207,29 @@ class Grid:
         """``dpsm_create_axisymmetric``: ``nr`` rings of width ``dr``."""
         f = "dpsm_create_axisymmetric"
         return cls._create(f, "axisymmetric", _c_int64(nr, "nr", f), float(dr))
+
+    @classmethod
+    def load(cls, path):
+        """``dpsm_load``: a new grid from a file written by ``save`` (a str,
+        bytes or os.PathLike path). A missing or unreadable file raises
+        ``Error`` with ``ERR_IO``; a truncated, corrupted or foreign one
+        ``ERR_BAD_FILE``."""
+        f = "dpsm_load"
+        raw = _c_path(path, f)
+        handle = GridPtr()
+        _check(lib.dpsm_load(raw, ctypes.byref(handle)), f, created=True)
+        nx, ny = ctypes.c_int64(), ctypes.c_int64()
+        status = lib.dpsm_get_shape(handle, ctypes.byref(nx), ctypes.byref(ny))
+        if status != C.DPSM_OK:  # cannot happen with a loaded grid; do not leak it
+            lib.dpsm_destroy(handle)
+            _check(status, "dpsm_get_shape")
+        return cls(_handle=handle, _kind=_restart_kind(raw, ny.value))
+
+    def save(self, path):
+        """``dpsm_save``: writes everything needed to continue the run bit for
+        bit to ``path`` (through ``path + ".tmp"``, renamed when complete)."""
+        f = "dpsm_save"
+        self._call(f, _c_path(path, f))
 
     def close(self):
         """``dpsm_destroy``: releases the grid; later calls on it fail with
@@ -246,6 +303,14 @@ class Grid:
         """``dpsm_set_threads``: at least 0; 0 means OpenMP's default."""
         f = "dpsm_set_threads"
         self._call(f, _c_int(n, "n", f, C.DPSM_ERR_INVALID_VALUE))
+
+    def set_flux_exponent(self, p):
+        """``dpsm_set_flux_exponent``: within [1, ``MAX_FLUX_EXPONENT``]; 1 is the paper's law."""
+        self._call("dpsm_set_flux_exponent", float(p))
+
+    def set_static_angle(self, radians):
+        """``dpsm_set_static_angle``: sand at rest starts to move only beyond it."""
+        self._call("dpsm_set_static_angle", float(radians))
 
     # ---- arrays --------------------------------------------------------------
 
@@ -345,6 +410,24 @@ class Grid:
         self._call(f, pointer)
         del keep
 
+    def set_bedrock(self, zb=None):
+        """``dpsm_set_bedrock``: a bed the sand cannot erode, an array of
+        ``shape`` at or below the heights; ``None`` removes it."""
+        self._set_field("dpsm_set_bedrock", zb, "zb")
+
+    def set_repose_angle_field(self, theta_radians=None):
+        """``dpsm_set_repose_angle_field``: an angle of repose per cell (radians),
+        an array of ``shape``; ``None`` returns to the uniform angle."""
+        self._set_field("dpsm_set_repose_angle_field", theta_radians, "theta_radians")
+
+    def _set_field(self, function, values, name):
+        if values is None:
+            self._call(function, None)
+            return
+        pointer, keep = self._doubles_in(values, self.shape, name, function)
+        self._call(function, pointer)
+        del keep
+
     def _block(self, function, i0, j0, ni, nj):
         block = (
             _c_int64(i0, "i0", function),
@@ -396,7 +479,7 @@ class Grid:
         self._call("dpsm_step", float(dt))
 
     def get_mass(self, quantity):
-        """``dpsm_get_mass``: ``MASS_TOTAL``, ``MASS_SOURCED``, ``MASS_EXTERNAL`` or ``MASS_OUTFLOW``."""
+        """``dpsm_get_mass``: ``MASS_TOTAL``, ``MASS_SOURCED``, ``MASS_EXTERNAL``, ``MASS_OUTFLOW`` or ``MASS_UNMET``."""
         f = "dpsm_get_mass"
         value = ctypes.c_double()
         self._call(f, _c_int(quantity, "quantity", f, C.DPSM_ERR_UNKNOWN_ENUM), ctypes.byref(value))

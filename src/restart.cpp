@@ -1,0 +1,541 @@
+// Restart files. The whole layout (docs/guide_restart.md) is in two places
+// only, write_header/write_body and read_header/read_body, field for field in
+// the same order. Every number is little-endian whatever the machine; doubles
+// and floats travel as their IEEE bit patterns, so a value comes back with
+// every bit it had. Two CRC-32 checksums guard the file: one over the fixed
+// header, so that its sizes can be trusted before anything is allocated from
+// them, and one over the whole file.
+#include "restart.hpp"
+
+#include <array>
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <limits>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#if defined(__unix__) || defined(__APPLE__)
+#include <unistd.h>
+#endif
+
+#include "dpsm/dpsm.h"
+#include "error.hpp"
+
+namespace dpsm {
+
+namespace {
+
+// PNG's trick: a high byte catches 7-bit transfers, CR LF and ^Z catch
+// text-mode conversions, before the checksum would.
+constexpr std::array<std::uint8_t, 8> kMagic{0x89, 'D', 'P', 'S', 'M', '\r', '\n', 0x1a};
+// The fixed header of version 1, its checksum included (docs/guide_restart.md).
+constexpr std::size_t kHeaderBytes = 220;
+constexpr std::size_t kChecksumBytes = 4;
+
+// Which optional per-cell arrays follow the mandatory ones.
+constexpr std::uint32_t kHasSource = 1u << 0;
+constexpr std::uint32_t kHasBed = 1u << 1;
+constexpr std::uint32_t kHasAngleField = 1u << 2;
+constexpr std::uint32_t kHasMoving = 1u << 3;
+constexpr std::uint32_t kKnownFlags = kHasSource | kHasBed | kHasAngleField | kHasMoving;
+
+// The limits of the C API's setters (capi.cpp), which a file must respect too.
+constexpr double kMaxMagnitude = 1e50;
+constexpr std::int64_t kMaxCells = std::numeric_limits<std::int64_t>::max() / 64;
+
+// ---- CRC-32 (ISO-HDLC, as zlib, PNG and gzip: reflected 0xEDB88320) -------
+
+struct Crc32Table {
+    std::array<std::uint32_t, 256> entry{};
+    Crc32Table() {
+        for (std::uint32_t n = 0; n < 256; ++n) {
+            std::uint32_t c = n;
+            for (int k = 0; k < 8; ++k) c = (c & 1u) ? 0xEDB88320u ^ (c >> 1) : c >> 1;
+            entry[n] = c;
+        }
+    }
+};
+
+// A running checksum: start at 0, feed bytes, the value is the CRC of all of them.
+std::uint32_t crc32_update(std::uint32_t crc, const std::uint8_t *bytes, std::size_t n) {
+    static const Crc32Table table;
+    std::uint32_t c = ~crc;
+    for (std::size_t k = 0; k < n; ++k) c = table.entry[(c ^ bytes[k]) & 0xffu] ^ (c >> 8);
+    return ~c;
+}
+
+template <class... Parts>
+[[noreturn]] void fail(int status, const char *function, const Parts &...parts) {
+    std::ostringstream msg;
+    msg.precision(17);
+    msg << function << ": ";
+    (msg << ... << parts);
+    throw Error(status, msg.str());
+}
+
+std::string system_reason(int error) {
+    const char *reason = std::strerror(error);
+    return reason ? reason : "unknown error";
+}
+
+// ---- writing ----------------------------------------------------------------
+
+// Serialises little-endian into a buffer that goes to the file in large
+// pieces, keeping the running checksum of everything written.
+class Writer {
+public:
+    Writer(std::FILE *file, const std::string &path, const char *function)
+        : file_(file), path_(path), function_(function) {
+        buffer_.reserve(kFlushBytes + 64);
+    }
+
+    void u8(std::uint8_t v) { buffer_.push_back(v); }
+    void u32(std::uint32_t v) {
+        for (int k = 0; k < 4; ++k) buffer_.push_back(static_cast<std::uint8_t>(v >> (8 * k)));
+    }
+    void u64(std::uint64_t v) {
+        for (int k = 0; k < 8; ++k) buffer_.push_back(static_cast<std::uint8_t>(v >> (8 * k)));
+    }
+    void i32(std::int32_t v) { u32(static_cast<std::uint32_t>(v)); }
+    void i64(std::int64_t v) { u64(static_cast<std::uint64_t>(v)); }
+    void f64(double v) {
+        std::uint64_t bits;
+        std::memcpy(&bits, &v, sizeof bits);
+        u64(bits);
+    }
+    void f32(float v) {
+        std::uint32_t bits;
+        std::memcpy(&bits, &v, sizeof bits);
+        u32(bits);
+    }
+    template <class T, class Put>
+    void array(const std::vector<T> &values, Put put) {
+        for (const T &v : values) {
+            (this->*put)(v);
+            if (buffer_.size() >= kFlushBytes) flush();
+        }
+    }
+
+    // The checksum of everything so far (the buffer included), written next.
+    void checksum() { u32(crc32_update(crc_, buffer_.data(), buffer_.size())); }
+    std::size_t buffered() const { return buffer_.size(); }
+
+    void flush() {
+        if (buffer_.empty()) return;
+        crc_ = crc32_update(crc_, buffer_.data(), buffer_.size());
+        if (std::fwrite(buffer_.data(), 1, buffer_.size(), file_) != buffer_.size())
+            fail(DPSM_ERR_IO, function_, "cannot write ", path_, ": ", system_reason(errno));
+        buffer_.clear();
+    }
+
+private:
+    static constexpr std::size_t kFlushBytes = 1 << 20;
+    std::FILE *file_;
+    const std::string &path_;
+    const char *function_;
+    std::vector<std::uint8_t> buffer_;
+    std::uint32_t crc_ = 0;
+};
+
+std::uint32_t flags_of(const Grid &g) {
+    std::uint32_t flags = 0;
+    if (!g.source().empty()) flags |= kHasSource;
+    if (!g.bed().empty()) flags |= kHasBed;
+    if (!g.angle_field().empty()) flags |= kHasAngleField;
+    if (!g.moving().empty()) flags |= kHasMoving;
+    return flags;
+}
+
+void write_header(Writer &w, const Grid &g) {
+    const Geometry &geo = g.geometry();
+    for (const std::uint8_t b : kMagic) w.u8(b);
+    w.u32(kRestartVersion);
+    w.u32(static_cast<std::uint32_t>(geo.dim));
+    w.u32(geo.axisymmetric ? 1u : 0u);
+    w.i64(geo.nx);
+    w.i64(geo.ny);
+    w.f64(geo.dx);
+    w.f64(geo.dy);
+    w.f64(g.repose_angle());
+    w.f64(g.mobility());
+    w.f64(g.rest_tolerance());
+    w.i64(g.max_substeps());
+    w.i32(g.threads());
+    w.u32(static_cast<std::uint32_t>(g.scheme()));
+    for (int side = 0; side < 4; ++side) w.u8(g.side_open(side) ? 1 : 0);
+    w.f64(g.flux_exponent());
+    w.f64(g.static_angle());
+    w.u32(flags_of(g));
+    const MassLedger &ledger = g.ledger();
+    for (const CompensatedSum *account : {&ledger.sourced, &ledger.external, &ledger.outflow, &ledger.unmet}) {
+        w.f64(account->sum());
+        w.f64(account->correction());
+    }
+    const StepInfo &info = g.last_step();
+    w.i64(info.substeps);
+    w.f64(info.time_integrated);
+    w.u32(info.at_rest ? 1u : 0u);
+    w.f64(info.max_excess_slope);
+    w.f64(info.cell_updates);
+    w.checksum();
+}
+
+void write_body(Writer &w, const Grid &g) {
+    w.array(g.heights(), &Writer::f64);
+    w.array(g.residuals(), &Writer::f32);
+    w.array(g.kinds(), &Writer::u8);
+    w.array(g.source(), &Writer::f64);  // each optional array: nothing when empty
+    w.array(g.bed(), &Writer::f64);
+    w.array(g.angle_field(), &Writer::f64);
+    w.array(g.moving(), &Writer::u8);
+    w.checksum();
+    w.flush();
+}
+
+// Closes a FILE on every path out, and removes the temporary file unless kept.
+struct TempFile {
+    std::FILE *file = nullptr;
+    std::string path;
+    bool keep = false;
+    ~TempFile() {
+        if (file) std::fclose(file);
+        if (!keep) std::remove(path.c_str());
+    }
+};
+
+// ---- reading ----------------------------------------------------------------
+
+// Reads little-endian values from a byte range, refusing to run past its end.
+class Reader {
+public:
+    Reader(const std::vector<std::uint8_t> &bytes, std::size_t at, const std::string &path, const char *function)
+        : bytes_(bytes), at_(at), path_(path), function_(function) {}
+
+    std::uint8_t u8() { return take(1)[0]; }
+    std::uint32_t u32() {
+        const std::uint8_t *p = take(4);
+        std::uint32_t v = 0;
+        for (int k = 0; k < 4; ++k) v |= static_cast<std::uint32_t>(p[k]) << (8 * k);
+        return v;
+    }
+    std::uint64_t u64() {
+        const std::uint8_t *p = take(8);
+        std::uint64_t v = 0;
+        for (int k = 0; k < 8; ++k) v |= static_cast<std::uint64_t>(p[k]) << (8 * k);
+        return v;
+    }
+    std::int32_t i32() { return static_cast<std::int32_t>(u32()); }
+    std::int64_t i64() { return static_cast<std::int64_t>(u64()); }
+    double f64() {
+        const std::uint64_t bits = u64();
+        double v;
+        std::memcpy(&v, &bits, sizeof v);
+        return v;
+    }
+    float f32() {
+        const std::uint32_t bits = u32();
+        float v;
+        std::memcpy(&v, &bits, sizeof v);
+        return v;
+    }
+    template <class T, class Get>
+    void array(std::vector<T> &values, std::size_t n, Get get) {
+        if (bytes_.size() - at_ < n)  // a cheap first guard; take() checks each value
+            fail(DPSM_ERR_BAD_FILE, function_, path_, " is truncated inside its arrays");
+        values.resize(n);
+        for (std::size_t k = 0; k < n; ++k) values[k] = static_cast<T>((this->*get)());
+    }
+    std::size_t at() const { return at_; }
+
+private:
+    const std::uint8_t *take(std::size_t n) {
+        if (bytes_.size() - at_ < n)
+            fail(DPSM_ERR_BAD_FILE, function_, path_, " is truncated: a field at byte ", at_, " runs past its end");
+        const std::uint8_t *p = bytes_.data() + at_;
+        at_ += n;
+        return p;
+    }
+
+    const std::vector<std::uint8_t> &bytes_;
+    std::size_t at_;
+    const std::string &path_;
+    const char *function_;
+};
+
+// What the header says, before it is turned into a grid's state.
+struct Header {
+    std::uint32_t version = 0, dim = 0, axisymmetric = 0;
+    std::int64_t nx = 0, ny = 0;
+    double dx = 0.0, dy = 0.0;
+    std::uint32_t scheme = 0, flags = 0, at_rest = 0;
+    std::array<std::uint8_t, 4> side_open{};
+};
+
+void read_header(Reader &r, Header &h, GridState &s) {
+    for (std::size_t k = 0; k < kMagic.size(); ++k) r.u8();  // checked already
+    h.version = r.u32();
+    h.dim = r.u32();
+    h.axisymmetric = r.u32();
+    h.nx = r.i64();
+    h.ny = r.i64();
+    h.dx = r.f64();
+    h.dy = r.f64();
+    s.repose_angle = r.f64();
+    s.mobility = r.f64();
+    s.rest_tolerance = r.f64();
+    s.max_substeps = r.i64();
+    s.threads = r.i32();
+    h.scheme = r.u32();
+    for (std::uint8_t &open : h.side_open) open = r.u8();
+    s.flux_exponent = r.f64();
+    s.static_angle = r.f64();
+    h.flags = r.u32();
+    for (CompensatedSum *account : {&s.ledger.sourced, &s.ledger.external, &s.ledger.outflow, &s.ledger.unmet}) {
+        const double sum = r.f64();
+        const double correction = r.f64();
+        *account = CompensatedSum(sum, correction);
+    }
+    s.last_step.substeps = r.i64();
+    s.last_step.time_integrated = r.f64();
+    h.at_rest = r.u32();
+    s.last_step.max_excess_slope = r.f64();
+    s.last_step.cell_updates = r.f64();
+    r.u32();  // the header's checksum, checked already
+}
+
+void read_body(Reader &r, const Header &h, std::size_t n, GridState &s) {
+    r.array(s.heights, n, &Reader::f64);
+    r.array(s.residuals, n, &Reader::f32);
+    r.array(s.kinds, n, &Reader::u8);
+    if (h.flags & kHasSource) r.array(s.source, n, &Reader::f64);
+    if (h.flags & kHasBed) r.array(s.bed, n, &Reader::f64);
+    if (h.flags & kHasAngleField) r.array(s.angle_field, n, &Reader::f64);
+    if (h.flags & kHasMoving) r.array(s.moving, n, &Reader::u8);
+}
+
+// The bytes each cell takes in the body, by the arrays the flags announce.
+std::size_t bytes_per_cell(std::uint32_t flags) {
+    std::size_t bytes = 8 + 4 + 1;  // heights, residuals, kinds
+    if (flags & kHasSource) bytes += 8;
+    if (flags & kHasBed) bytes += 8;
+    if (flags & kHasAngleField) bytes += 8;
+    if (flags & kHasMoving) bytes += 1;
+    return bytes;
+}
+
+bool is_angle(double theta) { return theta > 0.0 && theta < 0.5 * M_PI; }  // false for NaN
+bool in_scale(double v) { return std::isfinite(v) && v >= 1.0 / kMaxMagnitude && v <= kMaxMagnitude; }
+bool in_range(double v) { return std::isfinite(v) && std::fabs(v) <= kMaxMagnitude; }
+
+std::string hex32(std::uint32_t v) {
+    std::ostringstream s;
+    s << "0x" << std::hex << v;
+    return s.str();
+}
+
+// The header's sizes and layout: checked before the size of the file is
+// compared with them and anything is allocated from them.
+void check_layout(const Header &h, const std::string &path, const char *fn) {
+    const auto bad = [&](const auto &...parts) { fail(DPSM_ERR_BAD_FILE, fn, path, ": ", parts...); };
+    if (h.dim != 1 && h.dim != 2) bad("dim = ", h.dim, " is not 1 or 2");
+    if (h.axisymmetric > 1) bad("axisymmetric = ", h.axisymmetric, " is not 0 or 1");
+    if (h.axisymmetric && h.dim != 1) bad("an axisymmetric grid must have dim = 1, not ", h.dim);
+    if (h.nx < 1) bad("nx = ", h.nx, " must be at least 1");
+    if (h.ny < 1) bad("ny = ", h.ny, " must be at least 1");
+    if (h.dim == 1 && h.ny != 1) bad("a 1D grid has ny = 1, not ", h.ny);
+    if (h.nx > kMaxCells / h.ny)
+        bad("nx * ny = ", h.nx, " * ", h.ny, " cells is more than this library can address (", kMaxCells, ")");
+    if (h.flags & ~kKnownFlags) bad("unknown array flags ", hex32(h.flags & ~kKnownFlags));
+    const std::uint64_t cells = static_cast<std::uint64_t>(h.nx) * static_cast<std::uint64_t>(h.ny);
+    if (cells > (std::numeric_limits<std::size_t>::max() - kHeaderBytes - kChecksumBytes) / bytes_per_cell(h.flags))
+        bad(cells, " cells do not fit in this machine's memory");
+}
+
+// Every value as the setters would check it; the first one wrong is named.
+void check_values(const Header &h, const GridState &s, std::size_t n, const std::string &path, const char *fn) {
+    const auto bad = [&](const auto &...parts) { fail(DPSM_ERR_BAD_FILE, fn, path, ": ", parts...); };
+    if (!in_scale(h.dx)) bad("dx = ", h.dx, " is outside the supported range [1e-50, 1e50]");
+    if (h.dim == 2 ? !in_scale(h.dy) : h.dy != 1.0) bad("dy = ", h.dy, " is not valid for a grid of dim = ", h.dim);
+    if (!is_angle(s.repose_angle)) bad("the angle of repose ", s.repose_angle, " radians is outside (0, pi/2)");
+    if (!in_scale(s.mobility)) bad("the mobility ", s.mobility, " is outside the supported range [1e-50, 1e50]");
+    if (!(std::isfinite(s.rest_tolerance) && s.rest_tolerance > 0.0))
+        bad("the rest tolerance ", s.rest_tolerance, " is not finite and positive");
+    if (s.max_substeps < 1) bad("the sub-step limit ", s.max_substeps, " must be at least 1");
+    if (s.threads < 0) bad("threads = ", s.threads, " must be at least 0");
+    if (h.scheme != kPairwise && h.scheme != kIsotropic) bad("scheme = ", h.scheme, " is not pairwise (0) or isotropic (1)");
+    if (h.dim == 1 && h.scheme != kPairwise) bad("a 1D grid has the pairwise scheme (0), not ", h.scheme);
+    for (int side = 0; side < 4; ++side) {
+        if (h.side_open[side] > 1) bad("side ", side, " is ", static_cast<int>(h.side_open[side]), ", not 0 or 1");
+        if (h.side_open[side] && h.dim == 1 && side >= kYMin) bad("a 1D grid has no open y side (side ", side, ")");
+        if (h.side_open[side] && h.axisymmetric && side == kXMin) bad("the axis of an axisymmetric grid is open");
+    }
+    if (!(s.flux_exponent >= 1.0 && s.flux_exponent <= DPSM_MAX_FLUX_EXPONENT))
+        bad("the flux exponent ", s.flux_exponent, " is outside [1, ", DPSM_MAX_FLUX_EXPONENT, "]");
+    if (!(s.static_angle == 0.0 || is_angle(s.static_angle)))
+        bad("the static angle ", s.static_angle, " radians is neither 0 (none) nor in (0, pi/2)");
+    if (((h.flags & kHasMoving) != 0) != (s.static_angle > 0.0))
+        bad("the moving cells are ", (h.flags & kHasMoving) ? "present" : "missing", " but the static angle is ",
+            s.static_angle);
+    const MassLedger &l = s.ledger;
+    for (const CompensatedSum *account : {&l.sourced, &l.external, &l.outflow, &l.unmet})
+        if (!std::isfinite(account->sum()) || !std::isfinite(account->correction()))
+            bad("a ledger account is not finite (", account->sum(), " + ", account->correction(), ")");
+    const StepInfo &info = s.last_step;
+    if (info.substeps < 0) bad("the last step's sub-steps ", info.substeps, " are negative");
+    if (!(std::isfinite(info.time_integrated) && info.time_integrated >= 0.0))
+        bad("the last step's time integrated ", info.time_integrated, " is not finite and non-negative");
+    if (h.at_rest > 1) bad("the last step's at-rest flag is ", h.at_rest, ", not 0 or 1");
+    if (!(std::isfinite(info.max_excess_slope) && info.max_excess_slope >= 0.0))
+        bad("the last step's largest excess slope ", info.max_excess_slope, " is not finite and non-negative");
+    if (!(std::isfinite(info.cell_updates) && info.cell_updates >= 0.0))
+        bad("the last step's cell updates ", info.cell_updates, " are not finite and non-negative");
+
+    const auto cell = [&](std::size_t c) {
+        std::ostringstream where;
+        where << "[" << c << "] (cell i = " << static_cast<std::int64_t>(c) % h.nx
+              << ", j = " << static_cast<std::int64_t>(c) / h.nx << ")";
+        return where.str();
+    };
+    for (std::size_t c = 0; c < n; ++c) {
+        if (!in_range(s.heights[c])) bad("h", cell(c), " = ", s.heights[c], " is not finite within [-1e50, 1e50]");
+        if (!std::isfinite(s.residuals[c])) bad("the rounding residual", cell(c), " is not finite");
+        if (s.kinds[c] > kOpen) bad("kinds", cell(c), " = ", static_cast<int>(s.kinds[c]), " is not 0, 1 or 2");
+        if (!s.source.empty() && !in_range(s.source[c]))
+            bad("q", cell(c), " = ", s.source[c], " is not finite within [-1e50, 1e50]");
+        if (!s.bed.empty()) {
+            if (!in_range(s.bed[c])) bad("zb", cell(c), " = ", s.bed[c], " is not finite within [-1e50, 1e50]");
+            if (s.heights[c] < s.bed[c]) bad("h", cell(c), " = ", s.heights[c], " lies below its bed ", s.bed[c]);
+        }
+        if (!s.angle_field.empty() && !is_angle(s.angle_field[c]))
+            bad("theta", cell(c), " = ", s.angle_field[c], " radians is outside (0, pi/2)");
+        if (!s.moving.empty() && s.moving[c] > 1)
+            bad("moving", cell(c), " = ", static_cast<int>(s.moving[c]), " is not 0 or 1");
+    }
+}
+
+// Reads up to `want` more bytes onto `bytes`; false at the end of the file.
+bool read_more(std::FILE *file, std::vector<std::uint8_t> &bytes, std::size_t want, const std::string &path,
+               const char *fn) {
+    const std::size_t old = bytes.size();
+    bytes.resize(old + want);
+    const std::size_t got = std::fread(bytes.data() + old, 1, want, file);
+    bytes.resize(old + got);
+    if (got < want && std::ferror(file)) fail(DPSM_ERR_IO, fn, "cannot read ", path, ": ", system_reason(errno));
+    return got == want;
+}
+
+}  // namespace
+
+void save_restart(const Grid &grid, const char *path, const char *function) {
+    const std::string target(path);
+    TempFile tmp;
+    tmp.path = target + ".tmp";
+    errno = 0;
+    tmp.file = std::fopen(tmp.path.c_str(), "wb");
+    if (!tmp.file) {
+        tmp.keep = true;  // not ours: it may be something that exists and is not a file
+        fail(DPSM_ERR_IO, function, "cannot write ", target, ": cannot create ", tmp.path, ": ", system_reason(errno));
+    }
+    Writer w(tmp.file, target, function);
+    write_header(w, grid);
+    if (w.buffered() != kHeaderBytes)
+        fail(DPSM_ERR_INTERNAL, function, "the header takes ", w.buffered(), " bytes, not ", kHeaderBytes);
+    write_body(w, grid);
+    // On disk before it replaces the old file: a crash leaves one or the other.
+    if (std::fflush(tmp.file) != 0) fail(DPSM_ERR_IO, function, "cannot write ", target, ": ", system_reason(errno));
+#if defined(__unix__) || defined(__APPLE__)
+    if (fsync(fileno(tmp.file)) != 0) fail(DPSM_ERR_IO, function, "cannot write ", target, ": ", system_reason(errno));
+#endif
+    std::FILE *file = tmp.file;
+    tmp.file = nullptr;
+    if (std::fclose(file) != 0) fail(DPSM_ERR_IO, function, "cannot write ", target, ": ", system_reason(errno));
+#if defined(_WIN32)
+    std::remove(target.c_str());  // rename does not replace a file there
+#endif
+    if (std::rename(tmp.path.c_str(), target.c_str()) != 0)
+        fail(DPSM_ERR_IO, function, "cannot write ", target, ": cannot rename ", tmp.path, " to it: ",
+             system_reason(errno));
+    tmp.keep = true;  // it is the target now
+}
+
+void load_restart(const char *path, Geometry &geometry, GridState &state, const char *fn) {
+    const std::string source(path);
+    errno = 0;
+    struct Closer {
+        std::FILE *file;
+        ~Closer() {
+            if (file) std::fclose(file);
+        }
+    } in{std::fopen(path, "rb")};
+    if (!in.file) fail(DPSM_ERR_IO, fn, "cannot open ", source, ": ", system_reason(errno));
+    const auto bad = [&](const auto &...parts) { fail(DPSM_ERR_BAD_FILE, fn, source, parts...); };
+
+    // The fixed header first: its checksum makes its sizes trustworthy.
+    std::vector<std::uint8_t> bytes;
+    read_more(in.file, bytes, kHeaderBytes, source, fn);
+    const std::size_t got = bytes.size();
+    if (got == 0) bad(" is empty, not a dpsm restart file");
+    if (std::memcmp(bytes.data(), kMagic.data(), got < kMagic.size() ? got : kMagic.size()) != 0)
+        bad(" is not a dpsm restart file (it does not begin with the dpsm restart signature)");
+    if (got < 12) bad(" is truncated: expected at least ", kHeaderBytes, " bytes, found ", got);
+    Header header;
+    Reader r(bytes, 0, source, fn);
+    for (std::size_t k = 0; k < kMagic.size(); ++k) r.u8();
+    header.version = r.u32();
+    if (header.version > kRestartVersion)
+        bad(" was written by a newer dpsm, version ", header.version, " of the format; this library reads versions 1 to ",
+            kRestartVersion);
+    if (header.version == 0) bad(" is corrupted: format version 0 does not exist");
+    if (got < kHeaderBytes) bad(" is truncated: expected at least ", kHeaderBytes, " bytes, found ", got);
+    Reader checksum_reader(bytes, kHeaderBytes - kChecksumBytes, source, fn);
+    const std::uint32_t stored_header = checksum_reader.u32();
+    const std::uint32_t computed_header = crc32_update(0, bytes.data(), kHeaderBytes - kChecksumBytes);
+    if (stored_header != computed_header)
+        bad(" is corrupted: checksum mismatch in its header (stored ", hex32(stored_header), ", computed ",
+            hex32(computed_header), ")");
+    Reader header_reader(bytes, 0, source, fn);
+    read_header(header_reader, header, state);
+    check_layout(header, source, fn);
+
+    // Then exactly as many bytes as the header implies, read as they come (a
+    // short file allocates no more than it holds).
+    const std::size_t n = static_cast<std::size_t>(header.nx) * static_cast<std::size_t>(header.ny);
+    const std::size_t expected = kHeaderBytes + n * bytes_per_cell(header.flags) + kChecksumBytes;
+    constexpr std::size_t kChunk = std::size_t{1} << 22;
+    while (bytes.size() <= expected) {
+        const std::size_t want = expected + 1 - bytes.size();
+        if (!read_more(in.file, bytes, want < kChunk ? want : kChunk, source, fn)) break;
+    }
+    if (bytes.size() < expected)
+        bad(" is truncated: expected ", expected, " bytes, found ", bytes.size());
+    if (bytes.size() > expected) {
+        std::size_t found = bytes.size();
+        std::vector<std::uint8_t> rest;
+        while (read_more(in.file, rest, kChunk, source, fn)) {
+            found += rest.size();
+            rest.clear();
+        }
+        found += rest.size();
+        bad(" is corrupted: expected ", expected, " bytes, found ", found, " (data after the end)");
+    }
+    Reader trailer(bytes, expected - kChecksumBytes, source, fn);
+    const std::uint32_t stored = trailer.u32();
+    const std::uint32_t computed = crc32_update(0, bytes.data(), expected - kChecksumBytes);
+    if (stored != computed)
+        bad(" is corrupted: checksum mismatch (stored ", hex32(stored), ", computed ", hex32(computed), ")");
+
+    Reader body(bytes, kHeaderBytes, source, fn);
+    read_body(body, header, n, state);
+    if (body.at() != expected - kChecksumBytes)
+        fail(DPSM_ERR_INTERNAL, fn, "read ", body.at(), " bytes of ", source, ", expected ", expected - kChecksumBytes);
+    check_values(header, state, n, source, fn);
+    state.scheme = header.scheme == kIsotropic ? kIsotropic : kPairwise;
+    state.last_step.at_rest = header.at_rest != 0;
+    for (int side = 0; side < 4; ++side) state.side_open[side] = header.side_open[side] != 0;
+    geometry = Geometry{static_cast<int>(header.dim), header.axisymmetric != 0, header.nx, header.ny, header.dx, header.dy};
+}
+
+}  // namespace dpsm

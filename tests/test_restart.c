@@ -1,0 +1,622 @@
+/* Restart files (dpsm_save, dpsm_load): a grid saved mid-run and loaded
+ * continues bit for bit, for every kind of grid and every feature at once;
+ * every changed byte and every truncation of a file is refused with
+ * DPSM_ERR_BAD_FILE and no grid; files that cannot be read or written give
+ * DPSM_ERR_IO naming the path; a failed save leaves the old file as it was.
+ * Each test prints the figures it checks (file sizes, bytes tried). */
+#include <errno.h>
+#include <math.h>
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cmocka.h>
+
+#include "test_support.h"
+
+static const double kPi = 3.14159265358979323846;
+
+/* Offsets of version 1 of the format (docs/guide_restart.md). */
+enum {
+    kOffsetVersion = 8,
+    kOffsetNx = 20,
+    kOffsetRepose = 52,
+    kHeaderChecksum = 216,
+    kHeaderBytes = 220,
+};
+
+static char dir[256];
+
+static int make_dir(void **state) {
+    (void)state;
+    const char *tmp = getenv("TMPDIR");
+    snprintf(dir, sizeof dir, "%s/dpsm-restart-XXXXXX", tmp && *tmp ? tmp : "/tmp");
+    return mkdtemp(dir) ? 0 : -1;
+}
+
+static int remove_dir(void **state) {
+    (void)state;
+    char cmd[300];
+    snprintf(cmd, sizeof cmd, "rm -rf '%s'", dir);
+    return system(cmd) == 0 ? 0 : -1;
+}
+
+static void path_of(char *out, size_t size, const char *name) { snprintf(out, size, "%s/%s", dir, name); }
+
+static unsigned char *read_file(const char *path, size_t *size) {
+    FILE *f = fopen(path, "rb");
+    REQUIRE(f != NULL, "cannot open %s: %s", path, strerror(errno));
+    fseek(f, 0, SEEK_END);
+    const long n = ftell(f);
+    fseek(f, 0, SEEK_SET);
+    unsigned char *bytes = malloc((size_t)n + 1);
+    REQUIRE(fread(bytes, 1, (size_t)n, f) == (size_t)n, "cannot read %s", path);
+    fclose(f);
+    *size = (size_t)n;
+    return bytes;
+}
+
+static void write_file(const char *path, const unsigned char *bytes, size_t size) {
+    FILE *f = fopen(path, "wb");
+    REQUIRE(f != NULL, "cannot create %s: %s", path, strerror(errno));
+    REQUIRE(fwrite(bytes, 1, size, f) == size, "cannot write %s", path);
+    REQUIRE(fclose(f) == 0, "cannot close %s", path);
+}
+
+/* The standard CRC-32 (zlib's), written here again so that the test checks
+ * the format, not the library against itself. */
+static uint32_t crc32_of(const unsigned char *bytes, size_t n) {
+    uint32_t c = 0xffffffffu;
+    for (size_t k = 0; k < n; ++k) {
+        c ^= bytes[k];
+        for (int b = 0; b < 8; ++b) c = (c & 1u) ? 0xedb88320u ^ (c >> 1) : c >> 1;
+    }
+    return ~c;
+}
+
+static uint32_t get_u32(const unsigned char *p) {
+    return (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24;
+}
+
+static void put_u32(unsigned char *p, uint32_t v) {
+    for (int k = 0; k < 4; ++k) p[k] = (unsigned char)(v >> (8 * k));
+}
+
+static void put_f64(unsigned char *p, double v) {
+    uint64_t bits;
+    memcpy(&bits, &v, sizeof bits);
+    for (int k = 0; k < 8; ++k) p[k] = (unsigned char)(bits >> (8 * k));
+}
+
+/* Makes both checksums of a file right again after a deliberate change. */
+static void reseal(unsigned char *bytes, size_t size) {
+    put_u32(bytes + kHeaderChecksum, crc32_of(bytes, kHeaderChecksum));
+    put_u32(bytes + size - 4, crc32_of(bytes, size - 4));
+}
+
+/* Everything a host can read back, bit for bit: heights, the five ledger
+ * figures, the stable step, and the step information (the cell updates only
+ * when `with_cost`: a loaded grid looks at every tile once more, which costs
+ * work but changes no result). */
+static void require_same(const dpsm_grid *a, const dpsm_grid *b, int with_cost, const char *when) {
+    int64_t nx, ny, nx2, ny2;
+    CHECK_OK(a, dpsm_get_shape(a, &nx, &ny));
+    CHECK_OK(b, dpsm_get_shape(b, &nx2, &ny2));
+    REQUIRE(nx == nx2 && ny == ny2, "%s: shapes %lld x %lld and %lld x %lld", when, (long long)nx, (long long)ny,
+            (long long)nx2, (long long)ny2);
+    const size_t n = (size_t)(nx * ny);
+    double *ha = malloc(sizeof(double) * n), *hb = malloc(sizeof(double) * n);
+    CHECK_OK(a, dpsm_get_heights(a, ha));
+    CHECK_OK(b, dpsm_get_heights(b, hb));
+    size_t differ = 0;
+    for (size_t c = 0; c < n; ++c) differ += memcmp(&ha[c], &hb[c], sizeof(double)) != 0;
+    REQUIRE(differ == 0, "%s: %zu of %zu heights differ", when, differ, n);
+    for (int q = DPSM_MASS_TOTAL; q <= DPSM_MASS_UNMET; ++q) {
+        double ma, mb;
+        CHECK_OK(a, dpsm_get_mass(a, q, &ma));
+        CHECK_OK(b, dpsm_get_mass(b, q, &mb));
+        REQUIRE(memcmp(&ma, &mb, sizeof ma) == 0, "%s: mass quantity %d is %.17g and %.17g", when, q, ma, mb);
+    }
+    for (int item = DPSM_INFO_SUBSTEPS; item <= DPSM_INFO_CELL_UPDATES; ++item) {
+        if (item == DPSM_INFO_CELL_UPDATES && !with_cost) continue;
+        double va, vb;
+        CHECK_OK(a, dpsm_get_step_info(a, item, &va));
+        CHECK_OK(b, dpsm_get_step_info(b, item, &vb));
+        REQUIRE(memcmp(&va, &vb, sizeof va) == 0, "%s: step info %d is %.17g and %.17g", when, item, va, vb);
+    }
+    double da, db;
+    CHECK_OK(a, dpsm_stable_dt(a, &da));
+    CHECK_OK(b, dpsm_stable_dt(b, &db));
+    REQUIRE(memcmp(&da, &db, sizeof da) == 0, "%s: stable steps %.17g and %.17g", when, da, db);
+    free(ha);
+    free(hb);
+}
+
+/* A reproducible rough terrain in [0, amplitude). */
+static void rough(double *h, size_t n, double amplitude, unsigned seed) {
+    unsigned s = seed;
+    for (size_t c = 0; c < n; ++c) {
+        s = s * 1664525u + 1013904223u;
+        h[c] = amplitude * (double)(s >> 8) / (double)(1u << 24);
+    }
+}
+
+/* The calls a host makes after the restart, applied to both grids alike. */
+typedef void (*continuation)(dpsm_grid *g, int round);
+
+/* Saves `g` mid-run, loads it, checks the loaded grid reads back the same,
+ * that saving it again gives the same bytes, then runs `more` on both and
+ * compares after each round. */
+static void require_continues(dpsm_grid *g, continuation more, int rounds, const char *name) {
+    char path[300], again[300];
+    path_of(path, sizeof path, name);
+    snprintf(again, sizeof again, "%s.again", path);
+    CHECK_OK(g, dpsm_save(g, path));
+    dpsm_grid *loaded = NULL;
+    CHECK_OK(NULL, dpsm_load(path, &loaded));
+    assert_non_null(loaded);
+    require_same(g, loaded, 1, name);
+    /* Every field comes back exactly: the loaded grid writes the same file. */
+    CHECK_OK(loaded, dpsm_save(loaded, again));
+    size_t n1, n2;
+    unsigned char *b1 = read_file(path, &n1), *b2 = read_file(again, &n2);
+    REQUIRE(n1 == n2 && memcmp(b1, b2, n1) == 0, "%s: the loaded grid saves a different file (%zu, %zu bytes)", name,
+            n1, n2);
+    REQUIRE(crc32_of(b1, n1 - 4) == get_u32(b1 + n1 - 4), "%s: the last 4 bytes are not the file's CRC-32", name);
+    print_message("%s: %zu bytes, continues bit for bit over %d rounds\n", name, n1, rounds);
+    free(b1);
+    free(b2);
+    for (int round = 0; round < rounds; ++round) {
+        more(g, round);
+        more(loaded, round);
+        char when[64];
+        snprintf(when, sizeof when, "%s, round %d", name, round);
+        require_same(g, loaded, 0, when);
+    }
+    dpsm_destroy(loaded);
+}
+
+/* ---- the scenes ------------------------------------------------------------ */
+
+enum { kNx = 70, kNy = 50 };  /* more than one tile of 64 x 64 cells */
+
+static void continue_full(dpsm_grid *g, int round) {
+    CHECK_OK(g, dpsm_step(g, 0.02));
+    if (round == 1) {
+        /* The host drops sand on a block and changes the source. */
+        double dh[6 * 4];
+        for (int k = 0; k < 24; ++k) dh[k] = 0.05 * (k % 5);
+        CHECK_OK(g, dpsm_add_heights_region(g, 30, 20, 6, 4, dh));
+        double *q = calloc(kNx * kNy, sizeof(double));
+        for (int c = 0; c < kNx * kNy; ++c) q[c] = (c % kNx) < 20 ? -0.3 : 0.01;
+        CHECK_OK(g, dpsm_set_source(g, q));
+        free(q);
+    }
+    if (round == 3) CHECK_OK(g, dpsm_step(g, 5.0));
+}
+
+/* Every feature at once: obstacles and open cells, open sides, a source
+ * with erosion on a bed (some of it unmet), an angle field, exponent 1.5, a
+ * static angle, both schemes, several threads. */
+static void test_every_feature_continues_bit_for_bit(void **state) {
+    (void)state;
+    for (int scheme = DPSM_SCHEME_PAIRWISE; scheme <= DPSM_SCHEME_ISOTROPIC; ++scheme) {
+        const size_t n = kNx * kNy;
+        dpsm_grid *g = NULL;
+        CHECK_OK(NULL, dpsm_create_2d(kNx, kNy, 0.1, 0.08, &g));
+        CHECK_OK(g, dpsm_set_scheme(g, scheme));
+        CHECK_OK(g, dpsm_set_repose_angle(g, 0.55));
+        CHECK_OK(g, dpsm_set_mobility(g, 1.7));
+        CHECK_OK(g, dpsm_set_rest_tolerance(g, 3e-6));
+        CHECK_OK(g, dpsm_set_max_substeps(g, 5000000));
+        CHECK_OK(g, dpsm_set_threads(g, 2));
+        CHECK_OK(g, dpsm_set_boundary(g, DPSM_XMAX, DPSM_OPEN));
+        CHECK_OK(g, dpsm_set_boundary(g, DPSM_YMIN, DPSM_OPEN));
+        double *h = malloc(sizeof(double) * n), *zb = malloc(sizeof(double) * n);
+        double *q = malloc(sizeof(double) * n), *theta = malloc(sizeof(double) * n);
+        uint8_t *kinds = malloc(n);
+        rough(h, n, 0.3, 11u);
+        for (size_t c = 0; c < n; ++c) {
+            const double x = (double)(c % kNx) * 0.1, y = (double)(c / kNx) * 0.08;
+            h[c] += fmax(0.0, 2.0 - 1.5 * hypot(x - 3.5, y - 2.0));
+            zb[c] = h[c] - ((c % kNx) < 20 ? 0.02 : 0.5); /* thin sand on the left */
+            q[c] = (c % kNx) < 20 ? -0.5 : 0.02 * (double)(c % 3);
+            theta[c] = 0.5 + 0.1 * (double)((c / 7) % 3);
+            kinds[c] = DPSM_CELL_SAND;
+        }
+        for (int j = 10; j < 14; ++j)
+            for (int i = 45; i < 50; ++i) kinds[i + kNx * j] = DPSM_CELL_WALL;
+        kinds[5 + kNx * 40] = DPSM_CELL_OPEN;
+        kinds[66 + kNx * 45] = DPSM_CELL_OPEN;
+        CHECK_OK(g, dpsm_set_heights(g, h));
+        CHECK_OK(g, dpsm_set_cell_kinds(g, kinds));
+        CHECK_OK(g, dpsm_set_bedrock(g, zb));
+        CHECK_OK(g, dpsm_set_repose_angle_field(g, theta));
+        CHECK_OK(g, dpsm_set_flux_exponent(g, 1.5));
+        CHECK_OK(g, dpsm_set_static_angle(g, 0.62));
+        CHECK_OK(g, dpsm_set_source(g, q));
+        for (int k = 0; k < 3; ++k) CHECK_OK(g, dpsm_step(g, 0.03));
+        double unmet, outflow;
+        CHECK_OK(g, dpsm_get_mass(g, DPSM_MASS_UNMET, &unmet));
+        CHECK_OK(g, dpsm_get_mass(g, DPSM_MASS_OUTFLOW, &outflow));
+        print_message("scheme %d at the save: unmet %.6g, outflow %.6g\n", scheme, unmet, outflow);
+        /* The accounts the file must carry are not trivially 0. */
+        REQUIRE(unmet > 0.0 && outflow != 0.0, "unmet %g, outflow %g", unmet, outflow);
+        require_continues(g, continue_full, 5, scheme ? "full_isotropic.dpsm" : "full_pairwise.dpsm");
+        free(h);
+        free(zb);
+        free(q);
+        free(theta);
+        free(kinds);
+        dpsm_destroy(g);
+    }
+}
+
+static void continue_plain(dpsm_grid *g, int round) { CHECK_OK(g, dpsm_step(g, round == 2 ? 10.0 : 0.01)); }
+
+static void test_plain_2d_continues_bit_for_bit(void **state) {
+    (void)state;
+    const int64_t nx = 64, ny = 64;
+    dpsm_grid *g = NULL;
+    CHECK_OK(NULL, dpsm_create_2d(nx, ny, 0.1, 0.1, &g));
+    double *h = malloc(sizeof(double) * nx * ny);
+    for (int64_t c = 0; c < nx * ny; ++c)
+        h[c] = fmax(0.0, 2.0 - 2.0 * hypot((double)(c % nx) * 0.1 - 3.2, (double)(c / nx) * 0.1 - 3.2));
+    CHECK_OK(g, dpsm_set_heights(g, h));
+    CHECK_OK(g, dpsm_step(g, 0.02));
+    require_continues(g, continue_plain, 4, "plain_64x64.dpsm");
+    free(h);
+    dpsm_destroy(g);
+}
+
+static void continue_1d(dpsm_grid *g, int round) {
+    if (round == 1) CHECK_OK(g, dpsm_set_source(g, NULL));
+    CHECK_OK(g, dpsm_step(g, 0.05));
+}
+
+static void test_1d_continues_bit_for_bit(void **state) {
+    (void)state;
+    const int64_t nx = 90;
+    dpsm_grid *g = NULL;
+    CHECK_OK(NULL, dpsm_create_1d(nx, 0.05, &g));
+    CHECK_OK(g, dpsm_set_boundary(g, DPSM_XMAX, DPSM_OPEN));
+    double h[90], q[90], zb[90];
+    rough(h, 90, 0.2, 5u);
+    for (int c = 0; c < 90; ++c) {
+        h[c] += c < 30 ? 3.0 - 0.1 * c : 0.0;
+        zb[c] = h[c] - 0.05;
+        q[c] = c > 60 ? -0.2 : 0.05;
+    }
+    CHECK_OK(g, dpsm_set_heights(g, h));
+    CHECK_OK(g, dpsm_set_bedrock(g, zb));
+    CHECK_OK(g, dpsm_set_source(g, q));
+    CHECK_OK(g, dpsm_set_flux_exponent(g, 2.0));
+    CHECK_OK(g, dpsm_set_static_angle(g, 0.7));
+    CHECK_OK(g, dpsm_step(g, 0.05));
+    require_continues(g, continue_1d, 4, "line.dpsm");
+    dpsm_destroy(g);
+}
+
+static void continue_axisymmetric(dpsm_grid *g, int round) { CHECK_OK(g, dpsm_step(g, round == 3 ? 50.0 : 0.01)); }
+
+static void test_axisymmetric_continues_bit_for_bit(void **state) {
+    (void)state;
+    dpsm_grid *g = NULL;
+    CHECK_OK(NULL, dpsm_create_axisymmetric(60, 0.05, &g));
+    CHECK_OK(g, dpsm_set_boundary(g, DPSM_XMAX, DPSM_OPEN));
+    double h[60], theta[60];
+    for (int c = 0; c < 60; ++c) {
+        h[c] = c < 20 ? 2.0 : 0.0;
+        theta[c] = 0.5 + 0.002 * c;
+    }
+    CHECK_OK(g, dpsm_set_heights(g, h));
+    CHECK_OK(g, dpsm_set_repose_angle_field(g, theta));
+    CHECK_OK(g, dpsm_step(g, 0.02));
+    require_continues(g, continue_axisymmetric, 4, "rings.dpsm");
+    dpsm_destroy(g);
+}
+
+/* ---- damaged files ------------------------------------------------------------ */
+
+/* A small file with every optional array: source, bed, angle field, moving cells. */
+static unsigned char *small_file(const char *path, size_t *size) {
+    dpsm_grid *g = NULL;
+    CHECK_OK(NULL, dpsm_create_2d(5, 4, 0.1, 0.1, &g));
+    double h[20], zb[20], q[20], theta[20];
+    for (int c = 0; c < 20; ++c) {
+        h[c] = 0.1 * c;
+        zb[c] = h[c] - 0.5;
+        q[c] = 0.01;
+        theta[c] = 0.5;
+    }
+    CHECK_OK(g, dpsm_set_heights(g, h));
+    CHECK_OK(g, dpsm_set_bedrock(g, zb));
+    CHECK_OK(g, dpsm_set_source(g, q));
+    CHECK_OK(g, dpsm_set_repose_angle_field(g, theta));
+    CHECK_OK(g, dpsm_set_static_angle(g, 0.6));
+    CHECK_OK(g, dpsm_step(g, 0.1));
+    CHECK_OK(g, dpsm_save(g, path));
+    dpsm_destroy(g);
+    return read_file(path, size);
+}
+
+/* dpsm_load must refuse the file with DPSM_ERR_BAD_FILE, make no grid and
+ * name the file; `phrase` (if any) must be in the message. */
+static void require_refused(const char *path, const char *phrase, const char *what) {
+    dpsm_grid *out = (dpsm_grid *)&out; /* not NULL: a failure must reset it */
+    const int status = dpsm_load(path, &out);
+    const char *message = dpsm_last_error(NULL);
+    REQUIRE(status == DPSM_ERR_BAD_FILE, "%s: dpsm_load returned %s (%s)", what, dpsm_status_string(status), message);
+    REQUIRE(out == NULL, "%s: *out is not NULL after a failure", what);
+    REQUIRE(strstr(message, path) != NULL && strstr(message, "dpsm_load") != NULL,
+            "%s: the message does not name the function and the file: %s", what, message);
+    if (phrase) REQUIRE(strstr(message, phrase) != NULL, "%s: the message lacks '%s': %s", what, phrase, message);
+}
+
+static void test_every_changed_byte_is_refused(void **state) {
+    (void)state;
+    char path[300], bad[300];
+    path_of(path, sizeof path, "small.dpsm");
+    path_of(bad, sizeof bad, "changed.dpsm");
+    size_t size;
+    unsigned char *good = small_file(path, &size);
+    REQUIRE(size == kHeaderBytes + 20 * (8 + 4 + 1 + 8 + 8 + 8 + 1) + 4, "the small file has %zu bytes", size);
+    unsigned char *bytes = malloc(size);
+    const unsigned char masks[2] = {0xff, 0x01};
+    int tried = 0;
+    for (int m = 0; m < 2; ++m)
+        for (size_t at = 0; at < size; ++at) {
+            memcpy(bytes, good, size);
+            bytes[at] ^= masks[m];
+            write_file(bad, bytes, size);
+            char what[96];
+            snprintf(what, sizeof what, "byte %zu ^ 0x%02x", at, masks[m]);
+            /* The part of the file each byte lies in says which message. */
+            const char *phrase = at < 8 ? "not a dpsm restart file"
+                                 : at < 12 ? NULL /* a newer version, or version 0 */
+                                 : at < kHeaderBytes ? "checksum mismatch in its header"
+                                                     : "checksum mismatch";
+            require_refused(bad, phrase, what);
+            ++tried;
+        }
+    print_message("%d changed files of %zu bytes, all refused\n", tried, size);
+    /* The intact file still loads. */
+    dpsm_grid *g = NULL;
+    CHECK_OK(NULL, dpsm_load(path, &g));
+    dpsm_destroy(g);
+    free(bytes);
+    free(good);
+}
+
+static void test_every_truncation_is_refused(void **state) {
+    (void)state;
+    char path[300], cut[300];
+    path_of(path, sizeof path, "small.dpsm");
+    path_of(cut, sizeof cut, "cut.dpsm");
+    size_t size;
+    unsigned char *good = small_file(path, &size);
+    for (size_t length = 0; length < size; ++length) {
+        write_file(cut, good, length);
+        char what[64];
+        snprintf(what, sizeof what, "the first %zu bytes", length);
+        require_refused(cut, length == 0 ? "is empty" : "truncated", what);
+    }
+    /* The message says how much was expected and found. */
+    write_file(cut, good, size - 1);
+    char expected[128];
+    snprintf(expected, sizeof expected, "expected %zu bytes, found %zu", size, size - 1);
+    require_refused(cut, expected, "one byte short");
+    /* One byte more is refused too. */
+    unsigned char *longer = malloc(size + 1);
+    memcpy(longer, good, size);
+    longer[size] = 0;
+    write_file(cut, longer, size + 1);
+    require_refused(cut, "data after the end", "one byte more");
+    print_message("%zu truncations and one extension of %zu bytes, all refused\n", size, size);
+    free(longer);
+    free(good);
+}
+
+/* Behind intact checksums, every value is still checked as a setter would. */
+static void test_values_are_checked_behind_the_checksum(void **state) {
+    (void)state;
+    char path[300], bad[300];
+    path_of(path, sizeof path, "small.dpsm");
+    path_of(bad, sizeof bad, "resealed.dpsm");
+    size_t size;
+    unsigned char *good = small_file(path, &size);
+    REQUIRE(crc32_of((const unsigned char *)"123456789", 9) == 0xcbf43926u, "the test's CRC-32 is not the standard one");
+    REQUIRE(get_u32(good + kHeaderChecksum) == crc32_of(good, kHeaderChecksum), "the header's checksum is not its CRC-32");
+    unsigned char *bytes = malloc(size);
+
+    memcpy(bytes, good, size);
+    put_u32(bytes + kOffsetVersion, 2);
+    reseal(bytes, size);
+    write_file(bad, bytes, size);
+    require_refused(bad, "written by a newer dpsm, version 2", "version 2");
+
+    memcpy(bytes, good, size);
+    put_f64(bytes + kOffsetRepose, 2.0);
+    reseal(bytes, size);
+    write_file(bad, bytes, size);
+    require_refused(bad, "angle of repose 2 radians", "a repose angle of 2");
+
+    memcpy(bytes, good, size);
+    bytes[kHeaderBytes + 20 * 12 + 7] = 3; /* kinds[7] */
+    reseal(bytes, size);
+    write_file(bad, bytes, size);
+    require_refused(bad, "kinds[7] (cell i = 2, j = 1) = 3", "a cell kind 3");
+
+    memcpy(bytes, good, size);
+    put_f64(bytes + kHeaderBytes + 8 * 4, -1.0); /* h[4], below its bed */
+    reseal(bytes, size);
+    write_file(bad, bytes, size);
+    require_refused(bad, "below its bed", "a height below the bed");
+
+    memcpy(bytes, good, size);
+    put_f64(bytes + kHeaderBytes + 8 * 4, NAN);
+    reseal(bytes, size);
+    write_file(bad, bytes, size);
+    require_refused(bad, "h[4]", "a NaN height");
+
+    /* A header that claims a huge grid is refused by the size of the file,
+     * before anything of that size is allocated. */
+    memcpy(bytes, good, size);
+    put_u32(bytes + kOffsetNx, 0x40000000u);
+    reseal(bytes, size);
+    write_file(bad, bytes, size);
+    require_refused(bad, "truncated: expected", "nx = 2^30");
+    free(bytes);
+    free(good);
+}
+
+/* ---- files that cannot be read or written ----------------------------------- */
+
+static void require_io_failure(int status, const char *message, const char *path, const char *what) {
+    REQUIRE(status == DPSM_ERR_IO, "%s: returned %s (%s)", what, dpsm_status_string(status), message);
+    REQUIRE(strstr(message, path) != NULL, "%s: the message does not name %s: %s", what, path, message);
+}
+
+static void test_files_that_cannot_be_used(void **state) {
+    (void)state;
+    char missing[300], empty[300];
+    path_of(missing, sizeof missing, "missing.dpsm");
+    path_of(empty, sizeof empty, "empty.dpsm");
+    dpsm_grid *out = (dpsm_grid *)&out;
+    int status = dpsm_load(missing, &out);
+    require_io_failure(status, dpsm_last_error(NULL), missing, "a missing file");
+    assert_null(out);
+    assert_non_null(strstr(dpsm_last_error(NULL), "No such file"));
+    out = (dpsm_grid *)&out;
+    status = dpsm_load(dir, &out);
+    require_io_failure(status, dpsm_last_error(NULL), dir, "a directory");
+    assert_null(out);
+    write_file(empty, (const unsigned char *)"", 0);
+    require_refused(empty, "is empty", "an empty file");
+
+    dpsm_grid *g = NULL;
+    CHECK_OK(NULL, dpsm_create_1d(8, 0.1, &g));
+    const char *unwritable = "/nonexistent-dir/x";
+    status = dpsm_save(g, unwritable);
+    require_io_failure(status, dpsm_last_error(g), unwritable, "saving into a missing directory");
+    assert_non_null(strstr(dpsm_last_error(g), "dpsm_save"));
+    /* A directory is no file to replace, and no temporary file stays behind. */
+    char tmp[300];
+    snprintf(tmp, sizeof tmp, "%s.tmp", dir);
+    status = dpsm_save(g, dir);
+    require_io_failure(status, dpsm_last_error(g), dir, "saving over a directory");
+    struct stat st;
+    REQUIRE(stat(tmp, &st) != 0, "%s is left behind", tmp);
+    /* The grid is as it was and works. */
+    CHECK_OK(g, dpsm_step(g, 0.1));
+    assert_string_equal(dpsm_last_error(g), "");
+    dpsm_destroy(g);
+}
+
+/* A save that fails leaves the file it would have replaced as it was. */
+static void test_failed_save_leaves_the_old_file(void **state) {
+    (void)state;
+    char path[300], tmp[310];
+    path_of(path, sizeof path, "kept.dpsm");
+    snprintf(tmp, sizeof tmp, "%s.tmp", path);
+    dpsm_grid *g = NULL;
+    CHECK_OK(NULL, dpsm_create_2d(6, 5, 0.1, 0.1, &g));
+    double h[30];
+    for (int c = 0; c < 30; ++c) h[c] = 0.3 * (c % 4);
+    CHECK_OK(g, dpsm_set_heights(g, h));
+    CHECK_OK(g, dpsm_save(g, path));
+    size_t size_before;
+    unsigned char *before = read_file(path, &size_before);
+    /* The temporary file cannot be made: a directory stands in its way. */
+    REQUIRE(mkdir(tmp, 0700) == 0, "cannot make %s", tmp);
+    CHECK_OK(g, dpsm_step(g, 1.0));
+    const int status = dpsm_save(g, path);
+    require_io_failure(status, dpsm_last_error(g), path, "saving with the temporary file blocked");
+    size_t size_after;
+    unsigned char *after = read_file(path, &size_after);
+    REQUIRE(size_after == size_before && memcmp(before, after, size_before) == 0, "the old file changed");
+    rmdir(tmp);
+    /* And it is still a good file of the grid as it was saved. */
+    dpsm_grid *loaded = NULL;
+    CHECK_OK(NULL, dpsm_load(path, &loaded));
+    double h2[30];
+    CHECK_OK(loaded, dpsm_get_heights(loaded, h2));
+    assert_memory_equal(h, h2, sizeof h);
+    /* A save that succeeds replaces it. */
+    CHECK_OK(g, dpsm_save(g, path));
+    free(after);
+    after = read_file(path, &size_after);
+    REQUIRE(memcmp(before, after, size_before) != 0, "a successful save did not replace the file");
+    free(before);
+    free(after);
+    dpsm_destroy(loaded);
+    dpsm_destroy(g);
+}
+
+static void test_null_arguments(void **state) {
+    (void)state;
+    char path[300];
+    path_of(path, sizeof path, "null.dpsm");
+    dpsm_grid *g = NULL;
+    CHECK_OK(NULL, dpsm_create_1d(4, 0.1, &g));
+    assert_int_equal(dpsm_save(NULL, path), DPSM_ERR_NULL_POINTER);
+    assert_non_null(strstr(dpsm_last_error(NULL), "dpsm_save"));
+    assert_int_equal(dpsm_save(g, NULL), DPSM_ERR_NULL_POINTER);
+    assert_non_null(strstr(dpsm_last_error(g), "path"));
+    dpsm_grid *out = (dpsm_grid *)&out;
+    assert_int_equal(dpsm_load(NULL, &out), DPSM_ERR_NULL_POINTER);
+    assert_null(out);
+    assert_non_null(strstr(dpsm_last_error(NULL), "path"));
+    CHECK_OK(g, dpsm_save(g, path));
+    assert_int_equal(dpsm_load(path, NULL), DPSM_ERR_NULL_POINTER);
+    assert_non_null(strstr(dpsm_last_error(NULL), "out"));
+    dpsm_destroy(g);
+}
+
+/* The figure of the report: a 64 x 64 grid with and without every array. */
+static void test_file_sizes(void **state) {
+    (void)state;
+    char path[300];
+    path_of(path, sizeof path, "size.dpsm");
+    dpsm_grid *g = NULL;
+    CHECK_OK(NULL, dpsm_create_2d(64, 64, 0.1, 0.1, &g));
+    CHECK_OK(g, dpsm_save(g, path));
+    size_t plain, full;
+    free(read_file(path, &plain));
+    double *v = calloc(64 * 64, sizeof(double));
+    CHECK_OK(g, dpsm_set_source(g, v));
+    CHECK_OK(g, dpsm_set_bedrock(g, v));
+    for (int c = 0; c < 64 * 64; ++c) v[c] = 0.5;
+    CHECK_OK(g, dpsm_set_repose_angle_field(g, v));
+    CHECK_OK(g, dpsm_set_static_angle(g, 0.6));
+    CHECK_OK(g, dpsm_save(g, path));
+    free(read_file(path, &full));
+    print_message("64 x 64: %zu bytes plain, %zu bytes with every optional array\n", plain, full);
+    assert_int_equal(plain, kHeaderBytes + 64 * 64 * 13 + 4);
+    assert_int_equal(full, kHeaderBytes + 64 * 64 * 38 + 4);
+    free(v);
+    dpsm_destroy(g);
+}
+
+int main(void) {
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_every_feature_continues_bit_for_bit),
+        cmocka_unit_test(test_plain_2d_continues_bit_for_bit),
+        cmocka_unit_test(test_1d_continues_bit_for_bit),
+        cmocka_unit_test(test_axisymmetric_continues_bit_for_bit),
+        cmocka_unit_test(test_every_changed_byte_is_refused),
+        cmocka_unit_test(test_every_truncation_is_refused),
+        cmocka_unit_test(test_values_are_checked_behind_the_checksum),
+        cmocka_unit_test(test_files_that_cannot_be_used),
+        cmocka_unit_test(test_failed_save_leaves_the_old_file),
+        cmocka_unit_test(test_null_arguments),
+        cmocka_unit_test(test_file_sizes),
+    };
+    return cmocka_run_group_tests(tests, make_dir, remove_dir);
+}
