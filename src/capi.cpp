@@ -12,13 +12,8 @@
 #include "dpsm/dpsm.h"
 #include "error.hpp"
 #include "grid.hpp"
+#include "handle.hpp"
 #include "stepper.hpp"
-
-struct dpsm_grid {
-    explicit dpsm_grid(const dpsm::Geometry &geometry) : core(geometry) {}
-    dpsm::Grid core;
-    mutable std::string last_error;
-};
 
 namespace {
 
@@ -168,6 +163,8 @@ int create(int dim, bool axisymmetric, std::int64_t nx, std::int64_t ny, double 
 }
 
 }  // namespace
+
+void dpsm::set_error_without_grid(const char *message) noexcept { record_error(nullptr, message); }
 
 extern "C" {
 
@@ -338,15 +335,17 @@ int dpsm_get_mass(const dpsm_grid *g, int quantity, double *value) {
         require_grid(g, fn);
         require_pointer(value, fn, "value");
         const dpsm::MassLedger &ledger = g->core.ledger();
+        double local = 0.0;
         switch (quantity) {
-            case DPSM_MASS_TOTAL: *value = g->core.total_mass(); break;
-            case DPSM_MASS_SOURCED: *value = ledger.sourced.value(); break;
-            case DPSM_MASS_EXTERNAL: *value = ledger.external.value(); break;
-            case DPSM_MASS_OUTFLOW: *value = ledger.outflow.value(); break;
+            case DPSM_MASS_TOTAL: local = g->core.total_mass(); break;
+            case DPSM_MASS_SOURCED: local = ledger.sourced.value(); break;
+            case DPSM_MASS_EXTERNAL: local = ledger.external.value(); break;
+            case DPSM_MASS_OUTFLOW: local = ledger.outflow.value(); break;
             default:
                 fail(DPSM_ERR_UNKNOWN_ENUM, fn, "quantity = ", quantity,
                      " is not DPSM_MASS_TOTAL, DPSM_MASS_SOURCED, DPSM_MASS_EXTERNAL or DPSM_MASS_OUTFLOW");
         }
+        *value = g->core.global_sum(local);  // a distributed grid's figure is global
     });
 }
 

@@ -2,6 +2,7 @@
 
 #include <cmath>
 
+#include "decomposition.hpp"
 #include "dpsm/dpsm.h"
 #include "tiled_sweep.hpp"
 
@@ -26,6 +27,12 @@ Grid::Grid(const Geometry &geometry)
 }
 
 Grid::~Grid() = default;
+
+void Grid::set_decomposition(std::unique_ptr<Decomposition> decomposition) {
+    decomposition_ = std::move(decomposition);
+}
+
+double Grid::global_sum(double local) const { return decomposition_ ? decomposition_->sum(local) : local; }
 
 TiledWorkspace &Grid::tiled_workspace() {
     if (!tiled_) tiled_ = std::make_unique<TiledWorkspace>();
@@ -86,6 +93,7 @@ void Grid::set_cell_kinds(const std::uint8_t *kinds) {
     }
     wall_cells_ = walls;
     open_cells_ = opens;
+    ++masks_version_;
     ledger_.external.add(change.value());
     update_source_summary();
     update_open_levels();
@@ -100,6 +108,7 @@ void Grid::set_source(const double *q) {
         source_.assign(q, q + heights_.size());
     else
         source_.clear();
+    ++masks_version_;
     update_source_summary();
 }
 

@@ -9,6 +9,7 @@
 #endif
 
 #include "active_set.hpp"
+#include "decomposition.hpp"
 #include "grid.hpp"
 
 namespace dpsm {
@@ -27,21 +28,23 @@ int thread_count(int requested) {
 #endif
 }
 
-// The kind of a ghost cell beyond the domain: a sink at 0 beyond an open
-// side, a wall beyond a wall side; a corner is a sink only if both sides are.
-std::uint8_t ghost_kind(const Grid &grid, std::int64_t i, std::int64_t j) {
-    const Geometry &geo = grid.geometry();
+// The kind of a ghost cell (i, j) beyond a domain of nx x ny cells: a sink at
+// 0 beyond an open side, a wall beyond a wall side; a corner is a sink only if
+// both sides are. (A block of a distributed grid asks in global coordinates.)
+std::uint8_t ghost_kind(const Grid &grid, std::int64_t i, std::int64_t j, std::int64_t nx, std::int64_t ny) {
     bool open = true;
     if (i < 0) open = open && grid.side_open(kXMin);
-    if (i >= geo.nx) open = open && grid.side_open(kXMax);
+    if (i >= nx) open = open && grid.side_open(kXMax);
     if (j < 0) open = open && grid.side_open(kYMin);
-    if (j >= geo.ny) open = open && grid.side_open(kYMax);
+    if (j >= ny) open = open && grid.side_open(kYMax);
     return open ? kOpen : kWall;
 }
 
-// Copies a tile and its halo into the buffers, ghosts beyond the edge.
+// Copies a tile and its halo into the buffers, ghosts beyond the edge; on a
+// block of a distributed grid, the neighbours' cells from its halo store.
 void gather(const Grid &grid, TileBuffers &b, std::int64_t gi0, std::int64_t gj0, bool masked, bool source) {
     const Geometry &geo = grid.geometry();
+    const HaloStore *halo = grid.decomposition() ? &grid.decomposition()->halo() : nullptr;
     const double *h = grid.heights().data();
     const float *res = grid.residuals().data();
     const std::uint8_t *kind = grid.kinds().data();
@@ -66,10 +69,25 @@ void gather(const Grid &grid, TileBuffers &b, std::int64_t gi0, std::int64_t gj0
         for (int c = 0; c < b.width; ++c) {
             const std::int64_t i = gi0 + c;
             const bool in = i >= 0 && j >= 0 && i < geo.nx && j < geo.ny;
+            if (!in && halo) {
+                if (halo->in_domain(i, j)) {
+                    const std::size_t at = halo->index(i, j);
+                    hb[c] = halo->heights[at];
+                    rb[c] = static_cast<double>(halo->residuals[at]);
+                    if (masked) kb[c] = halo->kinds[at];
+                    if (source) qb[c] = halo->kinds[at] == kSand ? halo->sources[at] : 0.0;
+                } else {
+                    hb[c] = 0.0;
+                    rb[c] = 0.0;
+                    if (masked) kb[c] = ghost_kind(grid, i + halo->i0, j + halo->j0, halo->global_nx, halo->global_ny);
+                    if (source) qb[c] = 0.0;
+                }
+                continue;
+            }
             const std::int64_t cell = in ? i + geo.nx * j : 0;
             hb[c] = in ? h[cell] : 0.0;
             rb[c] = in ? static_cast<double>(res[cell]) : 0.0;
-            if (masked) kb[c] = in ? kind[cell] : ghost_kind(grid, i, j);
+            if (masked) kb[c] = in ? kind[cell] : ghost_kind(grid, i, j, geo.nx, geo.ny);
             if (source) qb[c] = in && kind[cell] == kSand ? q[cell] : 0.0;
         }
     }
@@ -100,6 +118,8 @@ std::int64_t tiled_sweep(Grid &grid, int levels, double dt, std::vector<LevelSum
     const Geometry &geo = grid.geometry();
     ActiveSet &active = grid.active_set();
     TiledWorkspace &ws = grid.tiled_workspace();
+    Decomposition *decomposition = grid.decomposition();
+    if (decomposition) decomposition->before_sweep(grid);  // the neighbours' cells and activity
     active.tiles_to_visit(levels, ws.visit, ws.boxes);
     const std::int64_t visits = static_cast<std::int64_t>(ws.visit.size());
     ws.stats.assign(static_cast<std::size_t>(visits) * levels, TileLevelStats{});
@@ -197,6 +217,7 @@ std::int64_t tiled_sweep(Grid &grid, int levels, double dt, std::vector<LevelSum
         }
         active.hot(ws.visit[k]) = moved;
     }
+    if (decomposition) decomposition->after_sweep(summaries);  // every rank takes the same sub-steps
     return visited_cells;
 }
 
