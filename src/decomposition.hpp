@@ -3,9 +3,10 @@
 // reaches any of this; the core only calls it at the few points where the
 // ranks must agree or see each other's cells:
 //
-//  - gather() (tiled_sweep.cpp) reads cells beyond the block from the
-//    HaloStore: heights and residuals of the neighbours' cells as they were at
-//    the start of the sweep, their kinds and sources as the host last set them;
+//  - after gather() (tiled_sweep.cpp) has copied a tile at the block's edge,
+//    gather_halo() fills its cells beyond the block from the HaloStore:
+//    heights and residuals of the neighbours' cells as they were at the start
+//    of the sweep, their kinds and sources as the host last set them;
 //  - before a sweep the Decomposition refreshes that store (one exchange per
 //    sweep of up to ActiveSet::kMaxLevels sub-steps) and tells the active set
 //    where the neighbours' cells may move (ActiveSet::set_remote_activity);

@@ -28,23 +28,21 @@ int thread_count(int requested) {
 #endif
 }
 
-// The kind of a ghost cell (i, j) beyond a domain of nx x ny cells: a sink at
-// 0 beyond an open side, a wall beyond a wall side; a corner is a sink only if
-// both sides are. (A block of a distributed grid asks in global coordinates.)
-std::uint8_t ghost_kind(const Grid &grid, std::int64_t i, std::int64_t j, std::int64_t nx, std::int64_t ny) {
+// The kind of a ghost cell beyond the domain: a sink at 0 beyond an open
+// side, a wall beyond a wall side; a corner is a sink only if both sides are.
+std::uint8_t ghost_kind(const Grid &grid, std::int64_t i, std::int64_t j) {
+    const Geometry &geo = grid.geometry();
     bool open = true;
     if (i < 0) open = open && grid.side_open(kXMin);
-    if (i >= nx) open = open && grid.side_open(kXMax);
+    if (i >= geo.nx) open = open && grid.side_open(kXMax);
     if (j < 0) open = open && grid.side_open(kYMin);
-    if (j >= ny) open = open && grid.side_open(kYMax);
+    if (j >= geo.ny) open = open && grid.side_open(kYMax);
     return open ? kOpen : kWall;
 }
 
-// Copies a tile and its halo into the buffers, ghosts beyond the edge; on a
-// block of a distributed grid, the neighbours' cells from its halo store.
+// Copies a tile and its halo into the buffers, ghosts beyond the edge.
 void gather(const Grid &grid, TileBuffers &b, std::int64_t gi0, std::int64_t gj0, bool masked, bool source) {
     const Geometry &geo = grid.geometry();
-    const HaloStore *halo = grid.decomposition() ? &grid.decomposition()->halo() : nullptr;
     const double *h = grid.heights().data();
     const float *res = grid.residuals().data();
     const std::uint8_t *kind = grid.kinds().data();
@@ -69,26 +67,59 @@ void gather(const Grid &grid, TileBuffers &b, std::int64_t gi0, std::int64_t gj0
         for (int c = 0; c < b.width; ++c) {
             const std::int64_t i = gi0 + c;
             const bool in = i >= 0 && j >= 0 && i < geo.nx && j < geo.ny;
-            if (!in && halo) {
-                if (halo->in_domain(i, j)) {
-                    const std::size_t at = halo->index(i, j);
-                    hb[c] = halo->heights[at];
-                    rb[c] = static_cast<double>(halo->residuals[at]);
-                    if (masked) kb[c] = halo->kinds[at];
-                    if (source) qb[c] = halo->kinds[at] == kSand ? halo->sources[at] : 0.0;
-                } else {
-                    hb[c] = 0.0;
-                    rb[c] = 0.0;
-                    if (masked) kb[c] = ghost_kind(grid, i + halo->i0, j + halo->j0, halo->global_nx, halo->global_ny);
-                    if (source) qb[c] = 0.0;
-                }
-                continue;
-            }
             const std::int64_t cell = in ? i + geo.nx * j : 0;
             hb[c] = in ? h[cell] : 0.0;
             rb[c] = in ? static_cast<double>(res[cell]) : 0.0;
-            if (masked) kb[c] = in ? kind[cell] : ghost_kind(grid, i, j, geo.nx, geo.ny);
+            if (masked) kb[c] = in ? kind[cell] : ghost_kind(grid, i, j);
             if (source) qb[c] = in && kind[cell] == kSand ? q[cell] : 0.0;
+        }
+    }
+}
+
+// The kind of a ghost cell (i, j) beyond the global domain of a distributed
+// grid, in global coordinates: as ghost_kind, with the global grid's sides.
+std::uint8_t global_ghost_kind(const Grid &grid, const HaloStore &halo, std::int64_t i, std::int64_t j) {
+    bool open = true;
+    if (i < 0) open = open && grid.side_open(kXMin);
+    if (i >= halo.global_nx) open = open && grid.side_open(kXMax);
+    if (j < 0) open = open && grid.side_open(kYMin);
+    if (j >= halo.global_ny) open = open && grid.side_open(kYMax);
+    return open ? kOpen : kWall;
+}
+
+// On a block of a distributed grid, replaces what gather() put in the buffer
+// for the cells beyond the block: the neighbours' cells come from the halo
+// store (decomposition.hpp), the cells beyond the global domain are ghosts of
+// its sides. The block's own cells are left as gather() copied them.
+void gather_halo(const Grid &grid, const HaloStore &halo, TileBuffers &b, std::int64_t gi0, std::int64_t gj0,
+                 bool masked, bool source) {
+    const Geometry &geo = grid.geometry();
+    for (int r = 0; r < b.height; ++r) {
+        const std::int64_t j = gj0 + r;
+        const std::size_t row = static_cast<std::size_t>(r) * b.width;
+        // The block's own columns of this row, [own0, own1) in the buffer (none off the block's rows).
+        int own0 = b.width, own1 = b.width;
+        if (j >= 0 && j < geo.ny) {
+            own0 = static_cast<int>(std::clamp<std::int64_t>(-gi0, 0, b.width));
+            own1 = static_cast<int>(std::clamp<std::int64_t>(geo.nx - gi0, 0, b.width));
+        }
+        for (int c = 0; c < b.width; ++c) {
+            if (c == own0 && own0 < own1) c = own1;
+            if (c >= b.width) break;
+            const std::int64_t i = gi0 + c;
+            const std::size_t at = row + static_cast<std::size_t>(c);
+            if (halo.in_domain(i, j)) {
+                const std::size_t k = halo.index(i, j);
+                b.h[0][at] = halo.heights[k];
+                b.residual[0][at] = static_cast<double>(halo.residuals[k]);
+                if (masked) b.kind[at] = halo.kinds[k];
+                if (source) b.source[at] = halo.kinds[k] == kSand ? halo.sources[k] : 0.0;
+            } else {
+                b.h[0][at] = 0.0;
+                b.residual[0][at] = 0.0;
+                if (masked) b.kind[at] = global_ghost_kind(grid, halo, i + halo.i0, j + halo.j0);
+                if (source) b.source[at] = 0.0;
+            }
         }
     }
 }
@@ -120,6 +151,7 @@ std::int64_t tiled_sweep(Grid &grid, int levels, double dt, std::vector<LevelSum
     TiledWorkspace &ws = grid.tiled_workspace();
     Decomposition *decomposition = grid.decomposition();
     if (decomposition) decomposition->before_sweep(grid);  // the neighbours' cells and activity
+    const HaloStore *halo_store = decomposition ? &decomposition->halo() : nullptr;
     active.tiles_to_visit(levels, ws.visit, ws.boxes);
     const std::int64_t visits = static_cast<std::int64_t>(ws.visit.size());
     ws.stats.assign(static_cast<std::size_t>(visits) * levels, TileLevelStats{});
@@ -147,6 +179,8 @@ std::int64_t tiled_sweep(Grid &grid, int levels, double dt, std::vector<LevelSum
         b.width = static_cast<int>(cells.i1 - cells.i0) + 2 * halo;
         b.height = static_cast<int>(cells.j1 - cells.j0) + 2 * halo;
         gather(grid, b, gi0, gj0, masked, source);
+        if (halo_store && !(gi0 >= 0 && gj0 >= 0 && gi0 + b.width <= geo.nx && gj0 + b.height <= geo.ny))
+            gather_halo(grid, *halo_store, b, gi0, gj0, masked, source);
         const TileLevelFunction kernel = select_tile_kernel(masked, isotropic, source);
         const TileRect tile{halo, b.height - halo, halo, b.width - halo};
         int in = 0;

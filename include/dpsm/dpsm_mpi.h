@@ -28,8 +28,10 @@
  * every rank alike when they differ. All other calls are local to the rank.
  *
  * Link with `-ldpsm_mpi` (pkg-config: `dpsm-mpi`; CMake: `dpsm::dpsm_mpi`)
- * instead of `-ldpsm`: libdpsm_mpi holds the whole library. Include this
- * header after `mpi.h`.
+ * instead of `-ldpsm`: libdpsm_mpi holds the whole library. This header
+ * includes `mpi.h` and dpsm.h. The user guide's page "Distributed grids over
+ * MPI" (docs/guide_mpi.md) shows a C and a Fortran host handing over their
+ * communicator and decomposition.
  */
 #ifndef DPSM_DPSM_MPI_H
 #define DPSM_DPSM_MPI_H
@@ -58,7 +60,8 @@ extern "C" {
  * rank's are wrong (a block outside the grid, two blocks overlapping, cells
  * no block covers, ranks disagreeing on the global size or spacing, a NULL
  * @p out), every rank returns the same error and dpsm_last_error(NULL) names
- * the problem and the ranks concerned; no rank hangs.
+ * the problem and the ranks concerned; no rank hangs, as long as every rank
+ * of @p comm makes the call with a valid communicator.
  *
  * @param comm      the host's communicator (an intracommunicator); MPI must be initialized.
  * @param nx_global cells of the global grid along x, at least 1.
