@@ -22,6 +22,8 @@ DPSM_APT_PACKAGES=(
     libclang-rt-14-dev # scripts/sanitize: clang's sanitizer and libFuzzer runtimes
     libomp-14-dev      # scripts/sanitize: OpenMP (libomp and its Archer tool) under ThreadSanitizer
     abigail-tools      # the `abi` test: abidw/abidiff against tests/abi/libdpsm.abi
+    libopenmpi-dev     # the MPI component (libdpsm_mpi, dpsm_mpi.h): Open MPI's headers and libraries
+    openmpi-bin        # mpiexec, which runs the MPI tests (tests/mpi) on 1, 2 and 4 ranks
 )
 
 DPSM_ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)

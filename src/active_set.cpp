@@ -85,6 +85,29 @@ void ActiveSet::refresh_source(const Grid &grid) {
         }
 }
 
+void ActiveSet::set_remote_activity(const std::vector<CellBox> &hot, const std::vector<CellBox> &sources) {
+    remote_.assign(hot_.size(), CellBox{});
+    remote_source_.assign(hot_.size(), 0);
+    // Each box joins the union of every tile it can reach within a sweep; the
+    // union may be larger than the boxes, which only visits more cells at rest.
+    auto spread = [&](const CellBox &box, bool source) {
+        if (box.empty()) return;
+        const std::int64_t t0 = std::max<std::int64_t>(0, (box.i0 - kReach) / kTile);
+        const std::int64_t t1 = std::min(tiles_x_ - 1, std::max<std::int64_t>(0, (box.i1 - 1 + kReach) / kTile));
+        const std::int64_t s0 = std::max<std::int64_t>(0, (box.j0 - kReach) / kTile);
+        const std::int64_t s1 = std::min(tiles_y_ - 1, std::max<std::int64_t>(0, (box.j1 - 1 + kReach) / kTile));
+        for (std::int64_t tj = s0; tj <= s1; ++tj)
+            for (std::int64_t ti = t0; ti <= t1; ++ti) {
+                const std::int64_t t = ti + tiles_x_ * tj;
+                if (!box.reaches(tile_cells(t), kReach)) continue;
+                remote_[t].add(box);
+                if (source) remote_source_[t] = 1;
+            }
+    };
+    for (const CellBox &box : hot) spread(box, false);
+    for (const CellBox &box : sources) spread(box, true);
+}
+
 bool ActiveSet::may_move() const {
     for (std::int64_t t = 0; t < tiles(); ++t)
         if (!hot_[t].empty() || !source_[t].empty()) return true;
@@ -117,6 +140,7 @@ void ActiveSet::tiles_to_visit(int levels, std::vector<std::int64_t> &tiles,
                     reached.add(hot_[u].grown_within(reach, cells));
                     reached.add(source_[u].grown_within(reach, cells));
                 }
+            if (!remote_.empty()) reached.add(remote_[t].grown_within(reach, cells));
             if (visit_all) reached = cells;
             if (reached.empty()) continue;
             tiles.push_back(t);

@@ -67,7 +67,16 @@ public:
 
     CellBox &hot(std::int64_t t) { return hot_[t]; }
     bool masked(std::int64_t t) const { return masked_[t] != 0; }
-    bool has_source(std::int64_t t) const { return has_source_[t] != 0; }
+    bool has_source(std::int64_t t) const {
+        return has_source_[t] != 0 || (!remote_source_.empty() && remote_source_[t] != 0);
+    }
+
+    // A distributed grid's view of its neighbours (decomposition.hpp): boxes of
+    // cells beyond this block, in its coordinates, that may move in the coming
+    // sweep (their hot boxes) or hold a source. Tiles they reach are visited
+    // and see those sources, as if the neighbours' tiles were this grid's.
+    // Replaces the previous view; a serial grid never sets one.
+    void set_remote_activity(const std::vector<CellBox> &hot, const std::vector<CellBox> &sources);
 
 private:
     // Calls visit(t) for every tile whose sweep reads cell (i, j).
@@ -79,6 +88,8 @@ private:
     std::vector<CellBox> source_;          // cells with a source, per tile
     std::vector<std::uint8_t> masked_;     // walls, sinks or the edge within a tile's reach
     std::vector<std::uint8_t> has_source_; // a source within a tile's reach
+    std::vector<CellBox> remote_;             // per tile: remote boxes that may reach it (empty: serial)
+    std::vector<std::uint8_t> remote_source_; // per tile: a remote source within reach (empty: serial)
 };
 
 }  // namespace dpsm

@@ -15,13 +15,8 @@
 #include "error.hpp"
 #include "grid.hpp"
 #include "restart.hpp"
+#include "handle.hpp"
 #include "stepper.hpp"
-
-struct dpsm_grid {
-    explicit dpsm_grid(const dpsm::Geometry &geometry) : core(geometry) {}
-    dpsm::Grid core;
-    mutable std::string last_error;
-};
 
 namespace {
 
@@ -167,6 +162,14 @@ void require_above_bed(const dpsm_grid *g, const dpsm::Grid::Block &b, const dou
     }
 }
 
+// The physics of real scenes and restart files are not distributed yet: their
+// per-cell state is not in the halo exchange of a distributed grid.
+void require_serial(const dpsm_grid *g, const char *function) {
+    if (g->core.decomposition())
+        fail(DPSM_ERR_NOT_APPLICABLE, function,
+             "is not supported on a distributed grid (dpsm_create_2d_mpi) in this version");
+}
+
 void require_angle(double theta, const char *function, const char *name) {
     require_finite(theta, function, name);
     if (!(theta > 0.0 && theta < 0.5 * M_PI))
@@ -194,6 +197,8 @@ int create(int dim, bool axisymmetric, std::int64_t nx, std::int64_t ny, double 
 }
 
 }  // namespace
+
+void dpsm::set_error_without_grid(const char *message) noexcept { record_error(nullptr, message); }
 
 extern "C" {
 
@@ -365,17 +370,19 @@ int dpsm_get_mass(const dpsm_grid *g, int quantity, double *value) {
         require_grid(g, fn);
         require_pointer(value, fn, "value");
         const dpsm::MassLedger &ledger = g->core.ledger();
+        double local = 0.0;
         switch (quantity) {
-            case DPSM_MASS_TOTAL: *value = g->core.total_mass(); break;
-            case DPSM_MASS_SOURCED: *value = ledger.sourced.value(); break;
-            case DPSM_MASS_EXTERNAL: *value = ledger.external.value(); break;
-            case DPSM_MASS_OUTFLOW: *value = ledger.outflow.value(); break;
-            case DPSM_MASS_UNMET: *value = ledger.unmet.value(); break;
+            case DPSM_MASS_TOTAL: local = g->core.total_mass(); break;
+            case DPSM_MASS_SOURCED: local = ledger.sourced.value(); break;
+            case DPSM_MASS_EXTERNAL: local = ledger.external.value(); break;
+            case DPSM_MASS_OUTFLOW: local = ledger.outflow.value(); break;
+            case DPSM_MASS_UNMET: local = ledger.unmet.value(); break;
             default:
                 fail(DPSM_ERR_UNKNOWN_ENUM, fn, "quantity = ", quantity,
                      " is not DPSM_MASS_TOTAL, DPSM_MASS_SOURCED, DPSM_MASS_EXTERNAL, DPSM_MASS_OUTFLOW"
                      " or DPSM_MASS_UNMET");
         }
+        *value = g->core.global_sum(local);  // a distributed grid's figure is global
     });
 }
 
@@ -441,6 +448,7 @@ int dpsm_set_bedrock(dpsm_grid *g, const double *zb) {
     const char *fn = "dpsm_set_bedrock";
     return guarded(g, fn, [&] {
         require_grid(g, fn);
+        require_serial(g, fn);
         if (zb) {
             require_finite_array(g, zb, fn, "zb");
             const dpsm::Geometry &geo = g->core.geometry();
@@ -458,6 +466,7 @@ int dpsm_set_repose_angle_field(dpsm_grid *g, const double *theta) {
     const char *fn = "dpsm_set_repose_angle_field";
     return guarded(g, fn, [&] {
         require_grid(g, fn);
+        require_serial(g, fn);
         if (theta) {
             const dpsm::Geometry &geo = g->core.geometry();
             for (std::int64_t c = 0; c < geo.cells(); ++c)
@@ -473,6 +482,7 @@ int dpsm_set_flux_exponent(dpsm_grid *g, double p) {
     const char *fn = "dpsm_set_flux_exponent";
     return guarded(g, fn, [&] {
         require_grid(g, fn);
+        require_serial(g, fn);
         require_finite(p, fn, "p");
         if (!(p >= 1.0 && p <= DPSM_MAX_FLUX_EXPONENT))
             fail(DPSM_ERR_INVALID_VALUE, fn, "p = ", p, " is outside [1, ", DPSM_MAX_FLUX_EXPONENT,
@@ -485,6 +495,7 @@ int dpsm_set_static_angle(dpsm_grid *g, double radians) {
     const char *fn = "dpsm_set_static_angle";
     return guarded(g, fn, [&] {
         require_grid(g, fn);
+        require_serial(g, fn);
         require_angle(radians, fn, "radians");
         g->core.set_static_angle(radians);
     });
@@ -494,6 +505,7 @@ int dpsm_save(const dpsm_grid *g, const char *path) {
     const char *fn = "dpsm_save";
     return guarded(g, fn, [&] {
         require_grid(g, fn);
+        require_serial(g, fn);
         require_pointer(path, fn, "path");
         dpsm::save_restart(g->core, path, fn);
     });

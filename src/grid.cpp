@@ -1,12 +1,20 @@
 #include "grid.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <utility>
 
+#include "decomposition.hpp"
 #include "dpsm/dpsm.h"
 #include "tiled_sweep.hpp"
 
 namespace dpsm {
+
+double bed_film(const Grid &grid) {
+    const Geometry &geo = grid.geometry();
+    const double spacing = geo.dim == 2 ? std::min(geo.dx, geo.dy) : geo.dx;
+    return grid.rest_tolerance() * std::tan(grid.min_repose_angle()) * spacing;
+}
 
 Grid::Grid(const Geometry &geometry)
     : geometry_(geometry),
@@ -27,6 +35,12 @@ Grid::Grid(const Geometry &geometry)
 }
 
 Grid::~Grid() = default;
+
+void Grid::set_decomposition(std::unique_ptr<Decomposition> decomposition) {
+    decomposition_ = std::move(decomposition);
+}
+
+double Grid::global_sum(double local) const { return decomposition_ ? decomposition_->sum(local) : local; }
 
 TiledWorkspace &Grid::tiled_workspace() {
     if (!tiled_) tiled_ = std::make_unique<TiledWorkspace>();
@@ -87,6 +101,7 @@ void Grid::set_cell_kinds(const std::uint8_t *kinds) {
     }
     wall_cells_ = walls;
     open_cells_ = opens;
+    ++masks_version_;
     ledger_.external.add(change.value());
     update_source_summary();
     update_open_levels();
@@ -140,6 +155,7 @@ void Grid::set_source(const double *q) {
         source_.assign(q, q + heights_.size());
     else
         source_.clear();
+    ++masks_version_;
     update_source_summary();
 }
 

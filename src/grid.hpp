@@ -40,6 +40,7 @@ struct Geometry {
 
 // What the last step did, for dpsm_get_step_info.
 struct TiledWorkspace;
+class Decomposition;
 
 struct StepInfo {
     std::int64_t substeps = 0;
@@ -68,6 +69,12 @@ struct GridState {
     MassLedger ledger;
     StepInfo last_step;
 };
+
+class Grid;
+// Sand thinner than this above the bed is left in place: the height scale of
+// the rest tolerance, tol tan(theta) d. Without it a drained slope would thin
+// geometrically (a face takes a share of what is there) and never rest.
+double bed_film(const Grid &grid);
 
 class Grid {
 public:
@@ -186,6 +193,16 @@ public:
     StepInfo &last_step() { return last_step_; }
     const StepInfo &last_step() const { return last_step_; }
 
+    // The grid's place in a distributed grid (decomposition.hpp); null on a
+    // serial grid, which never pays for any of it.
+    Decomposition *decomposition() const { return decomposition_.get(); }
+    void set_decomposition(std::unique_ptr<Decomposition> decomposition);
+    // Changes whenever the host sets cell kinds or sources: a distributed grid
+    // refreshes its halo's copies of them when it does.
+    std::uint64_t masks_version() const { return masks_version_; }
+    // The sum over all blocks of a distributed grid; `local` on a serial grid.
+    double global_sum(double local) const;
+
 private:
     void update_source_summary();
     void update_open_levels();
@@ -225,6 +242,8 @@ private:
 
     MassLedger ledger_;
     StepInfo last_step_;
+    std::unique_ptr<Decomposition> decomposition_;
+    std::uint64_t masks_version_ = 0;
 };
 
 }  // namespace dpsm

@@ -127,6 +127,7 @@ private:
         const std::vector<double> &q = grid.source();
         const Geometry &geo = grid.geometry();
         available_.assign(n, 0.0);
+        const double film = bed_film(grid);
         CompensatedSum unmet;
         for (std::size_t c = 0; c < n; ++c) {
             if (kind_[c] != kSand) continue;
@@ -139,7 +140,7 @@ private:
                 sand += applied;
             }
             rate_[c] += applied / dt_;
-            available_[c] = sand;
+            available_[c] = sand > film ? sand : 0.0;
         }
         result.unmet_mass = unmet.value();
     }

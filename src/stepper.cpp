@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "closure.hpp"
+#include "decomposition.hpp"
 #include "dpsm/dpsm.h"
 #include "error.hpp"
 #include "kernels.hpp"
@@ -33,14 +34,27 @@ namespace {
 // sum (h - L)^2 over sand cells falls whenever sand moves, as long as every
 // held level (open sides at 0, open cells) is the same L: the surface must come
 // to rest. Held levels that differ can keep sand flowing between them forever.
-bool can_flow_forever(const Grid &grid) {
-    if (grid.source_active()) return true;
-    if (!grid.has_open_cells()) return false;
+bool can_flow_forever(const Grid &grid, const StepAgreement &state) {
+    if (state.source_active) return true;
+    if (!state.has_open_cells) return false;
     const Geometry &geo = grid.geometry();
     bool any_side_open = grid.side_open(kXMin) || grid.side_open(kXMax);
     if (geo.dim == 2) any_side_open = any_side_open || grid.side_open(kYMin) || grid.side_open(kYMax);
-    if (grid.open_level_min() != grid.open_level_max()) return true;
-    return any_side_open && grid.open_level_min() != 0.0;
+    if (state.open_level_min != state.open_level_max) return true;
+    return any_side_open && state.open_level_min != 0.0;
+}
+
+// What decides the step's work: the grid's own figures, or on a block of a
+// distributed grid the same figures over all blocks (decomposition.hpp).
+StepAgreement agree_before_step(Grid &grid, double dt) {
+    if (Decomposition *decomposition = grid.decomposition()) return decomposition->agree_before_step(grid, dt);
+    StepAgreement state;
+    state.source_active = grid.source_active();
+    state.has_open_cells = grid.has_open_cells();
+    state.may_move = grid.geometry().dim == 2 && grid.active_set().may_move();
+    state.open_level_min = grid.open_level_min();
+    state.open_level_max = grid.open_level_max();
+    return state;
 }
 
 }  // namespace
@@ -51,7 +65,8 @@ void step(Grid &grid, double dt) {
     // A count beyond 2^53 cannot be stepped exactly; a scene that comes to rest
     // never gets there, and one that may flow forever is refused.
     const bool bounded = needed <= 9007199254740992.0;
-    if (can_flow_forever(grid) && (!bounded || needed > static_cast<double>(grid.max_substeps()))) {
+    const StepAgreement state = agree_before_step(grid, dt);
+    if (can_flow_forever(grid, state) && (!bounded || needed > static_cast<double>(grid.max_substeps()))) {
         std::ostringstream msg;
         msg << "dpsm_step: dt = " << dt << " needs " << needed << " sub-steps of at most " << dt_max
             << " in a scene that may never come to rest (an active source or open cells at different"
@@ -66,7 +81,7 @@ void step(Grid &grid, double dt) {
     // check above would have refused).
     const std::int64_t substeps = bounded ? std::max<std::int64_t>(1, static_cast<std::int64_t>(needed)) : INT64_MAX;
     const double sub_dt = bounded ? dt / static_cast<double>(substeps) : dt_max;
-    const bool source_active = grid.source_active();
+    const bool source_active = state.source_active;
     MassLedger &ledger = grid.ledger();
 
     // Books one sub-step; false once the surface is found at rest (nothing
@@ -90,7 +105,7 @@ void step(Grid &grid, double dt) {
 
     if (two_d) {
         // Idle: no tile can move and no source acts.
-        if (!source_active && !grid.active_set().may_move()) {
+        if (!source_active && !state.may_move) {
             info.at_rest = true;
         } else {
             std::vector<LevelSummary> levels;
@@ -111,6 +126,7 @@ void step(Grid &grid, double dt) {
             info.cell_updates += static_cast<double>(grid.geometry().cells());
         }
     }
+    if (grid.decomposition()) info.cell_updates = grid.global_sum(info.cell_updates);
     info.time_integrated = info.at_rest ? static_cast<double>(info.substeps) * sub_dt : dt;
     grid.last_step() = info;
 }

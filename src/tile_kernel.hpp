@@ -29,6 +29,7 @@ struct TileLevelParams {
     double flux_exponent = 1.0;
     double tan_static = 0.0;  // hysteresis: the threshold between cells at rest
     bool hysteresis = false, bed = false, angle_field = false;
+    double bed_film = 0.0;  // sand this thin above the bed is left in place (see dpsm_set_bedrock)
     double cell_area = 1.0;  // dx dy
 };
 

@@ -61,7 +61,8 @@ void advance_tile_level_physics(TileBuffers &b, int in, const TileRect &reg, con
             }
             const double sand = std::max(0.0, h[c] - zb[c]);
             applied[c] = asked < 0.0 ? -std::min(-asked, sand) : asked;
-            available[c] = sand + std::min(0.0, applied[c]);
+            const double left = sand + std::min(0.0, applied[c]);
+            available[c] = left > p.bed_film ? left : 0.0;
         }
 
     // (2) Faces. The transverse slope of a cell mirrors a wall neighbour.

@@ -9,6 +9,7 @@
 #endif
 
 #include "active_set.hpp"
+#include "decomposition.hpp"
 #include "grid.hpp"
 
 namespace dpsm {
@@ -93,6 +94,54 @@ void gather_physics(const Grid &grid, TileBuffers &b, std::int64_t gi0, std::int
         }
 }
 
+// The kind of a ghost cell (i, j) beyond the global domain of a distributed
+// grid, in global coordinates: as ghost_kind, with the global grid's sides.
+std::uint8_t global_ghost_kind(const Grid &grid, const HaloStore &halo, std::int64_t i, std::int64_t j) {
+    bool open = true;
+    if (i < 0) open = open && grid.side_open(kXMin);
+    if (i >= halo.global_nx) open = open && grid.side_open(kXMax);
+    if (j < 0) open = open && grid.side_open(kYMin);
+    if (j >= halo.global_ny) open = open && grid.side_open(kYMax);
+    return open ? kOpen : kWall;
+}
+
+// On a block of a distributed grid, replaces what gather() put in the buffer
+// for the cells beyond the block: the neighbours' cells come from the halo
+// store (decomposition.hpp), the cells beyond the global domain are ghosts of
+// its sides. The block's own cells are left as gather() copied them.
+void gather_halo(const Grid &grid, const HaloStore &halo, TileBuffers &b, std::int64_t gi0, std::int64_t gj0,
+                 bool masked, bool source) {
+    const Geometry &geo = grid.geometry();
+    for (int r = 0; r < b.height; ++r) {
+        const std::int64_t j = gj0 + r;
+        const std::size_t row = static_cast<std::size_t>(r) * b.width;
+        // The block's own columns of this row, [own0, own1) in the buffer (none off the block's rows).
+        int own0 = b.width, own1 = b.width;
+        if (j >= 0 && j < geo.ny) {
+            own0 = static_cast<int>(std::clamp<std::int64_t>(-gi0, 0, b.width));
+            own1 = static_cast<int>(std::clamp<std::int64_t>(geo.nx - gi0, 0, b.width));
+        }
+        for (int c = 0; c < b.width; ++c) {
+            if (c == own0 && own0 < own1) c = own1;
+            if (c >= b.width) break;
+            const std::int64_t i = gi0 + c;
+            const std::size_t at = row + static_cast<std::size_t>(c);
+            if (halo.in_domain(i, j)) {
+                const std::size_t k = halo.index(i, j);
+                b.h[0][at] = halo.heights[k];
+                b.residual[0][at] = static_cast<double>(halo.residuals[k]);
+                if (masked) b.kind[at] = halo.kinds[k];
+                if (source) b.source[at] = halo.kinds[k] == kSand ? halo.sources[k] : 0.0;
+            } else {
+                b.h[0][at] = 0.0;
+                b.residual[0][at] = 0.0;
+                if (masked) b.kind[at] = global_ghost_kind(grid, halo, i + halo.i0, j + halo.j0);
+                if (source) b.source[at] = 0.0;
+            }
+        }
+    }
+}
+
 }  // namespace
 
 void prepare_tiled_sweep(Grid &grid, int threads) {
@@ -121,6 +170,9 @@ std::int64_t tiled_sweep(Grid &grid, int levels, double dt, std::vector<LevelSum
     const Geometry &geo = grid.geometry();
     ActiveSet &active = grid.active_set();
     TiledWorkspace &ws = grid.tiled_workspace();
+    Decomposition *decomposition = grid.decomposition();
+    if (decomposition) decomposition->before_sweep(grid);  // the neighbours' cells and activity
+    const HaloStore *halo_store = decomposition ? &decomposition->halo() : nullptr;
     active.tiles_to_visit(levels, ws.visit, ws.boxes);
     const std::int64_t visits = static_cast<std::int64_t>(ws.visit.size());
     ws.stats.assign(static_cast<std::size_t>(visits) * levels, TileLevelStats{});
@@ -140,6 +192,7 @@ std::int64_t tiled_sweep(Grid &grid, int levels, double dt, std::vector<LevelSum
         params.bed = !grid.bed().empty();
         params.angle_field = !grid.tan_field().empty();
         params.cell_area = geo.dx * geo.dy;
+        params.bed_film = bed_film(grid);
     }
     const bool isotropic = grid.scheme() == kIsotropic;
     const int threads = thread_count(grid.threads());
@@ -159,6 +212,8 @@ std::int64_t tiled_sweep(Grid &grid, int levels, double dt, std::vector<LevelSum
         b.height = static_cast<int>(cells.j1 - cells.j0) + 2 * halo;
         // The physics kernel reads cell kinds on every tile.
         gather(grid, b, gi0, gj0, masked || physics, source);
+        if (halo_store && !(gi0 >= 0 && gj0 >= 0 && gi0 + b.width <= geo.nx && gj0 + b.height <= geo.ny))
+            gather_halo(grid, *halo_store, b, gi0, gj0, masked || physics, source);
         if (physics) gather_physics(grid, b, gi0, gj0);
         const TileLevelFunction kernel =
             physics ? select_physics_tile_kernel(isotropic, source) : select_tile_kernel(masked, isotropic, source);
@@ -236,6 +291,7 @@ std::int64_t tiled_sweep(Grid &grid, int levels, double dt, std::vector<LevelSum
         }
         active.hot(ws.visit[k]) = moved;
     }
+    if (decomposition) decomposition->after_sweep(summaries);  // every rank takes the same sub-steps
     return visited_cells;
 }
 

@@ -112,6 +112,9 @@ module dpsm
   public :: dpsm_last_error, dpsm_status_string, dpsm_version_string, dpsm_version_number
   ! Not in C: .true. when g holds a grid (its handle is not NULL).
   public :: dpsm_associated
+  ! Not in C: for companion modules (dpsm_mpi) whose own C constructors make
+  ! the handle: stores it in g as the dpsm_create_* routines do.
+  public :: dpsm_adopt_handle
 
   interface dpsm_create_1d
     module procedure create_1d_i64, create_1d_i32
@@ -515,6 +518,15 @@ contains
       allocate (g%state)
     end if
   end subroutine adopt
+
+  !> dpsm_adopt_handle(g, ptr, status): g takes the handle ptr that a C
+  !> constructor returned with status (none unless status is DPSM_OK).
+  subroutine dpsm_adopt_handle(g, ptr, status)
+    type(dpsm_grid), intent(out) :: g
+    type(c_ptr), intent(in) :: ptr
+    integer(c_int), intent(in) :: status
+    call adopt(g, ptr, status)
+  end subroutine dpsm_adopt_handle
 
   !> dpsm_create_1d(g, nx, dx[, ierr]): a 1D grid of nx cells of width dx.
   subroutine create_1d_i64(g, nx, dx, ierr)

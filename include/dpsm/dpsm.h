@@ -502,6 +502,10 @@ DPSM_API int dpsm_set_threads(dpsm_grid *g, int n);
  * takes from its upstream cell at most a quarter (a half in 1D) of the sand
  * that cell holds above its bed in a sub-step, after that cell's own erosion,
  * so the exchanges of a cell together take at most the sand that is there.
+ * Sand thinner than `tol * tan(theta) * dx` (the height scale of the rest
+ * tolerance, dpsm_set_rest_tolerance(), with the smallest angle and spacing)
+ * is left where it is, so that a drained slope comes to rest instead of
+ * thinning forever.
  * A negative source erodes only the sand there is: what it asked for beyond
  * that is not applied and is counted as ::DPSM_MASS_UNMET. A bare bed steeper
  * than the angle of repose does not move and is at rest.

@@ -18,6 +18,9 @@
 #  6. Python: prog.py imports the installed package with PYTHONPATH=<its dir>
 #     and no DPSM_LIBRARY; it must load the library installed next to it, with
 #     numpy and with DPSM_NO_NUMPY=1; before and after the move.
+#  7. MPI (when the MPI component was built, i.e. dpsm-mpi.pc is installed):
+#     $CC prog_mpi.c $(pkg-config --cflags --libs dpsm-mpi), run on 2 ranks;
+#     before and after the move.
 #
 # Environment: CC, CXX; DPSM_FC (default $FC or gfortran), DPSM_PYTHON (default
 # /usr/bin/python3 when it exists, else python3).
@@ -205,10 +208,45 @@ python_import() {
         "$PYTHON" "$here/prog.py" "$libdir" || fail "the installed Python package failed without numpy"
 }
 
+# ---- 7. MPI: dpsm-mpi.pc ----------------------------------------------------
+# When the MPI component is installed: builds prog_mpi.c against prefix $1 with
+# `pkg-config dpsm-mpi` (the plain C compiler: the .pc carries MPI's flags),
+# into directory $2, and runs it on 2 ranks through an rpath.
+# shellcheck disable=SC2086
+mpi_build() {
+    local prefix=$1 out=$2 pc libdir cflags libs deps
+    pc=$(find "$prefix" -name dpsm-mpi.pc -print -quit)
+    if [[ -z $pc ]]; then
+        say "MPI: no dpsm-mpi.pc under $prefix (dpsm was built without MPI): skipped"
+        return 0
+    fi
+    need mpiexec
+    installed "$prefix" dpsm_mpi.h >/dev/null
+    installed "$prefix" "libdpsm_mpi.so.$soversion" >/dev/null
+    mkdir -p "$out"
+    export PKG_CONFIG_PATH
+    PKG_CONFIG_PATH=$(dirname "$pc")
+    say "MPI: $CC prog_mpi.c \$(pkg-config --cflags --libs dpsm-mpi) against $prefix"
+    [[ $(pkg-config --modversion dpsm-mpi) == "$version" ]] ||
+        fail "pkg-config --modversion dpsm-mpi gives '$(pkg-config --modversion dpsm-mpi)', expected $version"
+    libdir=$(realpath "$(pkg-config --variable=libdir dpsm-mpi)")
+    cflags=$(pkg-config --cflags dpsm-mpi)
+    libs=$(pkg-config --libs dpsm-mpi)
+    (cd "$out" && set -x && $CC -Wall -Werror "$here/prog_mpi.c" -o prog_mpi $cflags $libs -lm -Wl,-rpath,"$libdir") 2>&1 ||
+        fail "the MPI build with pkg-config failed"
+    deps=$(ldd "$out/prog_mpi")
+    [[ $deps == *"libdpsm_mpi.so.$soversion => $libdir/"* && $deps != *"libdpsm.so"* ]] ||
+        fail "prog_mpi does not load libdpsm_mpi.so.$soversion (alone) from $libdir: $deps"
+    env OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMP_NUM_THREADS=1 \
+        mpiexec -n 2 --oversubscribe "$out/prog_mpi" || fail "prog_mpi (MPI, pkg-config) failed on 2 ranks"
+    unset PKG_CONFIG_PATH
+}
+
 pkgconfig_build "$work/prefix" "$work/pc"
 cmake_build "$work/prefix" "$work/cm"
 fortran_build "$work/prefix" "$work/f"
 python_import "$work/prefix"
+mpi_build "$work/prefix" "$work/mpi"
 
 # ---- 4. relocation ----------------------------------------------------------
 say "relocation: no installed file names the prefix"
@@ -222,5 +260,6 @@ pkgconfig_build "$work/elsewhere/deeper/moved" "$work/pc-moved"
 cmake_build "$work/elsewhere/deeper/moved" "$work/cm-moved"
 fortran_build "$work/elsewhere/deeper/moved" "$work/f-moved"
 python_import "$work/elsewhere/deeper/moved"
+mpi_build "$work/elsewhere/deeper/moved" "$work/mpi-moved"
 
 say "install/consume checks passed"

@@ -1,0 +1,44 @@
+#!/usr/bin/env bash
+# Regenerates the figures of docs/guide_mpi.md (scaling): builds dpsm-bench-mpi
+# and runs strong and weak scaling on 1 .. MAX_RANKS ranks (default: the
+# cores of this machine), and the communication alone, into
+# docs/data/mpi_scaling.csv (a log in docs/data/mpi_scaling.log).
+#
+#   bash bench/run_mpi_scaling.sh      # about a minute on 2 cores
+#
+# BUILD_DIR (default build-bench) is the build tree. Runs as root too (CI does).
+set -euo pipefail
+
+root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
+build=${BUILD_DIR:-$root/build-bench}
+ranks_max=${MAX_RANKS:-$(nproc)}
+data=$root/docs/data
+export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMP_NUM_THREADS=1
+
+cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=Release -DDPSM_BUILD_BENCH=ON \
+      -DDPSM_BUILD_TESTS=OFF -DDPSM_BUILD_DOCS=OFF -DDPSM_BUILD_EXAMPLES=OFF >/dev/null
+cmake --build "$build" --target dpsm-bench-mpi
+bench=$build/bench/dpsm-bench-mpi
+[[ -x $bench ]] || { echo "no $bench: was MPI found?" >&2; exit 1; }
+mkdir -p "$data"
+
+run() { mpiexec -n "$1" --bind-to core "$bench" "${@:2}" | tail -n 1; }
+{
+  echo "generated: $(date -u +%Y-%m-%dT%H:%M:%SZ) by bench/run_mpi_scaling.sh"
+  echo "source tree $(git -C "$root" describe --always --dirty 2>/dev/null || echo unknown)"
+  echo "machine: $(uname -m), $(nproc --all) cores, $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2- | sed 's/^ //')"
+  echo "load average before: $(cut -d' ' -f1-3 /proc/loadavg)"
+  echo "mpiexec: $(mpiexec --version 2>&1 | head -1)"
+} >"$data/mpi_scaling.log"
+
+{
+  echo "mode,ranks,nx_global,ny_global,cells_per_rank,seconds_per_sweep,mcell_updates_per_s,blocks_alone_seconds_per_sweep"
+  for p in $(seq 1 "$ranks_max"); do run "$p" strong 2048 10; done
+  for p in $(seq 1 "$ranks_max"); do run "$p" weak 1024 10; done
+} >"$data/mpi_scaling.csv"
+{
+  echo "mode,ranks,width,halo_bytes_per_rank,halo_exchange_s,allreduce_8_doubles_s"
+  for w in 1024 2048 8192; do run "$ranks_max" comm "$w" 2000; done
+} >"$data/mpi_comm.csv"
+echo "load average after: $(cut -d' ' -f1-3 /proc/loadavg)" >>"$data/mpi_scaling.log"
+cat "$data/mpi_scaling.csv" "$data/mpi_comm.csv"

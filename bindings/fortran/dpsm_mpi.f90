@@ -1,0 +1,74 @@
+!> dpsm_mpi: the Fortran binding of include/dpsm/dpsm_mpi.h (distributed grids).
+!>
+!> Built with the MPI component only, into libdpsm_mpi_fortran together with
+!> its own copy of module dpsm (over libdpsm_mpi, not libdpsm), whose .mod
+!> files are installed in <includedir>/dpsm/fortran-mpi. A program uses both
+!> modules: it creates its block with dpsm_create_2d_mpi and then calls the
+!> routines of module dpsm on it, as on any grid.
+!>
+!>     call dpsm_create_2d_mpi(g, comm, nx_global, ny_global, i0, j0, nx_local, ny_local, dx, dy[, ierr])
+!>
+!> comm is the integer handle of a Fortran communicator: MPI_COMM_WORLD (or
+!> any communicator) of `use mpi`, or comm%MPI_VAL of `use mpi_f08`. The
+!> module itself needs no MPI module: the C side turns the handle into an
+!> MPI_Comm (dpsm_create_2d_mpi_f, MPI_Comm_f2c). i0 and j0 are 0-based, as
+!> every block offset of module dpsm; sizes are integer(c_int64_t) or default
+!> integers. Without ierr a failure stops the program with the message.
+module dpsm_mpi
+  use, intrinsic :: iso_c_binding, only: c_ptr, c_int, c_int32_t, c_int64_t, c_double
+  use dpsm, only: dpsm_grid, dpsm_adopt_handle, dpsm_status_string, dpsm_last_error, DPSM_OK
+  implicit none
+  private
+
+  public :: dpsm_create_2d_mpi
+
+  interface dpsm_create_2d_mpi
+    module procedure create_2d_mpi_i64, create_2d_mpi_i32
+  end interface dpsm_create_2d_mpi
+
+  interface
+    ! MPI_Fint is a C int in Open MPI and MPICH (a default Fortran integer).
+    function c_dpsm_create_2d_mpi_f(comm, nx_global, ny_global, i0, j0, nx_local, ny_local, dx, dy, out) &
+        bind(C, name='dpsm_create_2d_mpi_f') result(status)
+      import :: c_int, c_int64_t, c_double, c_ptr
+      integer(c_int), value :: comm
+      integer(c_int64_t), value :: nx_global, ny_global, i0, j0, nx_local, ny_local
+      real(c_double), value :: dx, dy
+      type(c_ptr), intent(out) :: out
+      integer(c_int) :: status
+    end function c_dpsm_create_2d_mpi_f
+  end interface
+
+contains
+
+  !> dpsm_create_2d_mpi(g, comm, nx_global, ny_global, i0, j0, nx_local, ny_local, dx, dy[, ierr]):
+  !> this rank's block [i0, i0+nx_local) x [j0, j0+ny_local) of a global
+  !> nx_global x ny_global grid distributed over comm. Collective over comm.
+  subroutine create_2d_mpi_i64(g, comm, nx_global, ny_global, i0, j0, nx_local, ny_local, dx, dy, ierr)
+    type(dpsm_grid), intent(out) :: g
+    integer, intent(in) :: comm
+    integer(c_int64_t), intent(in) :: nx_global, ny_global, i0, j0, nx_local, ny_local
+    real(c_double), intent(in) :: dx, dy
+    integer, intent(out), optional :: ierr
+    type(c_ptr) :: ptr
+    integer(c_int) :: status
+    status = c_dpsm_create_2d_mpi_f(int(comm, c_int), nx_global, ny_global, i0, j0, nx_local, ny_local, dx, dy, ptr)
+    call dpsm_adopt_handle(g, ptr, status)
+    if (present(ierr)) then
+      ierr = int(status)
+    else if (status /= DPSM_OK) then
+      error stop 'dpsm_create_2d_mpi failed: '//dpsm_status_string(status)//': '//dpsm_last_error()
+    end if
+  end subroutine create_2d_mpi_i64
+
+  subroutine create_2d_mpi_i32(g, comm, nx_global, ny_global, i0, j0, nx_local, ny_local, dx, dy, ierr)
+    type(dpsm_grid), intent(out) :: g
+    integer, intent(in) :: comm
+    integer(c_int32_t), intent(in) :: nx_global, ny_global, i0, j0, nx_local, ny_local
+    real(c_double), intent(in) :: dx, dy
+    integer, intent(out), optional :: ierr
+    call create_2d_mpi_i64(g, comm, int(nx_global, c_int64_t), int(ny_global, c_int64_t), int(i0, c_int64_t), &
+                           int(j0, c_int64_t), int(nx_local, c_int64_t), int(ny_local, c_int64_t), dx, dy, ierr)
+  end subroutine create_2d_mpi_i32
+
+end module dpsm_mpi

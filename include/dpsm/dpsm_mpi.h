@@ -1,0 +1,110 @@
+/**
+ * @file dpsm_mpi.h
+ * @brief Distributed 2D grids over MPI: the optional MPI component (libdpsm_mpi).
+ *
+ * A host that runs on many MPI ranks, each owning a rectangular block of the
+ * domain, creates one dpsm grid per rank with dpsm_create_2d_mpi(), passing
+ * its own communicator and the block the rank owns. The handle it gets back
+ * works with every function of dpsm.h:
+ *
+ *  - heights, sources and cell kinds (dpsm_set_heights(), dpsm_get_heights(),
+ *    dpsm_set_source(), dpsm_set_cell_kinds(), the *_region functions,
+ *    dpsm_get_shape()) are the rank's block, `nx_local * ny_local` values,
+ *    x fastest, region offsets counted from the block's first cell;
+ *  - sides (dpsm_set_boundary()) name the sides of the global domain; the
+ *    edges between blocks are neither walls nor open;
+ *  - dpsm_step() exchanges the cells along the blocks' edges and takes the same
+ *    sub-steps on every rank; its results equal those of one serial grid of
+ *    `nx_global * ny_global` cells holding the same scene, bit for bit, for
+ *    any decomposition;
+ *  - dpsm_get_mass() and dpsm_get_step_info() return global figures, the same
+ *    on every rank.
+ *
+ * Collective calls: dpsm_create_2d_mpi(), dpsm_create_2d_mpi_f(), dpsm_step(),
+ * dpsm_get_mass() and dpsm_destroy(). Every rank
+ * of the communicator must call the collective ones, in the same order, with
+ * the same `dt` and the same parameters (repose angle, mobility, scheme, rest
+ * tolerance, sub-step limit, sides); dpsm_step() checks this and fails on
+ * every rank alike when they differ. All other calls are local to the rank.
+ *
+ * Link with `-ldpsm_mpi` (pkg-config: `dpsm-mpi`; CMake: `dpsm::dpsm_mpi`)
+ * instead of `-ldpsm`: libdpsm_mpi holds the whole library. This header
+ * includes `mpi.h` and dpsm.h. The user guide's page "Distributed grids over
+ * MPI" (docs/guide_mpi.md) shows a C and a Fortran host handing over their
+ * communicator and decomposition.
+ */
+#ifndef DPSM_DPSM_MPI_H
+#define DPSM_DPSM_MPI_H
+
+#include <mpi.h>
+#include <stdint.h>
+
+#include <dpsm/dpsm.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/**
+ * @brief Creates this rank's block of a 2D grid distributed over @p comm.
+ *
+ * Collective over @p comm: every rank calls it once, passing the same global
+ * size and spacing and the block of cells it owns, `[i0, i0 + nx_local) x
+ * [j0, j0 + ny_local)` of the global `nx_global x ny_global` cells (0-based).
+ * The blocks may be any rectangles, of any sizes (even narrower than the
+ * 5 cells a step reads beyond a block), as long as together they cover the
+ * global grid exactly once. The grid keeps a duplicate of @p comm, so its
+ * messages never mix with the host's; @p comm may be freed afterwards.
+ *
+ * The arguments of all ranks are gathered and checked together: when any
+ * rank's are wrong (a block outside the grid, two blocks overlapping, cells
+ * no block covers, ranks disagreeing on the global size or spacing, a NULL
+ * @p out), every rank returns the same error and dpsm_last_error(NULL) names
+ * the problem and the ranks concerned; no rank hangs, as long as every rank
+ * of @p comm makes the call with a valid communicator.
+ *
+ * @param comm      the host's communicator (an intracommunicator); MPI must be initialized.
+ * @param nx_global cells of the global grid along x, at least 1.
+ * @param ny_global cells of the global grid along y, at least 1.
+ * @param i0        the block's first column in the global grid, 0-based.
+ * @param j0        the block's first row in the global grid, 0-based.
+ * @param nx_local  the block's columns, at least 1.
+ * @param ny_local  the block's rows, at least 1.
+ * @param dx        cell size along x (as dpsm_create_2d()).
+ * @param dy        cell size along y.
+ * @param out       receives the handle (NULL on failure); release it with dpsm_destroy() on every rank.
+ * @return #DPSM_OK; #DPSM_ERR_NULL_POINTER (@p out NULL on some rank),
+ *         #DPSM_ERR_INVALID_SIZE (sizes, blocks that do not tile the grid),
+ *         #DPSM_ERR_INVALID_VALUE (spacings; MPI not initialized or @p comm
+ *         MPI_COMM_NULL), #DPSM_ERR_OUT_OF_MEMORY, #DPSM_ERR_INTERNAL (an MPI call failed).
+ */
+DPSM_API int dpsm_create_2d_mpi(MPI_Comm comm, int64_t nx_global, int64_t ny_global, int64_t i0, int64_t j0,
+                                int64_t nx_local, int64_t ny_local, double dx, double dy, dpsm_grid **out);
+
+/**
+ * @brief dpsm_create_2d_mpi() for a Fortran communicator.
+ *
+ * The same as dpsm_create_2d_mpi(MPI_Comm_f2c(comm), ...): @p comm is the
+ * integer handle of a Fortran communicator (`MPI_COMM_WORLD` of `use mpi`, or
+ * `comm%MPI_VAL` of `use mpi_f08`). The Fortran module `dpsm_mpi` calls it.
+ *
+ * @param comm      the Fortran handle of the host's communicator.
+ * @param nx_global cells of the global grid along x.
+ * @param ny_global cells of the global grid along y.
+ * @param i0        the block's first column, 0-based.
+ * @param j0        the block's first row, 0-based.
+ * @param nx_local  the block's columns.
+ * @param ny_local  the block's rows.
+ * @param dx        cell size along x.
+ * @param dy        cell size along y.
+ * @param out       receives the handle (NULL on failure).
+ * @return as dpsm_create_2d_mpi().
+ */
+DPSM_API int dpsm_create_2d_mpi_f(MPI_Fint comm, int64_t nx_global, int64_t ny_global, int64_t i0, int64_t j0,
+                                  int64_t nx_local, int64_t ny_local, double dx, double dy, dpsm_grid **out);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* DPSM_DPSM_MPI_H */

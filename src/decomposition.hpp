@@ -1,0 +1,99 @@
+// The hook by which a 2D grid runs as one block of a larger, distributed grid
+// (the MPI component, src/mpi/). A serial grid has no Decomposition and never
+// reaches any of this; the core only calls it at the few points where the
+// ranks must agree or see each other's cells:
+//
+//  - after gather() (tiled_sweep.cpp) has copied a tile at the block's edge,
+//    gather_halo() fills its cells beyond the block from the HaloStore:
+//    heights and residuals of the neighbours' cells as they were at the start
+//    of the sweep, their kinds and sources as the host last set them;
+//  - before a sweep the Decomposition refreshes that store (one exchange per
+//    sweep of up to ActiveSet::kMaxLevels sub-steps) and tells the active set
+//    where the neighbours' cells may move (ActiveSet::set_remote_activity);
+//  - after a sweep it makes every level's "moved" and largest excess slope global;
+//  - before a step it makes the flags that decide the step's work global;
+//  - sums (the ledger, cell updates) are taken over all blocks.
+//
+// Coordinates are the block's own (0 .. nx-1, 0 .. ny-1); the block starts at
+// (i0, j0) of the global grid of global_nx x global_ny cells.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+namespace dpsm {
+
+class Grid;
+struct LevelSummary;
+
+// The cells within `depth` of a block that lie outside it, in four strips:
+// below (rows -depth .. -1, columns -depth .. nx+depth-1), above (rows ny ..
+// ny+depth-1, same columns), left and right (rows 0 .. ny-1, depth columns).
+// Cells beyond the global domain are never read from here (they are ghosts).
+struct HaloStore {
+    int depth = 0;
+    std::int64_t nx = 0, ny = 0;                   // the block
+    std::int64_t i0 = 0, j0 = 0;                   // its first cell in the global grid
+    std::int64_t global_nx = 0, global_ny = 0;
+    std::vector<double> heights, sources;          // sources: 0 where none
+    std::vector<float> residuals;
+    std::vector<std::uint8_t> kinds;
+
+    void resize(int halo_depth, std::int64_t block_nx, std::int64_t block_ny) {
+        depth = halo_depth;
+        nx = block_nx;
+        ny = block_ny;
+        const std::size_t n = static_cast<std::size_t>(2 * depth * (nx + 2 * depth) + 2 * depth * ny);
+        heights.assign(n, 0.0);
+        sources.assign(n, 0.0);
+        residuals.assign(n, 0.0f);
+        kinds.assign(n, 0);
+    }
+    // Whether block cell (i, j) (outside the block, within depth) is a cell of the global grid.
+    bool in_domain(std::int64_t i, std::int64_t j) const {
+        return i + i0 >= 0 && i + i0 < global_nx && j + j0 >= 0 && j + j0 < global_ny;
+    }
+    // The index in the strips of block cell (i, j), which must lie outside the
+    // block and within depth of it.
+    std::size_t index(std::int64_t i, std::int64_t j) const {
+        const std::int64_t wide = nx + 2 * depth;
+        if (j < 0) return static_cast<std::size_t>((i + depth) + wide * (j + depth));
+        if (j >= ny) return static_cast<std::size_t>(wide * depth + (i + depth) + wide * (j - ny));
+        const std::int64_t sides = 2 * wide * depth;
+        if (i < 0) return static_cast<std::size_t>(sides + (i + depth) + depth * j);
+        return static_cast<std::size_t>(sides + depth * ny + (i - nx) + depth * j);
+    }
+};
+
+// What every rank must agree on before a step (each a global figure).
+struct StepAgreement {
+    bool source_active = false;   // a source acts somewhere
+    bool has_open_cells = false;  // open cells somewhere
+    bool may_move = false;        // some tile anywhere is hot or has a source
+    double open_level_min = 0.0, open_level_max = 0.0;  // over all open cells (when there are any)
+};
+
+class Decomposition {
+public:
+    virtual ~Decomposition() = default;
+
+    const HaloStore &halo() const { return halo_; }
+
+    // Collective, at the start of dpsm_step: refreshes the halo's kinds and
+    // sources if the host changed them on any rank, checks that every rank
+    // steps the same dt with the same parameters (throws Error otherwise, on
+    // every rank alike), and returns the global flags.
+    virtual StepAgreement agree_before_step(Grid &grid, double dt) = 0;
+    // Collective, before each sweep: refreshes the halo's heights and
+    // residuals and the active set's view of the neighbours' activity.
+    virtual void before_sweep(Grid &grid) = 0;
+    // Collective, after each sweep: moved and max_excess of every level over all ranks.
+    virtual void after_sweep(std::vector<LevelSummary> &levels) = 0;
+    // Collective: the sum over all ranks, the same on every rank.
+    virtual double sum(double local) const = 0;
+
+protected:
+    HaloStore halo_;
+};
+
+}  // namespace dpsm

@@ -1,0 +1,515 @@
+// The MPI component: a 2D grid as one rank's block of a grid distributed over
+// a communicator (include/dpsm/dpsm_mpi.h). The core runs the block as it runs
+// any grid; this file is its Decomposition (decomposition.hpp):
+//
+//  - the halo: every cell within kHaloDepth (the most a sweep reads beyond a
+//    tile) of the block that another rank owns. Whoever owns it sends it: one
+//    message per neighbouring rank per sweep, holding the cells' heights and
+//    residuals and the sender's hot boxes that can reach the receiver. Kinds
+//    and sources go the same way, but only when the host changed them on some
+//    rank. Neighbours are found from the rectangles alone, so blocks narrower
+//    than the halo simply have more of them;
+//  - agreement: one MAX all-reduce before a step (flags, and the parameters,
+//    so that ranks that disagree fail alike), one after each sweep (each
+//    level's "moved" and largest excess slope), and gathers for sums, which
+//    are added in rank order so every rank gets the same figure.
+//
+// With the halo filled and the same sub-steps on every rank, each cell is
+// computed from the same values by the same arithmetic as in a serial run:
+// heights are bit for bit those of the serial grid; only sums over cells (the
+// ledger) are added in a different order.
+#include <mpi.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <limits>
+#include <memory>
+#include <new>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "active_set.hpp"
+#include "decomposition.hpp"
+#include "dpsm/dpsm.h"
+#include "dpsm/dpsm_mpi.h"
+#include "error.hpp"
+#include "grid.hpp"
+#include "handle.hpp"
+#include "ledger.hpp"
+#include "tiled_sweep.hpp"
+
+namespace dpsm {
+namespace {
+
+// A sweep reads ActiveSet::kMaxLevels cells beyond a tile plus one ring of ghosts.
+constexpr int kHaloDepth = ActiveSet::kMaxLevels + 1;
+constexpr int kTagHeights = 1;
+constexpr int kTagMasks = 2;
+// Spacings, as dpsm_create_2d accepts them (capi.cpp).
+constexpr double kMaxMagnitude = 1e50;
+constexpr std::int64_t kMaxCells = std::numeric_limits<std::int64_t>::max() / 64;
+
+struct Rect {
+    std::int64_t i0 = 0, j0 = 0, ni = 0, nj = 0;  // [i0, i0 + ni) x [j0, j0 + nj)
+    bool empty() const { return ni <= 0 || nj <= 0; }
+    std::int64_t cells() const { return empty() ? 0 : ni * nj; }
+    Rect grown(std::int64_t d) const { return {i0 - d, j0 - d, ni + 2 * d, nj + 2 * d}; }
+};
+
+Rect intersect(const Rect &a, const Rect &b) {
+    const std::int64_t i0 = std::max(a.i0, b.i0), j0 = std::max(a.j0, b.j0);
+    const std::int64_t i1 = std::min(a.i0 + a.ni, b.i0 + b.ni), j1 = std::min(a.j0 + a.nj, b.j0 + b.nj);
+    return {i0, j0, std::max<std::int64_t>(0, i1 - i0), std::max<std::int64_t>(0, j1 - j0)};
+}
+
+std::string describe(const Rect &r) {
+    std::ostringstream s;
+    s << "[" << r.i0 << ", " << r.i0 + r.ni << ") x [" << r.j0 << ", " << r.j0 + r.nj << ")";
+    return s.str();
+}
+
+void check_mpi(int code, const char *what) {
+    if (code == MPI_SUCCESS) return;
+    char text[MPI_MAX_ERROR_STRING];
+    int length = 0;
+    MPI_Error_string(code, text, &length);
+    throw Error(DPSM_ERR_INTERNAL, std::string("dpsm (MPI): ") + what + " failed: " + std::string(text, length));
+}
+
+// One rank whose cells this block reads, or which reads this block's cells
+// (always both: the halo is as deep both ways).
+struct Neighbour {
+    int rank = 0;
+    Rect block;       // its block, global coordinates
+    Rect send;        // this block's cells it reads
+    Rect receive;     // its cells this block reads
+    std::int64_t tiles = 0;  // its tiles: the most hot boxes it sends
+    std::vector<double> send_buffer, receive_buffer;
+};
+
+class MpiDecomposition final : public Decomposition {
+public:
+    MpiDecomposition(MPI_Comm comm, int rank, const std::vector<Rect> &blocks, std::int64_t global_nx,
+                     std::int64_t global_ny)
+        : comm_(comm), block_(blocks[static_cast<std::size_t>(rank)]) {
+        halo_.resize(kHaloDepth, block_.ni, block_.nj);
+        halo_.i0 = block_.i0;
+        halo_.j0 = block_.j0;
+        halo_.global_nx = global_nx;
+        halo_.global_ny = global_ny;
+        const Rect domain{0, 0, global_nx, global_ny};
+        const Rect reach = intersect(block_.grown(kHaloDepth), domain);
+        for (std::size_t r = 0; r < blocks.size(); ++r) {
+            if (static_cast<int>(r) == rank) continue;
+            Neighbour n;
+            n.rank = static_cast<int>(r);
+            n.block = blocks[r];
+            n.receive = intersect(reach, n.block);
+            if (n.receive.empty()) continue;
+            n.send = intersect(intersect(n.block.grown(kHaloDepth), domain), block_);
+            n.tiles = ((n.block.ni + ActiveSet::kTile - 1) / ActiveSet::kTile) *
+                      ((n.block.nj + ActiveSet::kTile - 1) / ActiveSet::kTile);
+            neighbours_.push_back(std::move(n));
+        }
+        requests_.resize(2 * neighbours_.size());
+    }
+
+    ~MpiDecomposition() override {
+        int finalized = 0;
+        MPI_Finalized(&finalized);
+        if (!finalized) MPI_Comm_free(&comm_);
+    }
+
+    StepAgreement agree_before_step(Grid &grid, double dt) override {
+        // Everything as a maximum: minima are maxima of the negated values.
+        const double none = -std::numeric_limits<double>::infinity();
+        const bool open = grid.has_open_cells();
+        std::vector<double> v = {grid.source_active() ? 1.0 : 0.0,
+                                 open ? 1.0 : 0.0,
+                                 grid.active_set().may_move() ? 1.0 : 0.0,
+                                 grid.masks_version() != exchanged_masks_ ? 1.0 : 0.0,
+                                 open ? -grid.open_level_min() : none,
+                                 open ? grid.open_level_max() : none};
+        const std::size_t first_parameter = v.size();
+        const double parameters[] = {dt,
+                                     grid.repose_angle(),
+                                     grid.mobility(),
+                                     grid.rest_tolerance(),
+                                     static_cast<double>(grid.scheme()),
+                                     static_cast<double>(grid.max_substeps()),
+                                     grid.side_open(kXMin) ? 1.0 : 0.0,
+                                     grid.side_open(kXMax) ? 1.0 : 0.0,
+                                     grid.side_open(kYMin) ? 1.0 : 0.0,
+                                     grid.side_open(kYMax) ? 1.0 : 0.0};
+        for (double p : parameters) {
+            v.push_back(p);
+            v.push_back(-p);
+        }
+        check_mpi(MPI_Allreduce(MPI_IN_PLACE, v.data(), static_cast<int>(v.size()), MPI_DOUBLE, MPI_MAX, comm_),
+                  "MPI_Allreduce before dpsm_step");
+        static const char *const names[] = {"dt",         "the repose angle (dpsm_set_repose_angle)",
+                                            "the mobility (dpsm_set_mobility)",
+                                            "the rest tolerance (dpsm_set_rest_tolerance)",
+                                            "the scheme (dpsm_set_scheme)",
+                                            "the sub-step limit (dpsm_set_max_substeps)",
+                                            "side DPSM_XMIN (dpsm_set_boundary)", "side DPSM_XMAX (dpsm_set_boundary)",
+                                            "side DPSM_YMIN (dpsm_set_boundary)", "side DPSM_YMAX (dpsm_set_boundary)"};
+        for (std::size_t k = 0; k < sizeof(parameters) / sizeof(parameters[0]); ++k) {
+            const double hi = v[first_parameter + 2 * k], lo = -v[first_parameter + 2 * k + 1];
+            if (hi != lo) {
+                std::ostringstream msg;
+                msg.precision(17);
+                msg << "dpsm_step: the ranks of the distributed grid differ in " << names[k] << " (from " << lo
+                    << " to " << hi << "); every rank must step the same dt with the same parameters";
+                throw Error(DPSM_ERR_INVALID_VALUE, msg.str());
+            }
+        }
+        if (v[3] != 0.0) exchange_masks(grid);
+        StepAgreement state;
+        state.source_active = v[0] != 0.0;
+        state.has_open_cells = v[1] != 0.0;
+        state.may_move = v[2] != 0.0;
+        state.open_level_min = state.has_open_cells ? -v[4] : 0.0;
+        state.open_level_max = state.has_open_cells ? v[5] : 0.0;
+        return state;
+    }
+
+    void before_sweep(Grid &grid) override {
+        ActiveSet &active = grid.active_set();
+        const std::vector<double> &h = grid.heights();
+        const std::vector<float> &res = grid.residuals();
+        for (std::size_t k = 0; k < neighbours_.size(); ++k) {
+            Neighbour &n = neighbours_[k];
+            n.receive_buffer.resize(static_cast<std::size_t>(2 * n.receive.cells() + 1 + 4 * n.tiles));
+            check_mpi(MPI_Irecv(n.receive_buffer.data(), static_cast<int>(n.receive_buffer.size()), MPI_DOUBLE, n.rank,
+                                kTagHeights, comm_, &requests_[k]),
+                      "MPI_Irecv of the halo");
+        }
+        for (std::size_t k = 0; k < neighbours_.size(); ++k) {
+            Neighbour &n = neighbours_[k];
+            std::vector<double> &out = n.send_buffer;
+            out.clear();
+            for_cells(n.send, [&](std::size_t c) { out.push_back(h[c]); });
+            for_cells(n.send, [&](std::size_t c) { out.push_back(static_cast<double>(res[c])); });
+            // The hot boxes that can reach its block within a sweep, in global coordinates.
+            const std::size_t count_at = out.size();
+            out.push_back(0.0);
+            CellBox near;
+            near.add(n.block.i0 - block_.i0, n.block.i0 + n.block.ni - block_.i0, n.block.j0 - block_.j0,
+                     n.block.j0 + n.block.nj - block_.j0);
+            for (std::int64_t t = 0; t < active.tiles(); ++t) {
+                const CellBox &box = active.hot(t);
+                if (!box.reaches(near, kHaloDepth)) continue;
+                out.push_back(static_cast<double>(box.i0 + block_.i0));
+                out.push_back(static_cast<double>(box.i1 + block_.i0));
+                out.push_back(static_cast<double>(box.j0 + block_.j0));
+                out.push_back(static_cast<double>(box.j1 + block_.j0));
+                out[count_at] += 1.0;
+            }
+            check_mpi(MPI_Isend(out.data(), static_cast<int>(out.size()), MPI_DOUBLE, n.rank, kTagHeights, comm_,
+                                &requests_[neighbours_.size() + k]),
+                      "MPI_Isend of the halo");
+        }
+        check_mpi(MPI_Waitall(static_cast<int>(requests_.size()), requests_.data(), MPI_STATUSES_IGNORE),
+                  "MPI_Waitall of the halo");
+        remote_hot_.clear();
+        for (Neighbour &n : neighbours_) {
+            const double *in = n.receive_buffer.data();
+            const std::size_t cells = static_cast<std::size_t>(n.receive.cells());
+            std::size_t k = 0;
+            for_halo_cells(n.receive, [&](std::size_t at) { halo_.heights[at] = in[k++]; });
+            for_halo_cells(n.receive, [&](std::size_t at) { halo_.residuals[at] = static_cast<float>(in[k++]); });
+            const std::size_t boxes = static_cast<std::size_t>(in[2 * cells]);
+            for (std::size_t b = 0; b < boxes; ++b) {
+                const double *box = in + 2 * cells + 1 + 4 * b;
+                CellBox local;
+                local.add(static_cast<std::int64_t>(box[0]) - block_.i0, static_cast<std::int64_t>(box[1]) - block_.i0,
+                          static_cast<std::int64_t>(box[2]) - block_.j0, static_cast<std::int64_t>(box[3]) - block_.j0);
+                remote_hot_.push_back(local);
+            }
+        }
+        active.set_remote_activity(remote_hot_, remote_sources_);
+    }
+
+    void after_sweep(std::vector<LevelSummary> &levels) override {
+        std::vector<double> v;
+        for (const LevelSummary &level : levels) {
+            v.push_back(level.moved ? 1.0 : 0.0);
+            v.push_back(level.max_excess);
+        }
+        check_mpi(MPI_Allreduce(MPI_IN_PLACE, v.data(), static_cast<int>(v.size()), MPI_DOUBLE, MPI_MAX, comm_),
+                  "MPI_Allreduce after a sweep");
+        for (std::size_t s = 0; s < levels.size(); ++s) {
+            levels[s].moved = v[2 * s] != 0.0;
+            levels[s].max_excess = v[2 * s + 1];
+        }
+    }
+
+    double sum(double local) const override {
+        std::vector<double> all(static_cast<std::size_t>(ranks()));
+        check_mpi(MPI_Allgather(&local, 1, MPI_DOUBLE, all.data(), 1, MPI_DOUBLE, comm_), "MPI_Allgather of a sum");
+        CompensatedSum total;
+        for (double x : all) total.add(x);
+        return total.value();
+    }
+
+private:
+    int ranks() const {
+        int size = 1;
+        MPI_Comm_size(comm_, &size);
+        return size;
+    }
+
+    // Calls f(cell index in the block) for the cells of r (global coordinates, inside the block), x fastest.
+    template <class F>
+    void for_cells(const Rect &r, F &&f) const {
+        for (std::int64_t j = r.j0; j < r.j0 + r.nj; ++j)
+            for (std::int64_t i = r.i0; i < r.i0 + r.ni; ++i)
+                f(static_cast<std::size_t>((i - block_.i0) + block_.ni * (j - block_.j0)));
+    }
+    // Calls f(index in the halo store) for the cells of r (global coordinates, in the halo), x fastest.
+    template <class F>
+    void for_halo_cells(const Rect &r, F &&f) const {
+        for (std::int64_t j = r.j0; j < r.j0 + r.nj; ++j)
+            for (std::int64_t i = r.i0; i < r.i0 + r.ni; ++i) f(halo_.index(i - block_.i0, j - block_.j0));
+    }
+
+    // The halo's kinds and sources, and the boxes of its cells with a source.
+    void exchange_masks(Grid &grid) {
+        const std::vector<std::uint8_t> &kinds = grid.kinds();
+        const std::vector<double> &q = grid.source();
+        for (std::size_t k = 0; k < neighbours_.size(); ++k) {
+            Neighbour &n = neighbours_[k];
+            n.receive_buffer.resize(static_cast<std::size_t>(2 * n.receive.cells()));
+            check_mpi(MPI_Irecv(n.receive_buffer.data(), static_cast<int>(n.receive_buffer.size()), MPI_DOUBLE, n.rank,
+                                kTagMasks, comm_, &requests_[k]),
+                      "MPI_Irecv of the halo's cell kinds and sources");
+        }
+        for (std::size_t k = 0; k < neighbours_.size(); ++k) {
+            Neighbour &n = neighbours_[k];
+            std::vector<double> &out = n.send_buffer;
+            out.clear();
+            for_cells(n.send, [&](std::size_t c) { out.push_back(static_cast<double>(kinds[c])); });
+            for_cells(n.send, [&](std::size_t c) { out.push_back(q.empty() ? 0.0 : q[c]); });
+            check_mpi(MPI_Isend(out.data(), static_cast<int>(out.size()), MPI_DOUBLE, n.rank, kTagMasks, comm_,
+                                &requests_[neighbours_.size() + k]),
+                      "MPI_Isend of the halo's cell kinds and sources");
+        }
+        check_mpi(MPI_Waitall(static_cast<int>(requests_.size()), requests_.data(), MPI_STATUSES_IGNORE),
+                  "MPI_Waitall of the halo's cell kinds and sources");
+        remote_sources_.clear();
+        for (Neighbour &n : neighbours_) {
+            const double *in = n.receive_buffer.data();
+            std::size_t k = 0;
+            for_halo_cells(n.receive, [&](std::size_t at) { halo_.kinds[at] = static_cast<std::uint8_t>(in[k++]); });
+            for_halo_cells(n.receive, [&](std::size_t at) { halo_.sources[at] = in[k++]; });
+            CellBox sources;
+            for (std::int64_t j = n.receive.j0; j < n.receive.j0 + n.receive.nj; ++j)
+                for (std::int64_t i = n.receive.i0; i < n.receive.i0 + n.receive.ni; ++i) {
+                    const std::size_t at = halo_.index(i - block_.i0, j - block_.j0);
+                    if (halo_.kinds[at] == kSand && halo_.sources[at] != 0.0)
+                        sources.add(i - block_.i0, i - block_.i0 + 1, j - block_.j0, j - block_.j0 + 1);
+                }
+            if (!sources.empty()) remote_sources_.push_back(sources);
+        }
+        exchanged_masks_ = grid.masks_version();
+    }
+
+    MPI_Comm comm_;
+    Rect block_;
+    std::vector<Neighbour> neighbours_;
+    std::vector<MPI_Request> requests_;
+    std::vector<CellBox> remote_hot_, remote_sources_;
+    std::uint64_t exchanged_masks_ = std::numeric_limits<std::uint64_t>::max();  // none yet
+};
+
+// What each rank passes to dpsm_create_2d_mpi, gathered on every rank.
+struct Arguments {
+    std::int64_t nx_global, ny_global, i0, j0, nx_local, ny_local, out_is_null;
+    double dx, dy;
+};
+
+template <class... Parts>
+[[noreturn]] void fail(int status, const char *function, const Parts &...parts) {
+    std::ostringstream msg;
+    msg.precision(17);
+    msg << function << ": ";
+    (msg << ... << parts);
+    throw Error(status, msg.str());
+}
+
+bool bad_spacing(double d) { return !std::isfinite(d) || !(d >= 1.0 / kMaxMagnitude && d <= kMaxMagnitude); }
+
+// Checks the gathered arguments of all ranks; throws the first problem, the
+// same on every rank (everything here depends on the gathered values only).
+void check_decomposition(const std::vector<Arguments> &all, const char *fn) {
+    const std::size_t ranks = all.size();
+    for (std::size_t r = 0; r < ranks; ++r)
+        if (all[r].out_is_null) fail(DPSM_ERR_NULL_POINTER, fn, "out is NULL on rank ", r);
+    const Arguments &a0 = all[0];
+    for (std::size_t r = 0; r < ranks; ++r) {
+        const Arguments &a = all[r];
+        if (a.nx_global < 1 || a.ny_global < 1)
+            fail(DPSM_ERR_INVALID_SIZE, fn, "rank ", r, " passes a global grid of nx_global = ", a.nx_global,
+                 " by ny_global = ", a.ny_global, " cells; both must be at least 1");
+        if (a.nx_global > kMaxCells / a.ny_global)
+            fail(DPSM_ERR_INVALID_SIZE, fn, "rank ", r, " passes a global grid of ", a.nx_global, " x ", a.ny_global,
+                 " cells, more than this library can address (", kMaxCells, ")");
+        if (bad_spacing(a.dx) || bad_spacing(a.dy))
+            fail(DPSM_ERR_INVALID_VALUE, fn, "rank ", r, " passes dx = ", a.dx, ", dy = ", a.dy,
+                 "; both must be finite and in [1e-50, 1e50]");
+        if (a.nx_global != a0.nx_global || a.ny_global != a0.ny_global)
+            fail(DPSM_ERR_INVALID_SIZE, fn, "the ranks disagree on the global grid: rank 0 passes ", a0.nx_global,
+                 " x ", a0.ny_global, " cells, rank ", r, " passes ", a.nx_global, " x ", a.ny_global);
+        if (a.dx != a0.dx || a.dy != a0.dy)
+            fail(DPSM_ERR_INVALID_VALUE, fn, "the ranks disagree on the spacing: rank 0 passes dx = ", a0.dx,
+                 ", dy = ", a0.dy, ", rank ", r, " passes dx = ", a.dx, ", dy = ", a.dy);
+        if (a.nx_local < 1 || a.ny_local < 1)
+            fail(DPSM_ERR_INVALID_SIZE, fn, "rank ", r, " passes a block of nx_local = ", a.nx_local,
+                 " by ny_local = ", a.ny_local, " cells; both must be at least 1");
+        if (a.i0 < 0 || a.j0 < 0 || a.i0 > a.nx_global - a.nx_local || a.j0 > a.ny_global - a.ny_local)
+            fail(DPSM_ERR_INVALID_SIZE, fn, "the block of rank ", r, ", ",
+                 describe({a.i0, a.j0, a.nx_local, a.ny_local}), ", does not lie in the global grid [0, ",
+                 a.nx_global, ") x [0, ", a.ny_global, ")");
+    }
+    std::vector<Rect> blocks;
+    for (const Arguments &a : all) blocks.push_back({a.i0, a.j0, a.nx_local, a.ny_local});
+    // Overlaps: every pair once (P^2 / 2 tests of two rectangles, done once per grid).
+    for (std::size_t a = 0; a < ranks; ++a)
+        for (std::size_t b = a + 1; b < ranks; ++b) {
+            const Rect both = intersect(blocks[a], blocks[b]);
+            if (!both.empty())
+                fail(DPSM_ERR_INVALID_SIZE, fn, "the blocks of rank ", a, ", ", describe(blocks[a]), ", and rank ", b,
+                     ", ", describe(blocks[b]), ", overlap in ", describe(both),
+                     "; every cell must belong to exactly one rank");
+        }
+    // Without overlaps, the blocks tile the grid if their cells add up.
+    std::int64_t covered = 0;
+    for (const Rect &r : blocks) covered += r.cells();
+    const std::int64_t wanted = a0.nx_global * a0.ny_global;
+    if (covered != wanted) {
+        std::ostringstream where;
+        // The lowest, then leftmost, uncovered cell lies in row 0 or just above
+        // a block, in column 0 or just right of one: try those (few ranks only).
+        if (ranks <= 64) {
+            std::vector<std::int64_t> is{0}, js{0};
+            for (const Rect &r : blocks) {
+                is.push_back(r.i0 + r.ni);
+                js.push_back(r.j0 + r.nj);
+            }
+            std::sort(is.begin(), is.end());
+            std::sort(js.begin(), js.end());
+            bool found = false;
+            for (std::int64_t j : js) {
+                for (std::int64_t i : is) {
+                    if (i >= a0.nx_global || j >= a0.ny_global) continue;
+                    bool owned = false;
+                    for (const Rect &r : blocks)
+                        owned = owned || (i >= r.i0 && i < r.i0 + r.ni && j >= r.j0 && j < r.j0 + r.nj);
+                    if (!owned) {
+                        where << "; cell (i, j) = (" << i << ", " << j << ") belongs to no rank";
+                        found = true;
+                        break;
+                    }
+                }
+                if (found) break;
+            }
+        }
+        fail(DPSM_ERR_INVALID_SIZE, fn, "the blocks of the ", ranks, " ranks cover ", covered, " of the ",
+             a0.nx_global, " x ", a0.ny_global, " = ", wanted, " cells of the global grid", where.str(),
+             "; the blocks must tile the global grid");
+    }
+}
+
+int create_distributed(MPI_Comm comm, std::int64_t nx_global, std::int64_t ny_global, std::int64_t i0,
+                       std::int64_t j0, std::int64_t nx_local, std::int64_t ny_local, double dx, double dy,
+                       dpsm_grid **out, const char *fn) noexcept {
+    if (out) *out = nullptr;
+    dpsm_grid *made = nullptr;
+    try {
+        int initialized = 0, finalized = 0;
+        MPI_Initialized(&initialized);
+        MPI_Finalized(&finalized);
+        if (!initialized || finalized)
+            fail(DPSM_ERR_INVALID_VALUE, fn, "MPI is ", finalized ? "finalized" : "not initialized",
+                 "; call dpsm_create_2d_mpi between MPI_Init and MPI_Finalize");
+        if (comm == MPI_COMM_NULL) fail(DPSM_ERR_INVALID_VALUE, fn, "comm is MPI_COMM_NULL");
+        int inter = 0;
+        check_mpi(MPI_Comm_test_inter(comm, &inter), "MPI_Comm_test_inter");
+        if (inter) fail(DPSM_ERR_INVALID_VALUE, fn, "comm is an intercommunicator; pass an intracommunicator");
+        int rank = 0, size = 0;
+        check_mpi(MPI_Comm_rank(comm, &rank), "MPI_Comm_rank");
+        check_mpi(MPI_Comm_size(comm, &size), "MPI_Comm_size");
+
+        // Every rank checks everyone's arguments, so that all fail alike.
+        const Arguments mine{nx_global, ny_global, i0, j0, nx_local, ny_local, out == nullptr ? 1 : 0, dx, dy};
+        std::vector<Arguments> all(static_cast<std::size_t>(size));
+        check_mpi(MPI_Allgather(&mine, static_cast<int>(sizeof(Arguments)), MPI_BYTE, all.data(),
+                                static_cast<int>(sizeof(Arguments)), MPI_BYTE, comm),
+                  "MPI_Allgather of the blocks");
+        check_decomposition(all, fn);
+
+        std::vector<Rect> blocks;
+        for (const Arguments &a : all) blocks.push_back({a.i0, a.j0, a.nx_local, a.ny_local});
+        // Allocation failures are agreed on before the communicator is
+        // duplicated, so that no rank keeps a grid its peers do not have.
+        int failed = 0;
+        try {
+            made = new dpsm_grid(Geometry{2, false, nx_local, ny_local, dx, dy});
+        } catch (const std::bad_alloc &) {
+            failed = 1;
+        }
+        check_mpi(MPI_Allreduce(MPI_IN_PLACE, &failed, 1, MPI_INT, MPI_MAX, comm), "MPI_Allreduce");
+        if (failed) fail(DPSM_ERR_OUT_OF_MEMORY, fn, "out of memory for the block on some rank");
+        MPI_Comm own = MPI_COMM_NULL;
+        check_mpi(MPI_Comm_dup(comm, &own), "MPI_Comm_dup");
+        MPI_Comm_set_errhandler(own, MPI_ERRORS_RETURN);
+        try {
+            made->core.set_decomposition(std::make_unique<MpiDecomposition>(own, rank, blocks, nx_global, ny_global));
+        } catch (...) {
+            MPI_Comm_free(&own);
+            throw;
+        }
+        *out = made;
+        set_error_without_grid("");
+        return DPSM_OK;
+    } catch (const Error &e) {
+        delete made;
+        set_error_without_grid(e.what());
+        return e.status();
+    } catch (const std::bad_alloc &) {
+        delete made;
+        set_error_without_grid((std::string(fn) + ": out of memory").c_str());
+        return DPSM_ERR_OUT_OF_MEMORY;
+    } catch (const std::exception &e) {
+        delete made;
+        set_error_without_grid(e.what());
+        return DPSM_ERR_INTERNAL;
+    } catch (...) {
+        delete made;
+        set_error_without_grid("dpsm: internal error of unknown kind");
+        return DPSM_ERR_INTERNAL;
+    }
+}
+
+}  // namespace
+}  // namespace dpsm
+
+extern "C" {
+
+int dpsm_create_2d_mpi(MPI_Comm comm, int64_t nx_global, int64_t ny_global, int64_t i0, int64_t j0,
+                       int64_t nx_local, int64_t ny_local, double dx, double dy, dpsm_grid **out) {
+    return dpsm::create_distributed(comm, nx_global, ny_global, i0, j0, nx_local, ny_local, dx, dy, out,
+                                    "dpsm_create_2d_mpi");
+}
+
+int dpsm_create_2d_mpi_f(MPI_Fint comm, int64_t nx_global, int64_t ny_global, int64_t i0, int64_t j0,
+                         int64_t nx_local, int64_t ny_local, double dx, double dy, dpsm_grid **out) {
+    return dpsm::create_distributed(MPI_Comm_f2c(comm), nx_global, ny_global, i0, j0, nx_local, ny_local, dx, dy,
+                                    out, "dpsm_create_2d_mpi_f");
+}
+
+}  // extern "C"

@@ -1,0 +1,504 @@
+/* Distributed grids (dpsm_mpi.h) against serial runs of the same scenes.
+ *
+ * Run under mpiexec with any number of ranks. For every scene and every
+ * decomposition of its global grid into one block per rank (strips along x,
+ * strips along y, a px x py grid of blocks, uneven blocks, blocks narrower
+ * than the 5-cell halo), each rank runs the scene on its block of a
+ * distributed grid and, alone, on a serial grid of the whole scene, and
+ * requires after every step:
+ *   - its block's heights equal the serial heights bit for bit;
+ *   - the step information (sub-steps, time integrated, rest, largest excess
+ *     slope) equals the serial figures, on every rank;
+ *   - the four mass figures equal the serial ones to 1e-12 of the mass;
+ *     the ledger closes.
+ * Then bad decompositions and disagreeing ranks must fail on every rank with
+ * a message naming the problem.
+ *
+ * Every failed check prints rank, scene, decomposition and the first
+ * differing cell; the program exits non-zero when any rank saw a failure.
+ */
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <mpi.h>
+
+#include <dpsm/dpsm.h>
+#include <dpsm/dpsm_mpi.h>
+
+static int rank_, size_;
+static long failures_;
+static long checks_;
+
+#if defined(__GNUC__)
+__attribute__((format(printf, 2, 3)))
+#endif
+static void require(int cond, const char *fmt, ...) {
+    ++checks_;
+    if (cond) return;
+    ++failures_;
+    va_list ap;
+    va_start(ap, fmt);
+    fprintf(stderr, "FAIL (rank %d of %d): ", rank_, size_);
+    vfprintf(stderr, fmt, ap);
+    fputc('\n', stderr);
+    va_end(ap);
+}
+
+#define OK(g, call)                                                                                       \
+    do {                                                                                                  \
+        int status_ = (call);                                                                             \
+        require(status_ == DPSM_OK, "%s:%d: %s returned %s: %s", __FILE__, __LINE__, #call,               \
+                dpsm_status_string(status_), dpsm_last_error(g));                                         \
+    } while (0)
+
+typedef struct {
+    int64_t i0, j0, ni, nj;
+} block_t;
+
+/* ---- decompositions ------------------------------------------------------ */
+
+enum { STRIPS_X, STRIPS_Y, GRID_2D, UNEVEN, NARROW, N_DECOMPOSITIONS };
+static const char *const decomposition_names[] = {"strips along x", "strips along y", "px x py blocks",
+                                                  "uneven blocks", "blocks narrower than the halo"};
+
+/* The k-th of n parts of [0, n_cells): uneven on purpose (the first parts larger). */
+static void split(int64_t n_cells, int n, int k, int64_t *start, int64_t *count) {
+    int64_t base = n_cells / n, extra = n_cells % n;
+    *start = k * base + (k < extra ? k : extra);
+    *count = base + (k < extra ? 1 : 0);
+}
+
+/* This rank's block of an nx x ny grid under decomposition `kind`. */
+static block_t block_of(int kind, int rank, int size, int64_t nx, int64_t ny) {
+    block_t b = {0, 0, nx, ny};
+    if (size == 1) return b;
+    switch (kind) {
+        case STRIPS_X: split(nx, size, rank, &b.i0, &b.ni); break;
+        case STRIPS_Y: split(ny, size, rank, &b.j0, &b.nj); break;
+        case GRID_2D: {
+            int px = 1;
+            for (int p = 1; p * p <= size; ++p)
+                if (size % p == 0) px = p;
+            int py = size / px;
+            split(nx, px, rank % px, &b.i0, &b.ni);
+            split(ny, py, rank / px, &b.j0, &b.nj);
+            break;
+        }
+        case UNEVEN: {
+            /* Blocks that do not line up: the first half of the ranks split a
+             * left part in rows at one place, the rest a right part at others. */
+            int64_t cut = nx / 3 + 7;
+            int left = size / 2, right = size - left;
+            if (rank < left) {
+                b.ni = cut;
+                int64_t start, count;
+                split(ny, left, rank, &start, &count);
+                b.j0 = start;
+                b.nj = count;
+                if (left > 1 && rank == 0) b.nj += 9; /* move the row boundary off the even split */
+                if (left > 1 && rank == 1) {
+                    b.j0 += 9;
+                    b.nj -= 9;
+                }
+            } else {
+                b.i0 = cut;
+                b.ni = nx - cut;
+                int64_t start, count;
+                split(ny, right, rank - left, &start, &count);
+                b.j0 = start;
+                b.nj = count;
+            }
+            break;
+        }
+        case NARROW: {
+            /* Ranks but the last own strips of 1, 2, 3 ... columns (fewer than
+             * the halo's 5), the last rank the rest. */
+            int64_t at = 0;
+            for (int r = 0; r < rank; ++r) at += 1 + r % 4;
+            b.i0 = at;
+            b.ni = rank == size - 1 ? nx - at : 1 + rank % 4;
+            break;
+        }
+    }
+    return b;
+}
+
+/* ---- scenes -------------------------------------------------------------- */
+
+typedef struct {
+    const char *name;
+    int64_t nx, ny;
+    double dx, dy;
+    int sides[4];
+    int scheme;
+    double theta;
+    int steps;
+    double dt_in_stable_steps; /* dt of each dpsm_step, in units of dpsm_stable_dt */
+    double *h, *q;             /* nx*ny; q may be NULL */
+    uint8_t *kinds;            /* may be NULL */
+    /* Between steps: the host adds a bump here (global cells), and later sets new kinds. */
+    int bump_before_step;
+    block_t bump;
+    int new_kinds_before_step;
+    uint8_t *new_kinds;
+    /* When > 0: the bump is a spike of this height, 2 cells inside rank 1's
+     * block, on a surface at rest: only the tiles near it may move, and
+     * across the blocks' edge only the neighbour's activity can wake them. */
+    double spike;
+} scene_t;
+
+static double *zeros(int64_t n) { return calloc((size_t)n, sizeof(double)); }
+
+/* A column of height h0 and radius r0 centred at (cx, cy), in cells. */
+static void add_column(double *h, int64_t nx, int64_t ny, double cx, double cy, double r0, double h0) {
+    for (int64_t j = 0; j < ny; ++j)
+        for (int64_t i = 0; i < nx; ++i) {
+            double x = (double)i + 0.5 - cx, y = (double)j + 0.5 - cy;
+            if (x * x + y * y <= r0 * r0) h[i + nx * j] += h0;
+        }
+}
+
+static scene_t collapse_open(void) {
+    scene_t s = {"collapsing column, open sides", 150, 131, 1.0, 1.0, {DPSM_OPEN, DPSM_OPEN, DPSM_OPEN, DPSM_OPEN},
+                 DPSM_SCHEME_ISOTROPIC, 0.55, 6, 60.0, NULL, NULL, NULL, 0, {0, 0, 0, 0}, 0, NULL, 0.0};
+    s.h = zeros(s.nx * s.ny);
+    add_column(s.h, s.nx, s.ny, 66.0, 60.5, 24.0, 30.0);
+    s.bump_before_step = 3;
+    s.bump = (block_t){30, 20, 50, 40};
+    return s;
+}
+
+static scene_t source_walls(void) {
+    scene_t s = {"source straddling blocks, walls and an open side", 97, 140, 0.5, 0.7,
+                 {DPSM_WALL, DPSM_OPEN, DPSM_WALL, DPSM_WALL}, DPSM_SCHEME_ISOTROPIC, 0.6, 8, 25.0,
+                 NULL, NULL, NULL, 0, {0, 0, 0, 0}, 0, NULL, 0.0};
+    s.h = zeros(s.nx * s.ny);
+    s.q = zeros(s.nx * s.ny);
+    for (int64_t j = 0; j < s.ny; ++j)
+        for (int64_t i = 0; i < s.nx; ++i) {
+            s.h[i + s.nx * j] = 0.01 * (double)((i * 7 + j * 13) % 11);
+            if (i >= 20 && i < 60 && j >= 50 && j < 90) s.q[i + s.nx * j] = 0.3 + 0.01 * (double)(i % 5);
+        }
+    return s;
+}
+
+static scene_t obstacles(void) {
+    scene_t s = {"walls and sinks straddling blocks, pairwise scheme", 140, 100, 1.0, 1.0,
+                 {DPSM_WALL, DPSM_WALL, DPSM_OPEN, DPSM_WALL}, DPSM_SCHEME_PAIRWISE, 0.5, 6, 40.0,
+                 NULL, NULL, NULL, 0, {0, 0, 0, 0}, 0, NULL, 0.0};
+    int64_t n = s.nx * s.ny;
+    s.h = zeros(n);
+    s.kinds = calloc((size_t)n, 1);
+    s.new_kinds = calloc((size_t)n, 1);
+    add_column(s.h, s.nx, s.ny, 50.0, 50.0, 30.0, 25.0);
+    add_column(s.h, s.nx, s.ny, 100.0, 40.0, 15.0, 12.0);
+    for (int64_t j = 0; j < s.ny; ++j)
+        for (int64_t i = 0; i < s.nx; ++i) {
+            uint8_t k = DPSM_CELL_SAND;
+            if (i >= 45 && i < 75 && j >= 48 && j < 53) k = DPSM_CELL_WALL;    /* a wall across blocks */
+            if ((i - 70) * (i - 70) + (j - 70) * (j - 70) < 40) k = DPSM_CELL_OPEN; /* a sink */
+            if (i == 1 || j == 98) k = DPSM_CELL_WALL;                        /* thin walls along edges */
+            s.kinds[i + s.nx * j] = k;
+            s.new_kinds[i + s.nx * j] = k;
+            if (i >= 20 && i < 90 && j == 30) s.new_kinds[i + s.nx * j] = DPSM_CELL_OPEN; /* a new trench */
+        }
+    for (int64_t c = 0; c < n; ++c)
+        if (s.kinds[c] == DPSM_CELL_OPEN) s.h[c] = 1.5; /* sinks held at 1.5 */
+    s.new_kinds_before_step = 3;
+    return s;
+}
+
+static scene_t spike_near_edge(void) {
+    scene_t s = {"a spike near a block's edge on a surface at rest", 140, 120, 1.0, 1.0,
+                 {DPSM_WALL, DPSM_WALL, DPSM_WALL, DPSM_WALL}, DPSM_SCHEME_ISOTROPIC, 0.6, 6, 10.0,
+                 NULL, NULL, NULL, 0, {0, 0, 0, 0}, 0, NULL, 0.0};
+    s.h = zeros(s.nx * s.ny);
+    for (int64_t j = 0; j < s.ny; ++j)
+        for (int64_t i = 0; i < s.nx; ++i) s.h[i + s.nx * j] = 0.3 * (double)((i + j) % 2); /* at rest: slope 0.3 < tan 0.6 */
+    s.bump_before_step = 1;
+    s.spike = 8.0;
+    return s;
+}
+
+static void free_scene(scene_t *s) {
+    free(s->h);
+    free(s->q);
+    free(s->kinds);
+    free(s->new_kinds);
+}
+
+/* Copies the block b of a global nx-wide array (element size `size`). */
+static void *sub_array(const void *global, size_t size, int64_t nx, block_t b) {
+    char *out = malloc((size_t)(b.ni * b.nj) * size);
+    for (int64_t j = 0; j < b.nj; ++j)
+        memcpy(out + (size_t)(j * b.ni) * size, (const char *)global + (size_t)(b.i0 + nx * (b.j0 + j)) * size,
+               (size_t)b.ni * size);
+    return out;
+}
+
+/* Sets up g (the whole scene when b is the whole grid, else its block b). */
+static void set_scene(dpsm_grid *g, const scene_t *s, block_t b) {
+    for (int side = DPSM_XMIN; side <= DPSM_YMAX; ++side) OK(g, dpsm_set_boundary(g, side, s->sides[side]));
+    OK(g, dpsm_set_scheme(g, s->scheme));
+    OK(g, dpsm_set_repose_angle(g, s->theta));
+    if (s->kinds) {
+        uint8_t *k = sub_array(s->kinds, 1, s->nx, b);
+        OK(g, dpsm_set_cell_kinds(g, k));
+        free(k);
+    }
+    double *h = sub_array(s->h, sizeof(double), s->nx, b);
+    OK(g, dpsm_set_heights(g, h));
+    free(h);
+    if (s->q) {
+        double *q = sub_array(s->q, sizeof(double), s->nx, b);
+        OK(g, dpsm_set_source(g, q));
+        free(q);
+    }
+}
+
+/* The host's changes before step `step`, on the part of them in block b. */
+static void host_changes(dpsm_grid *g, const scene_t *s, block_t b, int step) {
+    if (s->bump_before_step == step) {
+        int64_t i0 = s->bump.i0 > b.i0 ? s->bump.i0 : b.i0, j0 = s->bump.j0 > b.j0 ? s->bump.j0 : b.j0;
+        int64_t i1 = s->bump.i0 + s->bump.ni < b.i0 + b.ni ? s->bump.i0 + s->bump.ni : b.i0 + b.ni;
+        int64_t j1 = s->bump.j0 + s->bump.nj < b.j0 + b.nj ? s->bump.j0 + s->bump.nj : b.j0 + b.nj;
+        if (i1 > i0 && j1 > j0) {
+            double *dh = malloc((size_t)((i1 - i0) * (j1 - j0)) * sizeof(double));
+            for (int64_t j = j0; j < j1; ++j)
+                for (int64_t i = i0; i < i1; ++i)
+                    dh[(i - i0) + (i1 - i0) * (j - j0)] = s->spike > 0 ? s->spike : 0.05 * (double)((i + 3 * j) % 40);
+            OK(g, dpsm_add_heights_region(g, i0 - b.i0, j0 - b.j0, i1 - i0, j1 - j0, dh));
+            free(dh);
+        }
+    }
+    if (s->new_kinds && s->new_kinds_before_step == step) {
+        uint8_t *k = sub_array(s->new_kinds, 1, s->nx, b);
+        OK(g, dpsm_set_cell_kinds(g, k));
+        free(k);
+    }
+}
+
+static void compare_step_info(const dpsm_grid *g, const dpsm_grid *serial, const char *what) {
+    const int items[] = {DPSM_INFO_SUBSTEPS, DPSM_INFO_TIME_INTEGRATED, DPSM_INFO_AT_REST, DPSM_INFO_MAX_EXCESS_SLOPE};
+    const char *names[] = {"sub-steps", "time integrated", "at rest", "largest excess slope"};
+    for (int k = 0; k < 4; ++k) {
+        double a = -1, b = -2;
+        OK(g, dpsm_get_step_info(g, items[k], &a));
+        OK(serial, dpsm_get_step_info(serial, items[k], &b));
+        require(a == b, "%s: step info %s is %.17g distributed, %.17g serial", what, names[k], a, b);
+    }
+}
+
+static void compare_mass(const dpsm_grid *g, const dpsm_grid *serial, const char *what) {
+    const int q[] = {DPSM_MASS_TOTAL, DPSM_MASS_SOURCED, DPSM_MASS_EXTERNAL, DPSM_MASS_OUTFLOW};
+    const char *names[] = {"total", "sourced", "external", "outflow"};
+    double a[4], b[4];
+    for (int k = 0; k < 4; ++k) {
+        OK(g, dpsm_get_mass(g, q[k], &a[k]));
+        OK(serial, dpsm_get_mass(serial, q[k], &b[k]));
+    }
+    double scale = fabs(b[0]) + fabs(b[1]) + fabs(b[2]) + fabs(b[3]);
+    for (int k = 0; k < 4; ++k)
+        require(fabs(a[k] - b[k]) <= 1e-12 * scale, "%s: mass %s is %.17g distributed, %.17g serial (scale %g)", what,
+                names[k], a[k], b[k], scale);
+    double residual = fabs(a[0] - (a[1] + a[2] - a[3]));
+    require(residual <= 1e-12 * scale, "%s: the global ledger does not close: residual %g of %g", what, residual, scale);
+    /* Every rank must hold the same global figures. */
+    double lo[4], hi[4];
+    MPI_Allreduce(a, lo, 4, MPI_DOUBLE, MPI_MIN, MPI_COMM_WORLD);
+    MPI_Allreduce(a, hi, 4, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
+    for (int k = 0; k < 4; ++k)
+        require(lo[k] == hi[k], "%s: mass %s differs between ranks (%.17g .. %.17g)", what, names[k], lo[k], hi[k]);
+}
+
+/* Runs scene s on decomposition `kind` and on a serial grid; returns the
+ * largest |difference| of heights seen (0 when bit for bit). */
+static void run_scene(const scene_t *s, int kind) {
+    char what[256];
+    block_t b = block_of(kind, rank_, size_, s->nx, s->ny);
+    block_t whole = {0, 0, s->nx, s->ny};
+    scene_t placed = *s;
+    if (s->spike > 0) {
+        block_t near = block_of(kind, size_ > 1 ? 1 : 0, size_, s->nx, s->ny);
+        placed.bump = (block_t){near.i0 + 2 < s->nx - 2 ? near.i0 + 2 : s->nx - 2,
+                                near.j0 + 2 < s->ny - 2 ? near.j0 + 2 : s->ny - 2, 2, 2};
+        s = &placed;
+    }
+    dpsm_grid *g = NULL, *serial = NULL;
+    int status = dpsm_create_2d_mpi(MPI_COMM_WORLD, s->nx, s->ny, b.i0, b.j0, b.ni, b.nj, s->dx, s->dy, &g);
+    snprintf(what, sizeof what, "%s, %s, block [%lld, %lld) x [%lld, %lld)", s->name, decomposition_names[kind],
+             (long long)b.i0, (long long)(b.i0 + b.ni), (long long)b.j0, (long long)(b.j0 + b.nj));
+    require(status == DPSM_OK, "%s: dpsm_create_2d_mpi: %s: %s", what, dpsm_status_string(status), dpsm_last_error(NULL));
+    if (status != DPSM_OK) return;
+    OK(NULL, dpsm_create_2d(s->nx, s->ny, s->dx, s->dy, &serial));
+    set_scene(g, s, b);
+    set_scene(serial, s, whole);
+
+    int64_t shape_x = 0, shape_y = 0;
+    OK(g, dpsm_get_shape(g, &shape_x, &shape_y));
+    require(shape_x == b.ni && shape_y == b.nj, "%s: dpsm_get_shape gives %lld x %lld", what, (long long)shape_x,
+            (long long)shape_y);
+    compare_mass(g, serial, what);
+
+    double stable = 0;
+    OK(serial, dpsm_stable_dt(serial, &stable));
+    const double dt = s->dt_in_stable_steps * stable;
+    double *mine = malloc((size_t)(b.ni * b.nj) * sizeof(double));
+    double *ref = malloc((size_t)(b.ni * b.nj) * sizeof(double));
+    int moved_any = 0;
+    for (int step = 0; step < s->steps; ++step) {
+        char at[320];
+        snprintf(at, sizeof at, "%s, step %d", what, step);
+        host_changes(g, s, b, step);
+        host_changes(serial, s, whole, step);
+        OK(g, dpsm_step(g, dt));
+        OK(serial, dpsm_step(serial, dt));
+        OK(g, dpsm_get_heights(g, mine));
+        OK(serial, dpsm_get_heights_region(serial, b.i0, b.j0, b.ni, b.nj, ref));
+        int64_t differ = 0, first = -1;
+        double worst = 0.0;
+        for (int64_t c = 0; c < b.ni * b.nj; ++c)
+            if (memcmp(&mine[c], &ref[c], sizeof(double)) != 0) {
+                if (first < 0) first = c;
+                ++differ;
+                if (fabs(mine[c] - ref[c]) > worst) worst = fabs(mine[c] - ref[c]);
+            }
+        require(differ == 0,
+                "%s: %lld cells differ from the serial run (largest |difference| %g); first: global cell (%lld, %lld)"
+                " is %.17g, serially %.17g",
+                at, (long long)differ, worst, first < 0 ? -1LL : (long long)(b.i0 + first % b.ni),
+                first < 0 ? -1LL : (long long)(b.j0 + first / b.ni), first < 0 ? 0.0 : mine[first],
+                first < 0 ? 0.0 : ref[first]);
+        compare_step_info(g, serial, at);
+        compare_mass(g, serial, at);
+        double substeps = 0;
+        OK(serial, dpsm_get_step_info(serial, DPSM_INFO_SUBSTEPS, &substeps));
+        if (substeps > 0) moved_any = 1;
+    }
+    require(moved_any, "%s: the scene never moved: it tests nothing", what);
+    free(mine);
+    free(ref);
+    dpsm_destroy(serial);
+    dpsm_destroy(g);
+}
+
+/* ---- bad input ----------------------------------------------------------- */
+
+/* Every rank must get a non-zero status and a message containing `needle`. */
+static void expect_create_fails(const char *what, int64_t nxg, int64_t nyg, block_t b, int null_out,
+                                const char *needle) {
+    dpsm_grid *g = (dpsm_grid *)&g; /* not NULL: the call must set it to NULL */
+    int status = dpsm_create_2d_mpi(MPI_COMM_WORLD, nxg, nyg, b.i0, b.j0, b.ni, b.nj, 1.0, 1.0, null_out ? NULL : &g);
+    const char *msg = dpsm_last_error(NULL);
+    require(status != DPSM_OK, "%s: dpsm_create_2d_mpi succeeded", what);
+    require(strstr(msg, needle) != NULL, "%s: the message \"%s\" does not name the problem (\"%s\")", what, msg, needle);
+    if (!null_out) require(g == NULL, "%s: *out is not NULL after a failure", what);
+    if (status == DPSM_OK && !null_out) dpsm_destroy(g);
+    int all = 0, mine = status != DPSM_OK;
+    MPI_Allreduce(&mine, &all, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
+    require(all == 1, "%s: some rank did not fail", what);
+    if (rank_ == 0) printf("  refused on every rank: %s: %s\n", what, msg);
+}
+
+static void bad_decompositions(void) {
+    const int64_t nx = 40, ny = 30;
+    block_t good = block_of(STRIPS_X, rank_, size_, nx, ny);
+    /* A gap: the last rank's block loses its last column (or the only rank's). */
+    block_t gap = good;
+    if (rank_ == size_ - 1) gap.ni -= 1;
+    expect_create_fails("a gap", nx, ny, gap, 0, "cover");
+    /* A block outside the grid. */
+    block_t outside = good;
+    if (rank_ == 0) outside.i0 = -1;
+    expect_create_fails("a block outside the grid", nx, ny, outside, 0, "does not lie in the global grid");
+    /* A NULL out on one rank. */
+    expect_create_fails("out NULL on rank 0", nx, ny, good, rank_ == 0, "out is NULL on rank 0");
+    if (rank_ == 0) {
+        /* rank 0 alone cannot read the message when its out is NULL: it is the same string */
+    }
+    /* A zero-sized block. */
+    block_t empty = good;
+    if (rank_ == 0) empty.ni = 0;
+    expect_create_fails("an empty block", nx, ny, empty, 0, "must be at least 1");
+    if (size_ >= 2) {
+        /* An overlap: rank 1's block starts one column early. */
+        block_t overlap = good;
+        if (rank_ == 1) {
+            overlap.i0 -= 1;
+            overlap.ni += 1;
+        }
+        expect_create_fails("an overlap", nx, ny, overlap, 0, "overlap");
+        /* The ranks disagree on the global size. */
+        expect_create_fails("a wrong global size on the last rank", rank_ == size_ - 1 ? nx + 1 : nx, ny, good, 0,
+                            "disagree on the global grid");
+    }
+    /* Not MPI_COMM_NULL. */
+    dpsm_grid *g = NULL;
+    int status = dpsm_create_2d_mpi(MPI_COMM_NULL, nx, ny, good.i0, good.j0, good.ni, good.nj, 1.0, 1.0, &g);
+    require(status != DPSM_OK && strstr(dpsm_last_error(NULL), "MPI_COMM_NULL") != NULL,
+            "MPI_COMM_NULL: status %d, message %s", status, dpsm_last_error(NULL));
+}
+
+/* Ranks that step different dt or with different parameters fail alike, and
+ * the grid is unchanged: a step with agreeing ranks then matches serial. */
+static void disagreeing_ranks(void) {
+    if (size_ < 2) return;
+    const int64_t nx = 60, ny = 50;
+    block_t b = block_of(GRID_2D, rank_, size_, nx, ny);
+    dpsm_grid *g = NULL;
+    OK(NULL, dpsm_create_2d_mpi(MPI_COMM_WORLD, nx, ny, b.i0, b.j0, b.ni, b.nj, 1.0, 1.0, &g));
+    if (!g) return;
+    double *h = calloc((size_t)(b.ni * b.nj), sizeof(double));
+    for (int64_t c = 0; c < b.ni * b.nj; ++c) h[c] = (double)((c * 37) % 17);
+    OK(g, dpsm_set_heights(g, h));
+    int status = dpsm_step(g, rank_ == 1 ? 2.0 : 1.0);
+    require(status == DPSM_ERR_INVALID_VALUE && strstr(dpsm_last_error(g), "differ in dt") != NULL,
+            "different dt: status %s, message \"%s\"", dpsm_status_string(status), dpsm_last_error(g));
+    OK(g, dpsm_set_repose_angle(g, rank_ == 0 ? 0.5 : 0.6));
+    status = dpsm_step(g, 1.0);
+    require(status == DPSM_ERR_INVALID_VALUE && strstr(dpsm_last_error(g), "repose angle") != NULL,
+            "different repose angles: status %s, message \"%s\"", dpsm_status_string(status), dpsm_last_error(g));
+    if (rank_ == 0) printf("  refused on every rank: %s\n", dpsm_last_error(g));
+    double *after = calloc((size_t)(b.ni * b.nj), sizeof(double));
+    OK(g, dpsm_get_heights(g, after));
+    require(memcmp(h, after, (size_t)(b.ni * b.nj) * sizeof(double)) == 0, "a refused step changed the heights");
+    OK(g, dpsm_set_repose_angle(g, 0.6));
+    OK(g, dpsm_step(g, 1.0));
+    free(h);
+    free(after);
+    dpsm_destroy(g);
+}
+
+int main(int argc, char **argv) {
+    MPI_Init(&argc, &argv);
+    MPI_Comm_rank(MPI_COMM_WORLD, &rank_);
+    MPI_Comm_size(MPI_COMM_WORLD, &size_);
+    if (rank_ == 0) printf("test_mpi on %d ranks\n", size_);
+
+    scene_t (*scenes[])(void) = {collapse_open, source_walls, obstacles, spike_near_edge};
+    for (size_t k = 0; k < sizeof scenes / sizeof scenes[0]; ++k) {
+        scene_t s = scenes[k]();
+        for (int kind = 0; kind < N_DECOMPOSITIONS; ++kind) {
+            long before = failures_;
+            run_scene(&s, kind);
+            long total = 0, mine = failures_ - before;
+            MPI_Allreduce(&mine, &total, 1, MPI_LONG, MPI_SUM, MPI_COMM_WORLD);
+            if (rank_ == 0)
+                printf("  %s: %s: %s\n", s.name, decomposition_names[kind],
+                       total == 0 ? "heights bit for bit, mass to 1e-12" : "FAILED");
+        }
+        free_scene(&s);
+    }
+    bad_decompositions();
+    disagreeing_ranks();
+
+    long total = 0, all_checks = 0;
+    MPI_Allreduce(&failures_, &total, 1, MPI_LONG, MPI_SUM, MPI_COMM_WORLD);
+    MPI_Allreduce(&checks_, &all_checks, 1, MPI_LONG, MPI_SUM, MPI_COMM_WORLD);
+    if (rank_ == 0) printf("%ld checks on %d ranks, %ld failed\n", all_checks, size_, total);
+    MPI_Finalize();
+    return total == 0 ? 0 : 1;
+}

@@ -1,0 +1,83 @@
+! The Fortran binding of the MPI component (module dpsm_mpi), under mpiexec:
+! each rank owns a strip of columns of a 50 x 40 grid; after every step its
+! block must equal, bit for bit, the same block of a serial run of the whole
+! scene, and the global mass must match; a decomposition with a gap must fail
+! on every rank with a message that says so.
+program test_mpi_fortran
+  use, intrinsic :: iso_c_binding, only: c_double, c_int64_t
+  use mpi
+  use dpsm
+  use dpsm_mpi
+  implicit none
+  integer, parameter :: nx = 50, ny = 40
+  type(dpsm_grid) :: g, serial
+  integer :: ierr, rank, ranks, i, j, step, failures, total, i0, ni
+  real(c_double) :: h(nx, ny), dt, mass_g, mass_s
+  real(c_double), allocatable :: mine(:, :), ref(:, :)
+  character(len=:), allocatable :: message
+
+  call MPI_Init(ierr)
+  call MPI_Comm_rank(MPI_COMM_WORLD, rank, ierr)
+  call MPI_Comm_size(MPI_COMM_WORLD, ranks, ierr)
+  failures = 0
+
+  ! This rank's strip of columns [i0, i0 + ni), uneven.
+  i0 = rank*(nx/ranks) + min(rank, mod(nx, ranks))
+  ni = nx/ranks
+  if (rank < mod(nx, ranks)) ni = ni + 1
+
+  do j = 1, ny
+    do i = 1, nx
+      h(i, j) = 0.0_c_double
+      if ((i - 25)**2 + (j - 20)**2 < 100) h(i, j) = 12.0_c_double
+    end do
+  end do
+
+  call dpsm_create_2d_mpi(g, MPI_COMM_WORLD, nx, ny, i0, 0, ni, ny, 1.0_c_double, 1.0_c_double)
+  call dpsm_create_2d(serial, nx, ny, 1.0_c_double, 1.0_c_double)
+  do i = DPSM_XMIN, DPSM_YMAX
+    call dpsm_set_boundary(g, i, DPSM_OPEN)
+    call dpsm_set_boundary(serial, i, DPSM_OPEN)
+  end do
+  call dpsm_set_heights(g, h(i0 + 1:i0 + ni, :))
+  call dpsm_set_heights(serial, h)
+  call dpsm_stable_dt(serial, dt)
+  dt = 30*dt
+  allocate (mine(ni, ny), ref(ni, ny))
+  do step = 1, 4
+    call dpsm_step(g, dt)
+    call dpsm_step(serial, dt)
+    call dpsm_get_heights(g, mine)
+    call dpsm_get_heights_region(serial, i0, 0, ni, ny, ref)
+    if (any(mine /= ref)) then
+      failures = failures + 1
+      print '(a,i0,a,i0,a,i0)', 'FAIL: rank ', rank, ' step ', step, ': cells differing from serial: ', &
+        count(mine /= ref)
+    end if
+    call dpsm_get_mass(g, DPSM_MASS_TOTAL, mass_g)
+    call dpsm_get_mass(serial, DPSM_MASS_TOTAL, mass_s)
+    if (abs(mass_g - mass_s) > 1e-12_c_double*abs(mass_s)) then
+      failures = failures + 1
+      print '(a,i0,a,2es25.17)', 'FAIL: rank ', rank, ' global mass differs: ', mass_g, mass_s
+    end if
+  end do
+  call dpsm_destroy(g)
+  call dpsm_destroy(serial)
+
+  ! A gap: the last rank leaves out its last column.
+  if (rank == ranks - 1) ni = ni - 1
+  call dpsm_create_2d_mpi(g, MPI_COMM_WORLD, int(nx, c_int64_t), int(ny, c_int64_t), int(i0, c_int64_t), &
+                          0_c_int64_t, int(ni, c_int64_t), int(ny, c_int64_t), 1.0_c_double, 1.0_c_double, ierr)
+  message = dpsm_last_error()
+  if (ierr == DPSM_OK .or. index(message, 'belongs to no rank') == 0 .or. dpsm_associated(g)) then
+    failures = failures + 1
+    print '(a,i0,a,i0,2a)', 'FAIL: rank ', rank, ' a gap gave status ', ierr, ' and message: ', message
+  else if (rank == 0) then
+    print '(2a)', 'refused on every rank: ', message
+  end if
+
+  call MPI_Allreduce(failures, total, 1, MPI_INTEGER, MPI_SUM, MPI_COMM_WORLD, ierr)
+  if (rank == 0) print '(a,i0,a,i0)', 'test_mpi_fortran on ', ranks, ' ranks: failures ', total
+  call MPI_Finalize(ierr)
+  if (total /= 0) error stop 1
+end program test_mpi_fortran
