@@ -1566,6 +1566,77 @@ static void test_mass_ledger_axisymmetric(void **state) {
 /* The source acts on sand cells only                                        */
 /* ------------------------------------------------------------------------ */
 
+/* The physics setters with good inputs: accepted, undone by NULL or the
+ * default, and the stable step follows them. */
+static void test_physics_setters(void **state) {
+    (void)state;
+    dpsm_grid *g = NULL;
+    CHECK_OK(NULL, dpsm_create_2d(6, 4, 0.5, 0.5, &g));
+    double h[24], zb[24], theta[24], dt_plain = 0.0, dt = 0.0;
+    for (int c = 0; c < 24; ++c) {
+        h[c] = 1.0 + 0.1 * c;
+        zb[c] = h[c];  /* a bed at the surface is allowed: bare rock */
+        theta[c] = (c % 2 ? 20.0 : 40.0) * kPi / 180.0;
+    }
+    CHECK_OK(g, dpsm_set_heights(g, h));
+    CHECK_OK(g, dpsm_stable_dt(g, &dt_plain));
+    CHECK_OK(g, dpsm_set_bedrock(g, zb));
+    CHECK_OK(g, dpsm_set_bedrock(g, NULL));
+    CHECK_OK(g, dpsm_set_bedrock(g, zb));
+    CHECK_OK(g, dpsm_set_repose_angle_field(g, theta));
+    CHECK_OK(g, dpsm_stable_dt(g, &dt));
+    REQUIRE_REL(dt, 1.0 / (2.0 * cos(20.0 * kPi / 180.0) * (4.0 + 4.0)), 1e-15);
+    CHECK_OK(g, dpsm_set_repose_angle_field(g, NULL));
+    CHECK_OK(g, dpsm_stable_dt(g, &dt));
+    REQUIRE(dt == dt_plain, "NULL returns to the uniform angle: %.17g vs %.17g", dt, dt_plain);
+    CHECK_OK(g, dpsm_set_flux_exponent(g, DPSM_MAX_FLUX_EXPONENT));
+    CHECK_OK(g, dpsm_stable_dt(g, &dt));
+    REQUIRE(dt > 0.0 && dt < dt_plain, "p = 2 has a steeper law, a smaller stable step: %.17g vs %.17g", dt, dt_plain);
+    CHECK_OK(g, dpsm_set_flux_exponent(g, DPSM_DEFAULT_FLUX_EXPONENT));
+    CHECK_OK(g, dpsm_stable_dt(g, &dt));
+    REQUIRE(dt == dt_plain, "p = 1 again: %.17g vs %.17g", dt, dt_plain);
+    CHECK_OK(g, dpsm_set_static_angle(g, 0.1)); /* below the angle of repose: acts as it */
+    CHECK_OK(g, dpsm_set_static_angle(g, 1.5));
+    CHECK_OK(g, dpsm_step(g, 1.0));
+    double unmet = -1.0;
+    CHECK_OK(g, dpsm_get_mass(g, DPSM_MASS_UNMET, &unmet));
+    REQUIRE(unmet == 0.0, "no erosion, no unmet: %g", unmet);
+    dpsm_destroy(g);
+}
+
+/* With a bed set, the host may not put a cell below it, by any of the three
+ * height setters; the grid stays as it was. NULL grids are refused. */
+static void test_heights_below_bed_refused(void **state) {
+    (void)state;
+    dpsm_grid *g = NULL;
+    CHECK_OK(NULL, dpsm_create_2d(5, 3, 1.0, 1.0, &g));
+    double h[15], zb[15], low[15], got[15];
+    for (int c = 0; c < 15; ++c) {
+        h[c] = 2.0;
+        zb[c] = 1.0;
+        low[c] = 2.0;
+    }
+    low[7] = 0.5;
+    CHECK_OK(g, dpsm_set_heights(g, h));
+    CHECK_OK(g, dpsm_set_bedrock(g, zb));
+    assert_int_equal(dpsm_set_heights(g, low), DPSM_ERR_INVALID_VALUE);
+    check_message_at(dpsm_last_error(g), "dpsm_set_heights", "h", "below its bed", __FILE__, __LINE__);
+    const double one_low = 0.9, drop = -1.5;
+    assert_int_equal(dpsm_set_heights_region(g, 2, 1, 1, 1, &one_low), DPSM_ERR_INVALID_VALUE);
+    check_message_at(dpsm_last_error(g), "dpsm_set_heights_region", "h", "below its bed", __FILE__, __LINE__);
+    assert_int_equal(dpsm_add_heights_region(g, 2, 1, 1, 1, &drop), DPSM_ERR_INVALID_VALUE);
+    check_message_at(dpsm_last_error(g), "dpsm_add_heights_region", "dh", "below its bed", __FILE__, __LINE__);
+    CHECK_OK(g, dpsm_get_heights(g, got));
+    REQUIRE(memcmp(got, h, sizeof h) == 0, "a refused call changed the heights");
+    const double to_bed = -1.0;
+    CHECK_OK(g, dpsm_add_heights_region(g, 2, 1, 1, 1, &to_bed)); /* down to the bed itself is fine */
+    EXPECT_NULL_GRID(dpsm_set_bedrock(NULL, zb), "dpsm_set_bedrock");
+    EXPECT_NULL_GRID(dpsm_set_repose_angle_field(NULL, NULL), "dpsm_set_repose_angle_field");
+    EXPECT_NULL_GRID(dpsm_set_flux_exponent(NULL, 1.0), "dpsm_set_flux_exponent");
+    EXPECT_NULL_GRID(dpsm_set_static_angle(NULL, 0.6), "dpsm_set_static_angle");
+    dpsm_destroy(g);
+}
+
 static void test_source_on_sand_cells_only(void **state) {
     (void)state;
     enum { NX = 5, NY = 4, N = NX * NY, WALL = 6, OPEN = 13 };
@@ -1840,6 +1911,58 @@ static void test_bad_source(void **state) {
     bad_array_cases(fx, 1);
 }
 
+/* The physics setters (issue 8): every bad value refused, naming it, and the
+ * grid unchanged (the fixture's twin checks hidden state). */
+static void test_bad_bedrock(void **state) {
+    fixture_t *fx = *state;
+    double h[MAX_CELLS], zb[MAX_CELLS];
+    CHECK_OK(fx->g, dpsm_get_heights(fx->g, h));
+    const size_t where[] = {0, fx->n / 2, fx->n - 1};
+    char detail[32];
+    for (size_t w = 0; w < 3; ++w) {
+        snprintf(detail, sizeof detail, "zb[%zu]", where[w]);
+        for (int k = 0; k < 4; ++k) {
+            CHECK_OK(fx->g, dpsm_get_heights(fx->g, h)); /* the probe after each failure steps the grid */
+            for (size_t c = 0; c < fx->n; ++c) zb[c] = h[c] - 1.0;
+            /* Not finite, outside the supported range, or above the cell's height. */
+            zb[where[w]] = k < 3 ? non_finite(k) : nextafter(h[where[w]], INFINITY);
+            EXPECT_FAIL_D(fx, dpsm_set_bedrock(fx->g, zb), DPSM_ERR_INVALID_VALUE, "dpsm_set_bedrock", "zb", detail);
+        }
+        for (size_t c = 0; c < fx->n; ++c) zb[c] = h[c] - 1.0;
+        zb[where[w]] = -2e50;
+        EXPECT_FAIL_D(fx, dpsm_set_bedrock(fx->g, zb), DPSM_ERR_INVALID_VALUE, "dpsm_set_bedrock", "zb", "range");
+    }
+}
+
+static void test_bad_repose_angle_field(void **state) {
+    fixture_t *fx = *state;
+    const double bad[] = {0.0, -0.1, kPi / 2.0, 2.0, NAN, INFINITY, -INFINITY};
+    double theta[MAX_CELLS];
+    char detail[48];
+    for (size_t k = 0; k < sizeof bad / sizeof *bad; ++k) {
+        for (size_t c = 0; c < fx->n; ++c) theta[c] = 0.6;
+        theta[fx->n - 1] = bad[k];
+        snprintf(detail, sizeof detail, "theta_radians[%zu]", fx->n - 1);
+        EXPECT_FAIL_D(fx, dpsm_set_repose_angle_field(fx->g, theta), DPSM_ERR_INVALID_VALUE,
+                      "dpsm_set_repose_angle_field", "theta_radians", detail);
+    }
+}
+
+static void test_bad_flux_exponent(void **state) {
+    fixture_t *fx = *state;
+    const double bad[] = {0.0, 0.5, 0.999999, -1.0, 2.000001, 3.0, 1e300, NAN, INFINITY, -INFINITY};
+    for (size_t k = 0; k < sizeof bad / sizeof *bad; ++k)
+        EXPECT_FAIL(fx, dpsm_set_flux_exponent(fx->g, bad[k]), DPSM_ERR_INVALID_VALUE, "dpsm_set_flux_exponent", "p");
+}
+
+static void test_bad_static_angle(void **state) {
+    fixture_t *fx = *state;
+    const double bad[] = {0.0, -0.0, -0.5, kPi / 2.0, 2.0, NAN, INFINITY, -INFINITY};
+    for (size_t k = 0; k < sizeof bad / sizeof *bad; ++k)
+        EXPECT_FAIL(fx, dpsm_set_static_angle(fx->g, bad[k]), DPSM_ERR_INVALID_VALUE, "dpsm_set_static_angle",
+                    "radians");
+}
+
 static void test_bad_get_heights(void **state) {
     fixture_t *fx = *state;
     EXPECT_FAIL(fx, dpsm_get_heights(fx->g, NULL), DPSM_ERR_NULL_POINTER, "dpsm_get_heights", "h");
@@ -1961,6 +2084,8 @@ int main(int argc, char **argv) {
         cmocka_unit_test(test_heights_region_1d_and_axisymmetric),
         cmocka_unit_test(test_add_heights_region_overflow),
         cmocka_unit_test(test_source_on_sand_cells_only),
+        cmocka_unit_test(test_physics_setters),
+        cmocka_unit_test(test_heights_below_bed_refused),
     };
 #define BAD_INPUT_TESTS                                                                                       \
     cmocka_unit_test(test_null_grid_every_function), cmocka_unit_test(test_bad_repose_angle),                 \
@@ -1971,7 +2096,9 @@ int main(int argc, char **argv) {
         cmocka_unit_test(test_bad_stable_dt), cmocka_unit_test(test_bad_step), cmocka_unit_test(test_bad_get_mass), \
         cmocka_unit_test(test_bad_get_step_info), cmocka_unit_test(test_bad_get_shape),                       \
         cmocka_unit_test(test_bad_rest_tolerance), cmocka_unit_test(test_bad_max_substeps),                   \
-        cmocka_unit_test(test_bad_threads),                                                                   \
+        cmocka_unit_test(test_bad_threads), cmocka_unit_test(test_bad_bedrock),                               \
+        cmocka_unit_test(test_bad_repose_angle_field), cmocka_unit_test(test_bad_flux_exponent),              \
+        cmocka_unit_test(test_bad_static_angle),                                                              \
         cmocka_unit_test(test_twin_still_identical)
     const struct CMUnitTest bad_2d[] = {BAD_INPUT_TESTS};
     const struct CMUnitTest bad_1d[] = {BAD_INPUT_TESTS};
