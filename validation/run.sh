@@ -22,8 +22,8 @@ data=$root/docs/data
 figures=$root/docs/figures
 
 cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=Release -DDPSM_BUILD_BENCH=ON \
-      -DDPSM_BUILD_TESTS=OFF -DDPSM_BUILD_DOCS=OFF -DDPSM_BUILD_EXAMPLES=OFF >/dev/null
-cmake --build "$build" --target dpsm-validate dpsm-bench
+      -DDPSM_BUILD_TESTS=OFF -DDPSM_BUILD_DOCS=OFF -DDPSM_BUILD_EXAMPLES=ON >/dev/null
+cmake --build "$build" --target dpsm-validate dpsm-bench dpsm-dune
 
 validate=$build/validation/dpsm-validate
 bench=$build/bench/dpsm-bench
@@ -54,7 +54,11 @@ run table_2d "$validate" table-2d "$data"
 run work_precision bash -c '"$1" work-precision "$2" "$3" > "$4"' _ "$bench" "$wp_max_n" "$wp_threads" \
     "$data/work_precision.csv"
 
+run dune_fig10 bash -c '"$1" "$2" > "$3"' _ "$build/examples/dpsm-dune" "$data/dune_fig10.csv" \
+    "$data/dune_fig10_summary.txt"
+
 "$python" "$root/validation/plot.py" "$data" "$figures"
+"$python" "$root/validation/plot_dune.py" "$data/dune_fig10.csv" "$figures/dune_fig10.png"
 "$python" "$root/bench/plot_work_precision.py" "$data/work_precision.csv" "$figures/work_precision.png" \
   | tee "$data/work_precision_orders.txt"
 echo "done: CSVs in docs/data/, figures in docs/figures/"
