@@ -13,6 +13,7 @@
 
 #include "dpsm/dpsm.h"
 #include "error.hpp"
+#include "limits.hpp"
 #include "grid.hpp"
 #include "restart.hpp"
 #include "handle.hpp"
@@ -21,6 +22,8 @@
 namespace {
 
 using dpsm::Error;
+using dpsm::kMaxCells;
+using dpsm::kMaxMagnitude;
 
 thread_local std::string error_without_grid;
 
@@ -85,10 +88,6 @@ void require_positive(double value, const char *function, const char *name) {
     if (!(value > 0.0)) fail(DPSM_ERR_INVALID_VALUE, function, name, " = ", value, " must be positive");
 }
 
-// The range in which every slope, its square and every cell area stay finite:
-// heights and sources within +-kMaxMagnitude, spacings and the mobility within
-// [1/kMaxMagnitude, kMaxMagnitude] (so |dh| / d <= 2e100, squared 4e200).
-constexpr double kMaxMagnitude = 1e50;
 
 const char *describe(double value) { return std::isnan(value) ? "NaN" : value > 0 ? "+Inf" : "-Inf"; }
 
@@ -176,9 +175,6 @@ void require_angle(double theta, const char *function, const char *name) {
         fail(DPSM_ERR_INVALID_VALUE, function, name, " = ", theta, " radians is outside (0, pi/2)");
 }
 
-// The largest number of cells we agree to address: every per-cell array must
-// fit in memory indices with room to spare.
-constexpr std::int64_t kMaxCells = std::numeric_limits<std::int64_t>::max() / 64;
 
 int create(int dim, bool axisymmetric, std::int64_t nx, std::int64_t ny, double dx, double dy, dpsm_grid **out, const char *function) {
     if (out) *out = nullptr;

@@ -23,6 +23,7 @@
 
 #include "dpsm/dpsm.h"
 #include "error.hpp"
+#include "limits.hpp"
 
 namespace dpsm {
 
@@ -42,9 +43,6 @@ constexpr std::uint32_t kHasAngleField = 1u << 2;
 constexpr std::uint32_t kHasMoving = 1u << 3;
 constexpr std::uint32_t kKnownFlags = kHasSource | kHasBed | kHasAngleField | kHasMoving;
 
-// The limits of the C API's setters (capi.cpp), which a file must respect too.
-constexpr double kMaxMagnitude = 1e50;
-constexpr std::int64_t kMaxCells = std::numeric_limits<std::int64_t>::max() / 64;
 
 // ---- CRC-32 (ISO-HDLC, as zlib, PNG and gzip: reflected 0xEDB88320) -------
 

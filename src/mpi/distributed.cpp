@@ -36,6 +36,7 @@
 #include "dpsm/dpsm.h"
 #include "dpsm/dpsm_mpi.h"
 #include "error.hpp"
+#include "limits.hpp"
 #include "grid.hpp"
 #include "handle.hpp"
 #include "ledger.hpp"
@@ -48,9 +49,6 @@ namespace {
 constexpr int kHaloDepth = ActiveSet::kMaxLevels + 1;
 constexpr int kTagHeights = 1;
 constexpr int kTagMasks = 2;
-// Spacings, as dpsm_create_2d accepts them (capi.cpp).
-constexpr double kMaxMagnitude = 1e50;
-constexpr std::int64_t kMaxCells = std::numeric_limits<std::int64_t>::max() / 64;
 
 struct Rect {
     std::int64_t i0 = 0, j0 = 0, ni = 0, nj = 0;  // [i0, i0 + ni) x [j0, j0 + nj)
