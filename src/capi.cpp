@@ -161,8 +161,7 @@ void require_above_bed(const dpsm_grid *g, const dpsm::Grid::Block &b, const dou
     }
 }
 
-// The physics of real scenes and restart files are not distributed yet: their
-// per-cell state is not in the halo exchange of a distributed grid.
+// Restart files hold one grid; a distributed grid is many (not supported yet).
 void require_serial(const dpsm_grid *g, const char *function) {
     if (g->core.decomposition())
         fail(DPSM_ERR_NOT_APPLICABLE, function,
@@ -444,7 +443,6 @@ int dpsm_set_bedrock(dpsm_grid *g, const double *zb) {
     const char *fn = "dpsm_set_bedrock";
     return guarded(g, fn, [&] {
         require_grid(g, fn);
-        require_serial(g, fn);
         if (zb) {
             require_finite_array(g, zb, fn, "zb");
             const dpsm::Geometry &geo = g->core.geometry();
@@ -462,7 +460,6 @@ int dpsm_set_repose_angle_field(dpsm_grid *g, const double *theta) {
     const char *fn = "dpsm_set_repose_angle_field";
     return guarded(g, fn, [&] {
         require_grid(g, fn);
-        require_serial(g, fn);
         if (theta) {
             const dpsm::Geometry &geo = g->core.geometry();
             for (std::int64_t c = 0; c < geo.cells(); ++c)
@@ -478,7 +475,6 @@ int dpsm_set_flux_exponent(dpsm_grid *g, double p) {
     const char *fn = "dpsm_set_flux_exponent";
     return guarded(g, fn, [&] {
         require_grid(g, fn);
-        require_serial(g, fn);
         require_finite(p, fn, "p");
         if (!(p >= 1.0 && p <= DPSM_MAX_FLUX_EXPONENT))
             fail(DPSM_ERR_INVALID_VALUE, fn, "p = ", p, " is outside [1, ", DPSM_MAX_FLUX_EXPONENT,
@@ -491,7 +487,6 @@ int dpsm_set_static_angle(dpsm_grid *g, double radians) {
     const char *fn = "dpsm_set_static_angle";
     return guarded(g, fn, [&] {
         require_grid(g, fn);
-        require_serial(g, fn);
         require_angle(radians, fn, "radians");
         g->core.set_static_angle(radians);
     });

@@ -38,6 +38,10 @@ struct HaloStore {
     std::vector<double> heights, sources;          // sources: 0 where none
     std::vector<float> residuals;
     std::vector<std::uint8_t> kinds;
+    // The physics of real scenes: bed and tan(theta) (0 where none) as the
+    // host last set them, and which cells were moving at the start of the sweep.
+    std::vector<double> bed, tan_theta;
+    std::vector<std::uint8_t> moving;
 
     void resize(int halo_depth, std::int64_t block_nx, std::int64_t block_ny) {
         depth = halo_depth;
@@ -48,6 +52,9 @@ struct HaloStore {
         sources.assign(n, 0.0);
         residuals.assign(n, 0.0f);
         kinds.assign(n, 0);
+        bed.assign(n, 0.0);
+        tan_theta.assign(n, 0.0);
+        moving.assign(n, 0);
     }
     // Whether block cell (i, j) (outside the block, within depth) is a cell of the global grid.
     bool in_domain(std::int64_t i, std::int64_t j) const {
@@ -79,10 +86,11 @@ public:
 
     const HaloStore &halo() const { return halo_; }
 
-    // Collective, at the start of dpsm_step: refreshes the halo's kinds and
-    // sources if the host changed them on any rank, checks that every rank
-    // steps the same dt with the same parameters (throws Error otherwise, on
-    // every rank alike), and returns the global flags.
+    // Collective, at the start of dpsm_step: refreshes the halo's kinds,
+    // sources, bed and angles if the host changed them on any rank, checks
+    // that every rank steps the same dt with the same parameters (throws Error
+    // otherwise, on every rank alike), gives the grid the smallest angle of
+    // repose of all blocks (it sets the sub-step), and returns the global flags.
     virtual StepAgreement agree_before_step(Grid &grid, double dt) = 0;
     // Collective, before each sweep: refreshes the halo's heights and
     // residuals and the active set's view of the neighbours' activity.

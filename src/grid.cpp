@@ -164,6 +164,7 @@ void Grid::set_bed(const double *zb) {
         bed_.assign(zb, zb + heights_.size());
     else
         bed_.clear();
+    ++masks_version_;
     touched_everywhere();
 }
 
@@ -181,6 +182,7 @@ void Grid::set_angle_field(const double *theta) {
         angle_field_.clear();
         tan_field_.clear();
     }
+    ++masks_version_;
     touched_everywhere();
 }
 

@@ -114,7 +114,13 @@ public:
     const std::vector<double> &tan_field() const { return tan_field_; }      // tan of angle_field
     void set_angle_field(const double *theta);                               // NULL: uniform
     // The smallest angle of repose of any cell: it sets the stable sub-step.
-    double min_repose_angle() const { return angle_field_.empty() ? repose_angle_ : min_angle_field_; }
+    double min_repose_angle() const {
+        if (distributed_min_angle_ > 0.0) return distributed_min_angle_;
+        return angle_field_.empty() ? repose_angle_ : min_angle_field_;
+    }
+    // On a block of a distributed grid: the smallest angle over all blocks,
+    // set by the Decomposition before each step.
+    void set_distributed_min_repose_angle(double theta) { distributed_min_angle_ = theta; }
     double flux_exponent() const { return flux_exponent_; }
     void set_flux_exponent(double p) {
         flux_exponent_ = p;
@@ -226,6 +232,7 @@ private:
     std::vector<double> bed_;
     std::vector<double> angle_field_, tan_field_;
     double min_angle_field_ = 0.0;
+    double distributed_min_angle_ = 0.0;  // 0: not distributed
     double flux_exponent_ = 1.0;
     double static_angle_ = 0.0, tan_static_ = 0.0;  // 0: no hysteresis
     std::vector<std::uint8_t> moving_;

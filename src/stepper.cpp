@@ -60,12 +60,12 @@ StepAgreement agree_before_step(Grid &grid, double dt) {
 }  // namespace
 
 void step(Grid &grid, double dt) {
+    const StepAgreement state = agree_before_step(grid, dt);  // first: it may set the smallest angle
     const double dt_max = stable_dt(grid);
     const double needed = std::ceil(dt / dt_max);
     // A count beyond 2^53 cannot be stepped exactly; a scene that comes to rest
     // never gets there, and one that may flow forever is refused.
     const bool bounded = needed <= 9007199254740992.0;
-    const StepAgreement state = agree_before_step(grid, dt);
     if (can_flow_forever(grid, state) && (!bounded || needed > static_cast<double>(grid.max_substeps()))) {
         std::ostringstream msg;
         msg << "dpsm_step: dt = " << dt << " needs " << needed << " sub-steps of at most " << dt_max

@@ -78,15 +78,24 @@ void gather(const Grid &grid, TileBuffers &b, std::int64_t gi0, std::int64_t gj0
 
 // Copies what the physics kernel reads besides heights: bed, angles and which
 // cells are moving; ghost cells are never moving and have no bed or angle.
-void gather_physics(const Grid &grid, TileBuffers &b, std::int64_t gi0, std::int64_t gj0) {
+// On a block of a distributed grid, the cells beyond the block that lie in
+// the global domain come from the halo store (decomposition.hpp).
+void gather_physics(const Grid &grid, const HaloStore *halo, TileBuffers &b, std::int64_t gi0, std::int64_t gj0) {
     const Geometry &geo = grid.geometry();
     const std::vector<double> &zb = grid.bed(), &tan_theta = grid.tan_field();
     const std::vector<std::uint8_t> &moving = grid.moving();
     for (int r = 0; r < b.height; ++r)
         for (int c = 0; c < b.width; ++c) {
             const std::int64_t i = gi0 + c, j = gj0 + r;
-            const bool in = i >= 0 && j >= 0 && i < geo.nx && j < geo.ny;
             const std::size_t at = static_cast<std::size_t>(r) * b.width + c;
+            const bool in = i >= 0 && j >= 0 && i < geo.nx && j < geo.ny;
+            if (!in && halo && halo->in_domain(i, j)) {
+                const std::size_t k = halo->index(i, j);
+                if (!zb.empty()) b.bed[at] = halo->bed[k];
+                if (!tan_theta.empty()) b.tan_theta[at] = halo->tan_theta[k];
+                if (!moving.empty()) b.moving[0][at] = halo->moving[k];
+                continue;
+            }
             const std::size_t cell = in ? static_cast<std::size_t>(i + geo.nx * j) : 0;
             if (!zb.empty()) b.bed[at] = in ? zb[cell] : 0.0;
             if (!tan_theta.empty()) b.tan_theta[at] = in ? tan_theta[cell] : 0.0;
@@ -214,7 +223,7 @@ std::int64_t tiled_sweep(Grid &grid, int levels, double dt, std::vector<LevelSum
         gather(grid, b, gi0, gj0, masked || physics, source);
         if (halo_store && !(gi0 >= 0 && gj0 >= 0 && gi0 + b.width <= geo.nx && gj0 + b.height <= geo.ny))
             gather_halo(grid, *halo_store, b, gi0, gj0, masked || physics, source);
-        if (physics) gather_physics(grid, b, gi0, gj0);
+        if (physics) gather_physics(grid, halo_store, b, gi0, gj0);
         const TileLevelFunction kernel =
             physics ? select_physics_tile_kernel(isotropic, source) : select_tile_kernel(masked, isotropic, source);
         const TileRect tile{halo, b.height - halo, halo, b.width - halo};

@@ -24,8 +24,12 @@
  * dpsm_get_mass() and dpsm_destroy(). Every rank
  * of the communicator must call the collective ones, in the same order, with
  * the same `dt` and the same parameters (repose angle, mobility, scheme, rest
- * tolerance, sub-step limit, sides); dpsm_step() checks this and fails on
- * every rank alike when they differ. All other calls are local to the rank.
+ * tolerance, sub-step limit, sides, flux exponent, static angle) and the same
+ * features (a bed on every rank or none, an angle field on every rank or
+ * none; their values are the rank's own block); dpsm_step() checks this and
+ * fails on every rank alike when they differ. All other calls are local to the
+ * rank. dpsm_save() refuses a distributed grid (::DPSM_ERR_NOT_APPLICABLE):
+ * restart files hold one grid.
  *
  * Link with `-ldpsm_mpi` (pkg-config: `dpsm-mpi`; CMake: `dpsm::dpsm_mpi`)
  * instead of `-ldpsm`: libdpsm_mpi holds the whole library. This header

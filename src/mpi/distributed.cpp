@@ -131,6 +131,8 @@ public:
                                  grid.masks_version() != exchanged_masks_ ? 1.0 : 0.0,
                                  open ? -grid.open_level_min() : none,
                                  open ? grid.open_level_max() : none};
+        grid.set_distributed_min_repose_angle(0.0);  // this block's own, to find the smallest of all
+        v.push_back(-grid.min_repose_angle());
         const std::size_t first_parameter = v.size();
         const double parameters[] = {dt,
                                      grid.repose_angle(),
@@ -141,7 +143,12 @@ public:
                                      grid.side_open(kXMin) ? 1.0 : 0.0,
                                      grid.side_open(kXMax) ? 1.0 : 0.0,
                                      grid.side_open(kYMin) ? 1.0 : 0.0,
-                                     grid.side_open(kYMax) ? 1.0 : 0.0};
+                                     grid.side_open(kYMax) ? 1.0 : 0.0,
+                                     // Every block must run the same kernel on its shared faces.
+                                     grid.bed().empty() ? 0.0 : 1.0,
+                                     grid.angle_field().empty() ? 0.0 : 1.0,
+                                     grid.flux_exponent(),
+                                     grid.static_angle()};
         for (double p : parameters) {
             v.push_back(p);
             v.push_back(-p);
@@ -154,7 +161,12 @@ public:
                                             "the scheme (dpsm_set_scheme)",
                                             "the sub-step limit (dpsm_set_max_substeps)",
                                             "side DPSM_XMIN (dpsm_set_boundary)", "side DPSM_XMAX (dpsm_set_boundary)",
-                                            "side DPSM_YMIN (dpsm_set_boundary)", "side DPSM_YMAX (dpsm_set_boundary)"};
+                                            "side DPSM_YMIN (dpsm_set_boundary)", "side DPSM_YMAX (dpsm_set_boundary)",
+                                            "whether they have a bed (dpsm_set_bedrock, on every rank or none)",
+                                            "whether they have an angle field (dpsm_set_repose_angle_field, on "
+                                            "every rank or none)",
+                                            "the flux exponent (dpsm_set_flux_exponent)",
+                                            "the static angle (dpsm_set_static_angle)"};
         for (std::size_t k = 0; k < sizeof(parameters) / sizeof(parameters[0]); ++k) {
             const double hi = v[first_parameter + 2 * k], lo = -v[first_parameter + 2 * k + 1];
             if (hi != lo) {
@@ -165,6 +177,7 @@ public:
                 throw Error(DPSM_ERR_INVALID_VALUE, msg.str());
             }
         }
+        grid.set_distributed_min_repose_angle(-v[6]);
         if (v[3] != 0.0) exchange_masks(grid);
         StepAgreement state;
         state.source_active = v[0] != 0.0;
@@ -179,9 +192,11 @@ public:
         ActiveSet &active = grid.active_set();
         const std::vector<double> &h = grid.heights();
         const std::vector<float> &res = grid.residuals();
+        const std::vector<std::uint8_t> &moving = grid.moving();
+        const bool hysteresis = grid.hysteresis();  // the same on every rank (agree_before_step)
         for (std::size_t k = 0; k < neighbours_.size(); ++k) {
             Neighbour &n = neighbours_[k];
-            n.receive_buffer.resize(static_cast<std::size_t>(2 * n.receive.cells() + 1 + 4 * n.tiles));
+            n.receive_buffer.resize(static_cast<std::size_t>((hysteresis ? 3 : 2) * n.receive.cells() + 1 + 4 * n.tiles));
             check_mpi(MPI_Irecv(n.receive_buffer.data(), static_cast<int>(n.receive_buffer.size()), MPI_DOUBLE, n.rank,
                                 kTagHeights, comm_, &requests_[k]),
                       "MPI_Irecv of the halo");
@@ -192,6 +207,7 @@ public:
             out.clear();
             for_cells(n.send, [&](std::size_t c) { out.push_back(h[c]); });
             for_cells(n.send, [&](std::size_t c) { out.push_back(static_cast<double>(res[c])); });
+            if (hysteresis) for_cells(n.send, [&](std::size_t c) { out.push_back(static_cast<double>(moving[c])); });
             // The hot boxes that can reach its block within a sweep, in global coordinates.
             const std::size_t count_at = out.size();
             out.push_back(0.0);
@@ -216,13 +232,14 @@ public:
         remote_hot_.clear();
         for (Neighbour &n : neighbours_) {
             const double *in = n.receive_buffer.data();
-            const std::size_t cells = static_cast<std::size_t>(n.receive.cells());
             std::size_t k = 0;
             for_halo_cells(n.receive, [&](std::size_t at) { halo_.heights[at] = in[k++]; });
             for_halo_cells(n.receive, [&](std::size_t at) { halo_.residuals[at] = static_cast<float>(in[k++]); });
-            const std::size_t boxes = static_cast<std::size_t>(in[2 * cells]);
+            if (hysteresis)
+                for_halo_cells(n.receive, [&](std::size_t at) { halo_.moving[at] = static_cast<std::uint8_t>(in[k++]); });
+            const std::size_t boxes = static_cast<std::size_t>(in[k]);
             for (std::size_t b = 0; b < boxes; ++b) {
-                const double *box = in + 2 * cells + 1 + 4 * b;
+                const double *box = in + k + 1 + 4 * b;
                 CellBox local;
                 local.add(static_cast<std::int64_t>(box[0]) - block_.i0, static_cast<std::int64_t>(box[1]) - block_.i0,
                           static_cast<std::int64_t>(box[2]) - block_.j0, static_cast<std::int64_t>(box[3]) - block_.j0);
@@ -275,13 +292,13 @@ private:
             for (std::int64_t i = r.i0; i < r.i0 + r.ni; ++i) f(halo_.index(i - block_.i0, j - block_.j0));
     }
 
-    // The halo's kinds and sources, and the boxes of its cells with a source.
+    // The halo's kinds, sources, bed and angles, and the boxes of its cells with a source.
     void exchange_masks(Grid &grid) {
         const std::vector<std::uint8_t> &kinds = grid.kinds();
-        const std::vector<double> &q = grid.source();
+        const std::vector<double> &q = grid.source(), &zb = grid.bed(), &tan_theta = grid.tan_field();
         for (std::size_t k = 0; k < neighbours_.size(); ++k) {
             Neighbour &n = neighbours_[k];
-            n.receive_buffer.resize(static_cast<std::size_t>(2 * n.receive.cells()));
+            n.receive_buffer.resize(static_cast<std::size_t>(4 * n.receive.cells()));
             check_mpi(MPI_Irecv(n.receive_buffer.data(), static_cast<int>(n.receive_buffer.size()), MPI_DOUBLE, n.rank,
                                 kTagMasks, comm_, &requests_[k]),
                       "MPI_Irecv of the halo's cell kinds and sources");
@@ -292,6 +309,8 @@ private:
             out.clear();
             for_cells(n.send, [&](std::size_t c) { out.push_back(static_cast<double>(kinds[c])); });
             for_cells(n.send, [&](std::size_t c) { out.push_back(q.empty() ? 0.0 : q[c]); });
+            for_cells(n.send, [&](std::size_t c) { out.push_back(zb.empty() ? 0.0 : zb[c]); });
+            for_cells(n.send, [&](std::size_t c) { out.push_back(tan_theta.empty() ? 0.0 : tan_theta[c]); });
             check_mpi(MPI_Isend(out.data(), static_cast<int>(out.size()), MPI_DOUBLE, n.rank, kTagMasks, comm_,
                                 &requests_[neighbours_.size() + k]),
                       "MPI_Isend of the halo's cell kinds and sources");
@@ -304,6 +323,8 @@ private:
             std::size_t k = 0;
             for_halo_cells(n.receive, [&](std::size_t at) { halo_.kinds[at] = static_cast<std::uint8_t>(in[k++]); });
             for_halo_cells(n.receive, [&](std::size_t at) { halo_.sources[at] = in[k++]; });
+            for_halo_cells(n.receive, [&](std::size_t at) { halo_.bed[at] = in[k++]; });
+            for_halo_cells(n.receive, [&](std::size_t at) { halo_.tan_theta[at] = in[k++]; });
             CellBox sources;
             for (std::int64_t j = n.receive.j0; j < n.receive.j0 + n.receive.nj; ++j)
                 for (std::int64_t i = n.receive.i0; i < n.receive.i0 + n.receive.ni; ++i) {
