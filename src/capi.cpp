@@ -22,6 +22,7 @@
 namespace {
 
 using dpsm::Error;
+using dpsm::fail;
 using dpsm::kMaxCells;
 using dpsm::kMaxMagnitude;
 
@@ -60,15 +61,6 @@ int guarded(const dpsm_grid *g, const char *function, Body &&body) noexcept {
         record_error(g, "dpsm: internal error of unknown kind");
         return DPSM_ERR_INTERNAL;
     }
-}
-
-template <class... Parts>
-[[noreturn]] void fail(int status, const char *function, const Parts &...parts) {
-    std::ostringstream msg;
-    msg.precision(17);
-    msg << function << ": ";
-    (msg << ... << parts);
-    throw Error(status, msg.str());
 }
 
 void require_grid(const dpsm_grid *g, const char *function) {

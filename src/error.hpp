@@ -2,6 +2,7 @@
 // status code and a per-handle message; nothing else may cross that boundary.
 #pragma once
 
+#include <sstream>
 #include <stdexcept>
 #include <string>
 
@@ -15,5 +16,16 @@ public:
 private:
     int status_;
 };
+
+// Throws Error(status) with the message "function: parts...", numbers with
+// every digit they have.
+template <class... Parts>
+[[noreturn]] void fail(int status, const char *function, const Parts &...parts) {
+    std::ostringstream msg;
+    msg.precision(17);
+    msg << function << ": ";
+    (msg << ... << parts);
+    throw Error(status, msg.str());
+}
 
 }  // namespace dpsm

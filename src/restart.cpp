@@ -65,15 +65,6 @@ std::uint32_t crc32_update(std::uint32_t crc, const std::uint8_t *bytes, std::si
     return ~c;
 }
 
-template <class... Parts>
-[[noreturn]] void fail(int status, const char *function, const Parts &...parts) {
-    std::ostringstream msg;
-    msg.precision(17);
-    msg << function << ": ";
-    (msg << ... << parts);
-    throw Error(status, msg.str());
-}
-
 std::string system_reason(int error) {
     const char *reason = std::strerror(error);
     return reason ? reason : "unknown error";

@@ -351,15 +351,6 @@ struct Arguments {
     double dx, dy;
 };
 
-template <class... Parts>
-[[noreturn]] void fail(int status, const char *function, const Parts &...parts) {
-    std::ostringstream msg;
-    msg.precision(17);
-    msg << function << ": ";
-    (msg << ... << parts);
-    throw Error(status, msg.str());
-}
-
 bool bad_spacing(double d) { return !std::isfinite(d) || !(d >= 1.0 / kMaxMagnitude && d <= kMaxMagnitude); }
 
 // Checks the gathered arguments of all ranks; throws the first problem, the
