@@ -46,7 +46,6 @@ void gather(const Grid &grid, TileBuffers &b, std::int64_t gi0, std::int64_t gj0
     const float *res = grid.residuals().data();
     const std::uint8_t *kind = grid.kinds().data();
     const double *q = source ? grid.source().data() : nullptr;
-    const bool inside = gi0 >= 0 && gj0 >= 0 && gi0 + b.width <= geo.nx && gj0 + b.height <= geo.ny;
     for (int r = 0; r < b.height; ++r) {
         const std::int64_t j = gj0 + r;
         const std::size_t row = static_cast<std::size_t>(r) * b.width;
@@ -54,24 +53,30 @@ void gather(const Grid &grid, TileBuffers &b, std::int64_t gi0, std::int64_t gj0
         double *rb = b.residual[0].data() + row;
         std::uint8_t *kb = b.kind.data() + row;
         double *qb = b.source.data() + row;
-        if (inside) {  // the common case: one copy per row
-            const std::size_t at = static_cast<std::size_t>(j * geo.nx + gi0);
-            std::memcpy(hb, h + at, sizeof(double) * b.width);
-            for (int c = 0; c < b.width; ++c) rb[c] = static_cast<double>(res[at + c]);
-            if (masked) std::memcpy(kb, kind + at, b.width);
+        // The row's cells inside the domain are one span, copied at once (the
+        // whole row but at the domain's edge); ghosts lie around it.
+        const bool row_in = j >= 0 && j < geo.ny;
+        const int c_in0 = row_in ? static_cast<int>(std::clamp<std::int64_t>(-gi0, 0, b.width)) : b.width;
+        const int c_in1 = row_in ? static_cast<int>(std::clamp<std::int64_t>(geo.nx - gi0, c_in0, b.width)) : b.width;
+        auto ghosts = [&](int c0, int c1) {
+            for (int c = c0; c < c1; ++c) {
+                hb[c] = 0.0;
+                rb[c] = 0.0;
+                if (masked) kb[c] = ghost_kind(grid, gi0 + c, j);
+                if (source) qb[c] = 0.0;
+            }
+        };
+        ghosts(0, c_in0);
+        if (c_in0 < c_in1) {
+            const std::size_t at = static_cast<std::size_t>(j * geo.nx + gi0 + c_in0);
+            const int count = c_in1 - c_in0;
+            std::memcpy(hb + c_in0, h + at, sizeof(double) * count);
+            for (int c = 0; c < count; ++c) rb[c_in0 + c] = static_cast<double>(res[at + c]);
+            if (masked) std::memcpy(kb + c_in0, kind + at, count);
             if (source)
-                for (int c = 0; c < b.width; ++c) qb[c] = kind[at + c] == kSand ? q[at + c] : 0.0;
-            continue;
+                for (int c = 0; c < count; ++c) qb[c_in0 + c] = kind[at + c] == kSand ? q[at + c] : 0.0;
         }
-        for (int c = 0; c < b.width; ++c) {
-            const std::int64_t i = gi0 + c;
-            const bool in = i >= 0 && j >= 0 && i < geo.nx && j < geo.ny;
-            const std::int64_t cell = in ? i + geo.nx * j : 0;
-            hb[c] = in ? h[cell] : 0.0;
-            rb[c] = in ? static_cast<double>(res[cell]) : 0.0;
-            if (masked) kb[c] = in ? kind[cell] : ghost_kind(grid, i, j);
-            if (source) qb[c] = in && kind[cell] == kSand ? q[cell] : 0.0;
-        }
+        ghosts(c_in1, b.width);
     }
 }
 
