@@ -91,8 +91,8 @@ bool ActiveSet::may_move() const {
     return false;
 }
 
-void ActiveSet::tiles_to_visit(int levels, std::vector<std::int64_t> &tiles,
-                               std::vector<CellBox> &boxes) const {
+void ActiveSet::tiles_to_visit(int levels, std::vector<std::int64_t> &tiles, std::vector<CellBox> &boxes,
+                               std::vector<CellBox> &seeds) const {
     // A face carries sand in a sub-step only if it did in the one before or a
     // cell within one of it changed: the cells touching moving faces spread by
     // at most one cell a sub-step. A hot box (grown by one cell when stored)
@@ -100,6 +100,7 @@ void ActiveSet::tiles_to_visit(int levels, std::vector<std::int64_t> &tiles,
     const std::int64_t reach = levels;
     tiles.clear();
     boxes.clear();
+    seeds.clear();
     // DPSM_VISIT_ALL_TILES=1 turns the active set off, for tests that show it
     // changes no result.
     const char *all = std::getenv("DPSM_VISIT_ALL_TILES");
@@ -108,19 +109,29 @@ void ActiveSet::tiles_to_visit(int levels, std::vector<std::int64_t> &tiles,
         for (std::int64_t ti = 0; ti < tiles_x_; ++ti) {
             const std::int64_t t = ti + tiles_x_ * tj;
             const CellBox cells = tile_cells(t);
-            CellBox reached;
+            // Seeds farther than the sweep's reach from the tile do not matter to it.
+            const CellBox near = cells.grown(2 * reach);
+            CellBox reached, seed;
             for (std::int64_t dj = -1; dj <= 1; ++dj)
                 for (std::int64_t di = -1; di <= 1; ++di) {
                     const std::int64_t ui = ti + di, uj = tj + dj;
                     if (ui < 0 || uj < 0 || ui >= tiles_x_ || uj >= tiles_y_) continue;
                     const std::int64_t u = ui + tiles_x_ * uj;
-                    reached.add(hot_[u].grown_within(reach, cells));
-                    reached.add(source_[u].grown_within(reach, cells));
+                    for (const CellBox &from : {hot_[u], source_[u]}) {
+                        const CellBox part = from.grown_within(reach, cells);
+                        if (part.empty()) continue;
+                        reached.add(part);
+                        seed.add(from.grown_within(0, near));
+                    }
                 }
-            if (visit_all) reached = cells;
+            if (visit_all) {  // every cell of the tile may change from the first sub-step
+                reached = cells;
+                seed = cells.grown(reach);
+            }
             if (reached.empty()) continue;
             tiles.push_back(t);
             boxes.push_back(reached);
+            seeds.push_back(seed);
         }
 }
 

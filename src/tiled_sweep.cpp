@@ -97,6 +97,7 @@ void prepare_tiled_sweep(Grid &grid, int threads) {
     const std::size_t tiles = static_cast<std::size_t>(grid.active_set().tiles());
     ws.visit.reserve(tiles);
     ws.boxes.reserve(tiles);
+    ws.seeds.reserve(tiles);
     ws.stats.reserve(tiles * ActiveSet::kMaxLevels);
     ws.origin.reserve(2 * tiles);
 }
@@ -105,7 +106,7 @@ std::int64_t tiled_sweep(Grid &grid, int levels, double dt, std::vector<LevelSum
     const Geometry &geo = grid.geometry();
     ActiveSet &active = grid.active_set();
     TiledWorkspace &ws = grid.tiled_workspace();
-    active.tiles_to_visit(levels, ws.visit, ws.boxes);
+    active.tiles_to_visit(levels, ws.visit, ws.boxes, ws.seeds);
     const std::int64_t visits = static_cast<std::int64_t>(ws.visit.size());
     ws.stats.assign(static_cast<std::size_t>(visits) * levels, TileLevelStats{});
     ws.origin.assign(static_cast<std::size_t>(2 * visits), 0);
@@ -122,23 +123,44 @@ std::int64_t tiled_sweep(Grid &grid, int levels, double dt, std::vector<LevelSum
     // Threads pay off only with enough work between their barriers; below this
     // a sweep runs on the calling thread (results are the same either way).
     const bool parallel = threads > 1 && visits > 1 && visited_cells >= kCellsForThreads;
-    const int halo = levels + 1;
 
     auto visit_tile = [&](std::int64_t k, TileBuffers &b) {
         const std::int64_t t = ws.visit[k];
         const CellBox &cells = ws.boxes[k];
         const bool masked = active.masked(t), source = active.has_source(t);
-        const std::int64_t gi0 = cells.i0 - halo, gj0 = cells.j0 - halo;
-        b.width = static_cast<int>(cells.i1 - cells.i0) + 2 * halo;
-        b.height = static_cast<int>(cells.j1 - cells.j0) + 2 * halo;
+        // Level s must be right on the cells that later levels read (within
+        // levels - s of the box) but can change only those within s of the
+        // seeds: it computes where both hold. What the levels read, one cell
+        // around that, is all the buffer holds.
+        CellBox level_cells[ActiveSet::kMaxLevels], read;
+        bool every_cell = true;  // each level computes all that later ones read
+        for (int s = 1; s <= levels; ++s) {
+            const CellBox needed = cells.grown(levels - s);
+            level_cells[s - 1] = ws.seeds[k].grown_within(s, needed);
+            every_cell = every_cell && level_cells[s - 1] == needed;
+            read.add(level_cells[s - 1].grown(1));
+        }
+        const std::int64_t gi0 = read.i0, gj0 = read.j0;
+        b.width = static_cast<int>(read.i1 - read.i0);
+        b.height = static_cast<int>(read.j1 - read.j0);
         gather(grid, b, gi0, gj0, masked, source);
+        if (!every_cell) {
+            // A cell a level leaves alone keeps its gathered value, which the
+            // next level then reads from the other slot.
+            const std::size_t count = static_cast<std::size_t>(b.width) * b.height;
+            std::memcpy(b.h[1].data(), b.h[0].data(), sizeof(double) * count);
+            std::memcpy(b.residual[1].data(), b.residual[0].data(), sizeof(double) * count);
+        }
+        auto in_buffer = [&](const CellBox &box) {
+            return TileRect{static_cast<int>(box.j0 - gj0), static_cast<int>(box.j1 - gj0),
+                            static_cast<int>(box.i0 - gi0), static_cast<int>(box.i1 - gi0)};
+        };
         const TileLevelFunction kernel = select_tile_kernel(masked, isotropic, source);
-        const TileRect tile{halo, b.height - halo, halo, b.width - halo};
+        const TileRect tile = in_buffer(cells);
         int in = 0;
         for (int s = 1; s <= levels; ++s) {
-            const int grow = levels - s;
-            const TileRect region{tile.r0 - grow, tile.r1 + grow, tile.c0 - grow, tile.c1 + grow};
-            kernel(b, in, region, tile, params, ws.stats[static_cast<std::size_t>(k) * levels + (s - 1)]);
+            kernel(b, in, in_buffer(level_cells[s - 1]), tile, params,
+                   ws.stats[static_cast<std::size_t>(k) * levels + (s - 1)]);
             in = 1 - in;
         }
         for (int r = tile.r0; r < tile.r1; ++r) {
