@@ -154,8 +154,7 @@ void advance_tile_level(TileBuffers &b, int in, const TileRect &reg, const TileR
 
             // Motion is sand carried by a face, even where an increment is too
             // small to change a height (a tiny dt): such a cell stays hot.
-            const M carried = V::either(V::either(f_west != zero, f_east != zero),
-                                        V::either(f_south != zero, f_north != zero));
+            const M carried = V::any_nonzero(f_west, f_east, f_south, f_north);
             moved = V::either(moved, V::either(changes, carried));
             if (!row_in_tile) continue;
             const M in_tile =
