@@ -71,8 +71,8 @@ public:
     bool may_move() const;  // some tile is hot or has a source
     // The tiles a sweep of `levels` sub-steps must visit, in order, and in each
     // the box of its cells that can change (the rest of the tile stays as it is)
-    // and the box of the hot boxes and sources that reach it (its seeds):
-    // after s sub-steps only cells within s of the seeds can have changed.
+    // and the box of the hot boxes and sources (grown by one) that reach it,
+    // its seeds: in sub-step s only cells within s - 1 of them can change.
     void tiles_to_visit(int levels, std::vector<std::int64_t> &tiles, std::vector<CellBox> &boxes,
                         std::vector<CellBox> &seeds) const;
 

@@ -129,14 +129,14 @@ std::int64_t tiled_sweep(Grid &grid, int levels, double dt, std::vector<LevelSum
         const CellBox &cells = ws.boxes[k];
         const bool masked = active.masked(t), source = active.has_source(t);
         // Level s must be right on the cells that later levels read (within
-        // levels - s of the box) but can change only those within s of the
+        // levels - s of the box) but can change only those within s - 1 of the
         // seeds: it computes where both hold. What the levels read, one cell
         // around that, is all the buffer holds.
         CellBox level_cells[ActiveSet::kMaxLevels], read;
         bool every_cell = true;  // each level computes all that later ones read
         for (int s = 1; s <= levels; ++s) {
             const CellBox needed = cells.grown(levels - s);
-            level_cells[s - 1] = ws.seeds[k].grown_within(s, needed);
+            level_cells[s - 1] = ws.seeds[k].grown_within(s - 1, needed);
             every_cell = every_cell && level_cells[s - 1] == needed;
             read.add(level_cells[s - 1].grown(1));
         }
