@@ -109,6 +109,7 @@ static void dune_bed(double *h, int64_t n) {
 int cmd_sparse(int argc, char **argv) {
     const int64_t n = argc > 0 ? atoll(argv[0]) : 4096;
     const double target = argc > 1 ? atof(argv[1]) : 0.01; /* fraction of cells on slip faces */
+    const int threads = argc > 2 ? atoi(argv[2]) : 0;      /* 0: the OpenMP default */
     const double cells = (double)n * (double)n;
     double *h = xcalloc((size_t)(n * n), sizeof(double)), *q = xcalloc((size_t)(n * n), sizeof(double));
     dune_bed(h, n);
@@ -133,7 +134,7 @@ int cmd_sparse(int argc, char **argv) {
                     if (i < i0 + 3) q[i + n * j] = 0.2; /* the brink */
                 }
         }
-    dpsm_grid *g = make_grid(n, h, 0, 0);
+    dpsm_grid *g = make_grid(n, h, threads, 0);
     CHECK(g, dpsm_set_source(g, q));
     double dt;
     CHECK(g, dpsm_stable_dt(g, &dt));
@@ -148,7 +149,7 @@ int cmd_sparse(int argc, char **argv) {
 
     steep_surface(h, n);
     double full_updates;
-    const double full_per_substep = dpsm_seconds_per_substep(n, h, 0, 8, &full_updates);
+    const double full_per_substep = dpsm_seconds_per_substep(n, h, threads, 8, &full_updates);
     printf("n,slip_face_fraction,cells_visited_fraction,sparse_s_per_substep,full_s_per_substep,ratio\n");
     printf("%lld,%.4f,%.4f,%.3e,%.3e,%.4f\n", (long long)n, (double)placed * face_w * face_h / cells,
            updates / (substeps * cells), sparse_per_substep, full_per_substep, sparse_per_substep / full_per_substep);

@@ -46,14 +46,15 @@ void ActiveSet::mark_all() {
 }
 
 void ActiveSet::mark_block(std::int64_t i0, std::int64_t j0, std::int64_t ni, std::int64_t nj) {
+    // A changed cell can steepen the faces within one of it: those cells are hot.
     CellBox changed;
-    changed.add(i0, i0 + ni, j0, j0 + nj);
+    changed.add(i0 - 1, i0 + ni + 1, j0 - 1, j0 + nj + 1);
     const std::int64_t t0 = std::max<std::int64_t>(0, (i0 - 1) / kTile), t1 = std::min(tiles_x_ - 1, (i0 + ni) / kTile);
     const std::int64_t s0 = std::max<std::int64_t>(0, (j0 - 1) / kTile), s1 = std::min(tiles_y_ - 1, (j0 + nj) / kTile);
     for (std::int64_t tj = s0; tj <= s1; ++tj)
         for (std::int64_t ti = t0; ti <= t1; ++ti) {
             const std::int64_t t = ti + tiles_x_ * tj;
-            if (changed.reaches(tile_cells(t), 1)) hot_[t].add(changed);
+            if (changed.reaches(tile_cells(t), 0)) hot_[t].add(changed);
         }
 }
 
@@ -105,7 +106,8 @@ void ActiveSet::set_remote_activity(const std::vector<CellBox> &hot, const std::
             }
     };
     for (const CellBox &box : hot) spread(box, false);
-    for (const CellBox &box : sources) spread(box, true);
+    // A source changes its cells every sub-step, steepening the faces within one.
+    for (const CellBox &box : sources) spread(box.grown(1), true);
 }
 
 bool ActiveSet::may_move() const {
@@ -114,15 +116,19 @@ bool ActiveSet::may_move() const {
     return false;
 }
 
-void ActiveSet::tiles_to_visit(int levels, std::vector<std::int64_t> &tiles,
-                               std::vector<CellBox> &boxes) const {
+void ActiveSet::tiles_to_visit(int levels, std::vector<std::int64_t> &tiles, std::vector<CellBox> &boxes,
+                               std::vector<CellBox> &seeds) const {
     // A face carries sand in a sub-step only if it did in the one before or a
     // cell within one of it changed: the cells touching moving faces spread by
-    // at most one cell a sub-step. A hot box (grown by one cell when stored)
-    // therefore reaches `levels` cells within a sweep.
-    const std::int64_t reach = levels;
+    // at most one cell a sub-step. A hot box holds the cells that may touch a
+    // moving face in a sweep's first sub-step, so in its sub-step s such cells
+    // lie within s - 1 of it: a hot box reaches levels - 1 cells. A source
+    // changes its cells every sub-step, steepening the faces within one of
+    // them: grown by one it is a hot box.
+    const std::int64_t reach = levels - 1;
     tiles.clear();
     boxes.clear();
+    seeds.clear();
     // DPSM_VISIT_ALL_TILES=1 turns the active set off, for tests that show it
     // changes no result.
     const char *all = std::getenv("DPSM_VISIT_ALL_TILES");
@@ -131,20 +137,38 @@ void ActiveSet::tiles_to_visit(int levels, std::vector<std::int64_t> &tiles,
         for (std::int64_t ti = 0; ti < tiles_x_; ++ti) {
             const std::int64_t t = ti + tiles_x_ * tj;
             const CellBox cells = tile_cells(t);
-            CellBox reached;
+            // Seeds farther than the sweep's reach from the tile do not matter to it.
+            const CellBox near = cells.grown(2 * reach);
+            CellBox reached, seed;
             for (std::int64_t dj = -1; dj <= 1; ++dj)
                 for (std::int64_t di = -1; di <= 1; ++di) {
                     const std::int64_t ui = ti + di, uj = tj + dj;
                     if (ui < 0 || uj < 0 || ui >= tiles_x_ || uj >= tiles_y_) continue;
                     const std::int64_t u = ui + tiles_x_ * uj;
-                    reached.add(hot_[u].grown_within(reach, cells));
-                    reached.add(source_[u].grown_within(reach, cells));
+                    for (const CellBox &from : {hot_[u], source_[u].grown(1)}) {
+                        const CellBox part = from.grown_within(reach, cells);
+                        if (part.empty()) continue;
+                        reached.add(part);
+                        seed.add(from.grown_within(0, near));
+                    }
                 }
-            if (!remote_.empty()) reached.add(remote_[t].grown_within(reach, cells));
-            if (visit_all) reached = cells;
+            // The neighbours' activity on a block of a distributed grid (its
+            // sources already grown by one): as this block's own.
+            if (!remote_.empty()) {
+                const CellBox part = remote_[t].grown_within(reach, cells);
+                if (!part.empty()) {
+                    reached.add(part);
+                    seed.add(remote_[t].grown_within(0, near));
+                }
+            }
+            if (visit_all) {  // every cell of the tile may change from the first sub-step
+                reached = cells;
+                seed = cells.grown(levels);
+            }
             if (reached.empty()) continue;
             tiles.push_back(t);
             boxes.push_back(reached);
+            seeds.push_back(seed);
         }
 }
 

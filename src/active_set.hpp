@@ -34,6 +34,14 @@ struct CellBox {
               j1 + d < o.j1 ? j1 + d : o.j1);
         return b;
     }
+    CellBox grown(std::int64_t d) const {
+        CellBox b;
+        if (!empty()) b.add(i0 - d, i1 + d, j0 - d, j1 + d);
+        return b;
+    }
+    bool operator==(const CellBox &o) const {
+        return (empty() && o.empty()) || (i0 == o.i0 && i1 == o.i1 && j0 == o.j0 && j1 == o.j1);
+    }
     // Whether this box grown by d cells meets the other.
     bool reaches(const CellBox &o, std::int64_t d) const {
         return !empty() && !o.empty() && i0 - d < o.i1 && o.i0 < i1 + d && j0 - d < o.j1 && o.j0 < j1 + d;
@@ -62,8 +70,11 @@ public:
 
     bool may_move() const;  // some tile is hot or has a source
     // The tiles a sweep of `levels` sub-steps must visit, in order, and in each
-    // the box of its cells that can change (the rest of the tile stays as it is).
-    void tiles_to_visit(int levels, std::vector<std::int64_t> &tiles, std::vector<CellBox> &boxes) const;
+    // the box of its cells that can change (the rest of the tile stays as it is)
+    // and the box of the hot boxes and sources (grown by one) that reach it,
+    // its seeds: in sub-step s only cells within s - 1 of them can change.
+    void tiles_to_visit(int levels, std::vector<std::int64_t> &tiles, std::vector<CellBox> &boxes,
+                        std::vector<CellBox> &seeds) const;
 
     CellBox &hot(std::int64_t t) { return hot_[t]; }
     bool masked(std::int64_t t) const { return masked_[t] != 0; }

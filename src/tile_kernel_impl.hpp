@@ -4,6 +4,7 @@
 #pragma once
 
 #include <algorithm>
+#include <cmath>
 #include <utility>
 
 #include "grid.hpp"
@@ -38,7 +39,7 @@ void advance_tile_level(TileBuffers &b, int in, const TileRect &reg, const TileR
     const V dt = V::broadcast(p.dt);
     const V x_len = V::broadcast(p.x_face_length), y_len = V::broadcast(p.y_face_length);
     const M all = V::first_lanes(w);
-    V excess_max = zero, outflow = zero;
+    V steepest2 = zero, outflow = zero;  // largest squared slope of a face that carries sand
     M moved = V::first_lanes(0);
     // The tile's cells that moved: rows, and columns as bits from tile.c0.
     int moved_r0 = st.hot_r0, moved_r1 = st.hot_r1;
@@ -65,13 +66,16 @@ void advance_tile_level(TileBuffers &b, int in, const TileRect &reg, const TileR
     };
     // The flux law on the full slope (gn along the face normal, gt across),
     // positive from the first cell to the second; zero up to the threshold.
+    // 1 - tan(theta) / |g| cancels near the threshold, so 1/|g| is refined to
+    // full precision; 1/sqrt(1 + |g|^2) only scales the flux and takes the
+    // cheaper refinement.
     auto face_flux = [&](V gn, V gt, M open, double *flux_out, int m) {
         const V u = gn * gn + gt * gt;
         const M hot = V::both(u > threshold2, open);
         const V r1 = rsqrt(max(u, threshold2));
-        const V r2 = rsqrt(one + u);
+        const V r2 = rsqrt_fast(one + u);
         const V flux = select(hot, nu * gn * (one - tan_theta * r1) * r2, zero);
-        excess_max = max(excess_max, select(hot, u * r1 - tan_theta, zero));
+        steepest2 = max(steepest2, select(hot, u, zero));
         store(flux_out, flux, m);
     };
     // Central differences along x of row r, for the faces across it.
@@ -150,8 +154,7 @@ void advance_tile_level(TileBuffers &b, int in, const TileRect &reg, const TileR
 
             // Motion is sand carried by a face, even where an increment is too
             // small to change a height (a tiny dt): such a cell stays hot.
-            const M carried = V::either(V::either(f_west != zero, f_east != zero),
-                                        V::either(f_south != zero, f_north != zero));
+            const M carried = V::any_nonzero(f_west, f_east, f_south, f_north);
             moved = V::either(moved, V::either(changes, carried));
             if (!row_in_tile) continue;
             const M in_tile =
@@ -184,7 +187,8 @@ void advance_tile_level(TileBuffers &b, int in, const TileRect &reg, const TileR
         st.hot_c1 = std::max(st.hot_c1, tile.c0 + 64 - __builtin_clzll(moved_columns));
     }
     st.moved = st.moved || V::any(moved);
-    st.max_excess = std::max(st.max_excess, V::hmax(excess_max));
+    const double steepest = std::sqrt(V::hmax(steepest2));
+    if (steepest > 0.0) st.max_excess = std::max(st.max_excess, steepest - p.tan_theta);
     st.outflow_rate += V::sum(outflow);
 }
 

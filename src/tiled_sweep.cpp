@@ -28,6 +28,40 @@ int thread_count(int requested) {
 #endif
 }
 
+// Residuals are kept in float in the grid and in double in a tile's buffer.
+// These loops run once per row of every tile visit; where the CPU has AVX-512
+// a copy built for it converts 8 cells at a time instead of 2. (Chosen by a
+// test of the CPU, not by an ifunc: ifunc resolvers run before a sanitizer's
+// runtime and crash it.) A conversion rounds the same way on every CPU.
+template <class From, class To>
+inline void convert_row(const From *from, To *to, int count) {
+    for (int c = 0; c < count; ++c) to[c] = static_cast<To>(from[c]);
+}
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+__attribute__((target("avx512f"))) void widen_avx512(const float *from, double *to, int count) {
+    convert_row(from, to, count);
+}
+__attribute__((target("avx512f"))) void narrow_avx512(const double *from, float *to, int count) {
+    convert_row(from, to, count);
+}
+bool rows_in_avx512() {
+    static const bool yes = [] {
+        __builtin_cpu_init();
+        return __builtin_cpu_supports("avx512f") != 0;
+    }();
+    return yes;
+}
+void widen(const float *from, double *to, int count) {
+    rows_in_avx512() ? widen_avx512(from, to, count) : convert_row(from, to, count);
+}
+void narrow(const double *from, float *to, int count) {
+    rows_in_avx512() ? narrow_avx512(from, to, count) : convert_row(from, to, count);
+}
+#else
+void widen(const float *from, double *to, int count) { convert_row(from, to, count); }
+void narrow(const double *from, float *to, int count) { convert_row(from, to, count); }
+#endif
+
 // The kind of a ghost cell beyond the domain: a sink at 0 beyond an open
 // side, a wall beyond a wall side; a corner is a sink only if both sides are.
 std::uint8_t ghost_kind(const Grid &grid, std::int64_t i, std::int64_t j) {
@@ -47,7 +81,6 @@ void gather(const Grid &grid, TileBuffers &b, std::int64_t gi0, std::int64_t gj0
     const float *res = grid.residuals().data();
     const std::uint8_t *kind = grid.kinds().data();
     const double *q = source ? grid.source().data() : nullptr;
-    const bool inside = gi0 >= 0 && gj0 >= 0 && gi0 + b.width <= geo.nx && gj0 + b.height <= geo.ny;
     for (int r = 0; r < b.height; ++r) {
         const std::int64_t j = gj0 + r;
         const std::size_t row = static_cast<std::size_t>(r) * b.width;
@@ -55,24 +88,30 @@ void gather(const Grid &grid, TileBuffers &b, std::int64_t gi0, std::int64_t gj0
         double *rb = b.residual[0].data() + row;
         std::uint8_t *kb = b.kind.data() + row;
         double *qb = b.source.data() + row;
-        if (inside) {  // the common case: one copy per row
-            const std::size_t at = static_cast<std::size_t>(j * geo.nx + gi0);
-            std::memcpy(hb, h + at, sizeof(double) * b.width);
-            for (int c = 0; c < b.width; ++c) rb[c] = static_cast<double>(res[at + c]);
-            if (masked) std::memcpy(kb, kind + at, b.width);
+        // The row's cells inside the domain are one span, copied at once (the
+        // whole row but at the domain's edge); ghosts lie around it.
+        const bool row_in = j >= 0 && j < geo.ny;
+        const int c_in0 = row_in ? static_cast<int>(std::clamp<std::int64_t>(-gi0, 0, b.width)) : b.width;
+        const int c_in1 = row_in ? static_cast<int>(std::clamp<std::int64_t>(geo.nx - gi0, c_in0, b.width)) : b.width;
+        auto ghosts = [&](int c0, int c1) {
+            for (int c = c0; c < c1; ++c) {
+                hb[c] = 0.0;
+                rb[c] = 0.0;
+                if (masked) kb[c] = ghost_kind(grid, gi0 + c, j);
+                if (source) qb[c] = 0.0;
+            }
+        };
+        ghosts(0, c_in0);
+        if (c_in0 < c_in1) {
+            const std::size_t at = static_cast<std::size_t>(j * geo.nx + gi0 + c_in0);
+            const int count = c_in1 - c_in0;
+            std::memcpy(hb + c_in0, h + at, sizeof(double) * count);
+            widen(res + at, rb + c_in0, count);
+            if (masked) std::memcpy(kb + c_in0, kind + at, count);
             if (source)
-                for (int c = 0; c < b.width; ++c) qb[c] = kind[at + c] == kSand ? q[at + c] : 0.0;
-            continue;
+                for (int c = 0; c < count; ++c) qb[c_in0 + c] = kind[at + c] == kSand ? q[at + c] : 0.0;
         }
-        for (int c = 0; c < b.width; ++c) {
-            const std::int64_t i = gi0 + c;
-            const bool in = i >= 0 && j >= 0 && i < geo.nx && j < geo.ny;
-            const std::int64_t cell = in ? i + geo.nx * j : 0;
-            hb[c] = in ? h[cell] : 0.0;
-            rb[c] = in ? static_cast<double>(res[cell]) : 0.0;
-            if (masked) kb[c] = in ? kind[cell] : ghost_kind(grid, i, j);
-            if (source) qb[c] = in && kind[cell] == kSand ? q[cell] : 0.0;
-        }
+        ghosts(c_in1, b.width);
     }
 }
 
@@ -171,6 +210,7 @@ void prepare_tiled_sweep(Grid &grid, int threads) {
     const std::size_t tiles = static_cast<std::size_t>(grid.active_set().tiles());
     ws.visit.reserve(tiles);
     ws.boxes.reserve(tiles);
+    ws.seeds.reserve(tiles);
     ws.stats.reserve(tiles * ActiveSet::kMaxLevels);
     ws.origin.reserve(2 * tiles);
 }
@@ -182,7 +222,7 @@ std::int64_t tiled_sweep(Grid &grid, int levels, double dt, std::vector<LevelSum
     Decomposition *decomposition = grid.decomposition();
     if (decomposition) decomposition->before_sweep(grid);  // the neighbours' cells and activity
     const HaloStore *halo_store = decomposition ? &decomposition->halo() : nullptr;
-    active.tiles_to_visit(levels, ws.visit, ws.boxes);
+    active.tiles_to_visit(levels, ws.visit, ws.boxes, ws.seeds);
     const std::int64_t visits = static_cast<std::int64_t>(ws.visit.size());
     ws.stats.assign(static_cast<std::size_t>(visits) * levels, TileLevelStats{});
     ws.origin.assign(static_cast<std::size_t>(2 * visits), 0);
@@ -210,28 +250,50 @@ std::int64_t tiled_sweep(Grid &grid, int levels, double dt, std::vector<LevelSum
     // Threads pay off only with enough work between their barriers; below this
     // a sweep runs on the calling thread (results are the same either way).
     const bool parallel = threads > 1 && visits > 1 && visited_cells >= kCellsForThreads;
-    const int halo = levels + 1;
 
     auto visit_tile = [&](std::int64_t k, TileBuffers &b) {
         const std::int64_t t = ws.visit[k];
         const CellBox &cells = ws.boxes[k];
         const bool masked = active.masked(t), source = active.has_source(t);
-        const std::int64_t gi0 = cells.i0 - halo, gj0 = cells.j0 - halo;
-        b.width = static_cast<int>(cells.i1 - cells.i0) + 2 * halo;
-        b.height = static_cast<int>(cells.j1 - cells.j0) + 2 * halo;
+        // Level s must be right on the cells that later levels read (within
+        // levels - s of the box) but can change only those within s - 1 of the
+        // seeds: it computes where both hold. What the levels read, one cell
+        // around that, is all the buffer holds.
+        CellBox level_cells[ActiveSet::kMaxLevels], read;
+        bool every_cell = true;  // each level computes all that later ones read
+        for (int s = 1; s <= levels; ++s) {
+            const CellBox needed = cells.grown(levels - s);
+            level_cells[s - 1] = ws.seeds[k].grown_within(s - 1, needed);
+            every_cell = every_cell && level_cells[s - 1] == needed;
+            read.add(level_cells[s - 1].grown(1));
+        }
+        const std::int64_t gi0 = read.i0, gj0 = read.j0;
+        b.width = static_cast<int>(read.i1 - read.i0);
+        b.height = static_cast<int>(read.j1 - read.j0);
         // The physics kernel reads cell kinds on every tile.
         gather(grid, b, gi0, gj0, masked || physics, source);
         if (halo_store && !(gi0 >= 0 && gj0 >= 0 && gi0 + b.width <= geo.nx && gj0 + b.height <= geo.ny))
             gather_halo(grid, *halo_store, b, gi0, gj0, masked || physics, source);
         if (physics) gather_physics(grid, halo_store, b, gi0, gj0);
+        if (!every_cell) {
+            // A cell a level leaves alone keeps its gathered value, which the
+            // next level then reads from the other slot.
+            const std::size_t count = static_cast<std::size_t>(b.width) * b.height;
+            std::memcpy(b.h[1].data(), b.h[0].data(), sizeof(double) * count);
+            std::memcpy(b.residual[1].data(), b.residual[0].data(), sizeof(double) * count);
+            if (hysteresis) std::memcpy(b.moving[1].data(), b.moving[0].data(), count);
+        }
+        auto in_buffer = [&](const CellBox &box) {
+            return TileRect{static_cast<int>(box.j0 - gj0), static_cast<int>(box.j1 - gj0),
+                            static_cast<int>(box.i0 - gi0), static_cast<int>(box.i1 - gi0)};
+        };
         const TileLevelFunction kernel =
             physics ? select_physics_tile_kernel(isotropic, source) : select_tile_kernel(masked, isotropic, source);
-        const TileRect tile{halo, b.height - halo, halo, b.width - halo};
+        const TileRect tile = in_buffer(cells);
         int in = 0;
         for (int s = 1; s <= levels; ++s) {
-            const int grow = levels - s;
-            const TileRect region{tile.r0 - grow, tile.r1 + grow, tile.c0 - grow, tile.c1 + grow};
-            kernel(b, in, region, tile, params, ws.stats[static_cast<std::size_t>(k) * levels + (s - 1)]);
+            kernel(b, in, in_buffer(level_cells[s - 1]), tile, params,
+                   ws.stats[static_cast<std::size_t>(k) * levels + (s - 1)]);
             in = 1 - in;
         }
         for (int r = tile.r0; r < tile.r1; ++r) {
@@ -239,7 +301,7 @@ std::int64_t tiled_sweep(Grid &grid, int levels, double dt, std::vector<LevelSum
             const std::size_t to = static_cast<std::size_t>((gj0 + r) * geo.nx + gi0 + tile.c0);
             const int count = tile.c1 - tile.c0;
             std::memcpy(ws.heights.data() + to, b.h[in].data() + from, sizeof(double) * count);
-            for (int c = 0; c < count; ++c) ws.residuals[to + c] = static_cast<float>(b.residual[in][from + c]);
+            narrow(b.residual[in].data() + from, ws.residuals.data() + to, count);
             if (hysteresis) std::memcpy(ws.moving.data() + to, b.moving[in].data() + from, count);
         }
         ws.origin[2 * k] = gi0;

@@ -30,6 +30,7 @@ struct TiledWorkspace {
     std::vector<TileBuffers> buffers;  // one per thread
     std::vector<std::int64_t> visit;
     std::vector<CellBox> boxes;         // per visited tile: the cells that can change
+    std::vector<CellBox> seeds;         // per visited tile: the hot boxes and sources that reach it
     std::vector<TileLevelStats> stats;  // per visited tile and level
     std::vector<std::int64_t> origin;   // per visited tile: its buffer's first cell (i, j)
 };

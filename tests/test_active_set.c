@@ -123,6 +123,61 @@ static void test_results_do_not_depend_on_threads(void **state) {
     free(c);
 }
 
+/* Where skipping is tightest: motion that starts at the corners and edges of
+ * tiles (64 x 64 cells), fed by a thin source along a tile edge and woken by
+ * host edits next to one, stepped in sweeps of 1 to 4 sub-steps. The heights
+ * and ledger must match visiting every tile, bit for bit. */
+static double *run_tile_edge_scene(int scheme, int visit_all, ledger_t *ledger) {
+    if (visit_all)
+        setenv("DPSM_VISIT_ALL_TILES", "1", 1);
+    else
+        unsetenv("DPSM_VISIT_ALL_TILES");
+    enum { N = 200 };
+    dpsm_grid *g = NULL;
+    CHECK_OK(NULL, dpsm_create_2d(N, N, 1.0, 1.0, &g));
+    CHECK_OK(g, dpsm_set_scheme(g, scheme));
+    CHECK_OK(g, dpsm_set_threads(g, 1));
+    double *h = malloc(sizeof(double) * N * N), *q = calloc(N * N, sizeof(double));
+    for (int j = 0; j < N; ++j)
+        for (int i = 0; i < N; ++i) {
+            double v = 1.0 + 0.05 * sin(0.3 * i) * cos(0.2 * j);
+            if (abs(i - 64) < 2 && abs(j - 64) < 2) v += 3.0; /* at a tile corner */
+            if (i == 127 && j >= 30 && j < 34) v += 2.5;     /* on a tile edge */
+            h[i + N * j] = v;
+            if (i == 128 && j >= 150 && j < 152) q[i + N * j] = 0.4; /* just past a tile edge */
+        }
+    CHECK_OK(g, dpsm_set_heights(g, h));
+    CHECK_OK(g, dpsm_set_source(g, q));
+    double dt;
+    CHECK_OK(g, dpsm_stable_dt(g, &dt));
+    for (int k = 1; k <= 12; ++k) CHECK_OK(g, dpsm_step(g, (double)(k % 5) * dt + 0.5 * dt));
+    const double bump[2] = {2.0, 3.0};
+    CHECK_OK(g, dpsm_add_heights_region(g, 191, 63, 1, 2, bump)); /* the last row of a tile and the next */
+    CHECK_OK(g, dpsm_set_source(g, NULL));
+    CHECK_OK(g, dpsm_step(g, 1e6));
+    CHECK_OK(g, dpsm_get_heights(g, h));
+    *ledger = read_ledger(g);
+    dpsm_destroy(g);
+    free(q);
+    unsetenv("DPSM_VISIT_ALL_TILES");
+    return h;
+}
+
+static void test_active_set_at_tile_edges(void **state) {
+    (void)state;
+    for (int scheme = DPSM_SCHEME_PAIRWISE; scheme <= DPSM_SCHEME_ISOTROPIC; ++scheme) {
+        ledger_t skip, all;
+        double *a = run_tile_edge_scene(scheme, 0, &skip);
+        double *b = run_tile_edge_scene(scheme, 1, &all);
+        size_t differ = 0;
+        for (size_t c = 0; c < 200 * 200; ++c) differ += memcmp(&a[c], &b[c], sizeof(double)) != 0;
+        assert_int_equal(differ, 0);
+        assert_memory_equal(&skip, &all, sizeof skip);
+        free(a);
+        free(b);
+    }
+}
+
 /* A surface at rest costs no cell update, however large; a few cells changed
  * by the host wake only the tiles around them. */
 static void test_idle_and_local_updates(void **state) {
@@ -162,6 +217,7 @@ static void test_idle_and_local_updates(void **state) {
 int main(void) {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_active_set_changes_no_result),
+        cmocka_unit_test(test_active_set_at_tile_edges),
         cmocka_unit_test(test_results_do_not_depend_on_threads),
         cmocka_unit_test(test_idle_and_local_updates),
     };
