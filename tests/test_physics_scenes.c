@@ -298,7 +298,7 @@ static void test_flux_exponent_sets_the_speed(void **state) {
  * (no new extremum at its stable step) and takes longer over the slightly
  * supercritical tail: its excess decays like 1/t, not exponentially, so the
  * time to rest grows like 1/tol (hence a tolerance of 1e-3 here; at the
- * default 1e-6 p = 2 takes over 5e7 sub-steps on this scene). */
+ * default 1e-6 p = 2 took over 5e7 sub-steps on this scene at dx = 0.05). */
 static void test_flux_exponent_same_rest_state(void **state) {
     (void)state;
     enum { N = 150 };
