@@ -31,6 +31,12 @@ void advance_tile_level(TileBuffers &b, int in, const TileRect &reg, const TileR
     double *__restrict fx = ty + stride;
     double *fy_below = fx + stride, *fy_above = fy_below + stride;
     double *tx_lo = fy_above + stride, *tx_hi = tx_lo + stride;
+    // Masked tiles: each cell's outflow rate of the row, summed one by one in
+    // column order and row by row, so that the sum does not depend on where
+    // the computed region starts (lanes would group the cells by it): a tile
+    // visited whole or in part, or after a restart, books the same outflow.
+    double *outflow_row = tx_hi + stride;
+    double outflow = 0.0;
 
     const V zero = V::broadcast(0.0), one = V::broadcast(1.0), half = V::broadcast(0.5);
     const V nu = V::broadcast(p.nu), tan_theta = V::broadcast(p.tan_theta), threshold2 = V::broadcast(p.threshold2);
@@ -39,7 +45,7 @@ void advance_tile_level(TileBuffers &b, int in, const TileRect &reg, const TileR
     const V dt = V::broadcast(p.dt);
     const V x_len = V::broadcast(p.x_face_length), y_len = V::broadcast(p.y_face_length);
     const M all = V::first_lanes(w);
-    V steepest2 = zero, outflow = zero;  // largest squared slope of a face that carries sand
+    V steepest2 = zero;  // largest squared slope of a face that carries sand
     M moved = V::first_lanes(0);
     // The tile's cells that moved: rows, and columns as bits from tile.c0.
     int moved_r0 = st.hot_r0, moved_r1 = st.hot_r1;
@@ -175,8 +181,12 @@ void advance_tile_level(TileBuffers &b, int in, const TileRect &reg, const TileR
                 const V north = select(V::kind_is(kind + c + W, kOpen), f_north, zero);
                 const V south = select(V::kind_is(kind + c - W, kOpen), f_south, zero);
                 const V rate = (east - west) * x_len + (north - south) * y_len;
-                outflow = outflow + select(V::both(sand, in_tile), rate, zero);
+                store(outflow_row + k, select(V::both(sand, in_tile), rate, zero), m);
             }
+        }
+        if constexpr (Masked) {
+            if (row_in_tile)
+                for (int k = 0; k < n; ++k) outflow += outflow_row[k];
         }
         std::swap(fy_below, fy_above);
     }
@@ -189,7 +199,7 @@ void advance_tile_level(TileBuffers &b, int in, const TileRect &reg, const TileR
     st.moved = st.moved || V::any(moved);
     const double steepest = std::sqrt(V::hmax(steepest2));
     if (steepest > 0.0) st.max_excess = std::max(st.max_excess, steepest - p.tan_theta);
-    st.outflow_rate += V::sum(outflow);
+    st.outflow_rate += outflow;
 }
 
 template <class V>
