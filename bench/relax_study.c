@@ -7,8 +7,14 @@
  *    each sweep, a relaxation without a time scale), and
  *  - Runge-Kutta-Chebyshev super-time-stepping (10, 20, 40 stages), whose
  *    steps are about 0.33 s^2 explicit sub-steps long,
- * both written here as plain loops on the isotropic scheme. "sweeps" counts
- * rate evaluations (explicit: sub-steps). */
+ *  - explicit sub-steps with momentum (Nesterov's, restarted when a step
+ *    works against the rates, its factor capped at 0.9 and 0.95), and
+ *  - the limit of backward Euler as dt -> infinity, the L2 projection of the
+ *    surface onto the surfaces whose every face is no steeper than the angle
+ *    of repose, solved by FISTA on its dual (a first-order solver),
+ * all written here as plain loops on the isotropic scheme. "sweeps" counts
+ * rate evaluations (explicit: sub-steps; projection: applications of the
+ * face gradients and their transpose). */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -157,6 +163,208 @@ static int64_t rkc_to_rest(double *h, int64_t n, double dx, double theta, double
     return evaluations;
 }
 
+/* Explicit sub-steps at the stability limit with momentum: y = x + beta (x -
+ * x_prev), x_next = y + dt rate(y), beta = k / (k + 3) capped at beta_max,
+ * k reset to 0 when the step works against the rates (O'Donoghue and Candes'
+ * gradient restart) or when y is at rest. At rest when the rates vanish at a
+ * point reached without momentum. Returns the rate evaluations. */
+static int64_t momentum_to_rest(double *h, int64_t n, double dx, double theta, double tolerance, double beta_max,
+                                int *at_rest) {
+    reference_grid r;
+    if (!reference_init(&r, n, n, dx, dx, 1.0, theta, tolerance, h)) exit(1);
+    const int64_t cells = n * n;
+    double *x = xcalloc((size_t)cells, sizeof(double)), *x_prev = xcalloc((size_t)cells, sizeof(double));
+    double *y = xcalloc((size_t)cells, sizeof(double)), *rate = xcalloc((size_t)cells, sizeof(double));
+    memcpy(x, h, sizeof(double) * (size_t)cells);
+    memcpy(x_prev, h, sizeof(double) * (size_t)cells);
+    const double dt = dx * dx / (4.0 * cos(theta)); /* nu = 1, dx = dy: the explicit limit */
+    int64_t evaluations = 0, k = 0;
+    *at_rest = 0;
+    while (evaluations < 14000) {
+        const double beta = fmin(beta_max, (double)k / (double)(k + 3));
+        for (int64_t c = 0; c < cells; ++c) {
+            y[c] = x[c] + beta * (x[c] - x_prev[c]);
+            reference_set_height(&r, c % n, c / n, y[c]);
+        }
+        const double excess = reference_rates(&r, rate);
+        ++evaluations;
+        if (excess == 0.0) {
+            memcpy(x, y, sizeof(double) * (size_t)cells);
+            if (k == 0) {
+                *at_rest = 1;
+                break;
+            }
+            memcpy(x_prev, y, sizeof(double) * (size_t)cells);
+            k = 0;
+            continue;
+        }
+        double along = 0.0;
+        for (int64_t c = 0; c < cells; ++c) {
+            const double next = y[c] + dt * rate[c];
+            along += rate[c] * (next - x[c]);
+            x_prev[c] = x[c];
+            x[c] = next;
+        }
+        if (along < 0.0) {
+            memcpy(x_prev, x, sizeof(double) * (size_t)cells);
+            k = 0;
+        } else {
+            ++k;
+        }
+    }
+    memcpy(h, x, sizeof(double) * (size_t)cells);
+    reference_free(&r);
+    free(x);
+    free(x_prev);
+    free(y);
+    free(rate);
+    return evaluations;
+}
+
+/* The face gradients of the isotropic scheme as the reference loop takes
+ * them (a frame of zeros beyond the open sides, no transverse slope there):
+ * face f of direction d joins cell a = (i, j) to b = its neighbour in +x (d = 0)
+ * or +y (d = 1), for i (d = 0) or j (d = 1) from -1 to n - 1; its normal part
+ * is (h_b - h_a) / dx, its transverse part the mean of a's and b's central
+ * differences across it. */
+typedef struct {
+    int64_t n;
+    double dx;
+} face_grid;
+
+static int64_t face_index(const face_grid *f, int d, int64_t i, int64_t j) {
+    return d == 0 ? (i + 1) + (f->n + 1) * j : (j + 1) + (f->n + 1) * i;
+}
+
+static double cell_at(const face_grid *f, const double *h, int64_t i, int64_t j) {
+    return (i < 0 || j < 0 || i >= f->n || j >= f->n) ? 0.0 : h[i + f->n * j];
+}
+
+static int inside(const face_grid *f, int64_t i, int64_t j) { return i >= 0 && j >= 0 && i < f->n && j < f->n; }
+
+/* g = G h: normal[d][face], transverse[d][face]. */
+static void face_gradients(const face_grid *f, const double *h, double *normal[2], double *transverse[2]) {
+    const int64_t n = f->n;
+    const double inv = 1.0 / f->dx, half = 0.5 / f->dx;
+    for (int d = 0; d < 2; ++d)
+        for (int64_t j = (d == 0 ? 0 : -1); j < n; ++j)
+            for (int64_t i = (d == 0 ? -1 : 0); i < n; ++i) {
+                const int64_t i2 = i + (d == 0), j2 = j + (d == 1), e = face_index(f, d, i, j);
+                normal[d][e] = (cell_at(f, h, i2, j2) - cell_at(f, h, i, j)) * inv;
+                double t = 0.0;
+                for (int side = 0; side < 2; ++side) {
+                    const int64_t a = side ? i2 : i, b = side ? j2 : j;
+                    if (!inside(f, a, b)) continue;
+                    t += d == 0 ? cell_at(f, h, a, b + 1) - cell_at(f, h, a, b - 1)
+                                : cell_at(f, h, a + 1, b) - cell_at(f, h, a - 1, b);
+                }
+                transverse[d][e] = 0.5 * half * t;
+            }
+}
+
+static void add_to(const face_grid *f, double *out, int64_t i, int64_t j, double v) {
+    if (inside(f, i, j)) out[i + f->n * j] += v;
+}
+
+/* out = G^T p, the transpose of face_gradients. */
+static void face_gradients_transposed(const face_grid *f, double *normal[2], double *transverse[2], double *out) {
+    const int64_t n = f->n;
+    const double inv = 1.0 / f->dx, half = 0.5 / f->dx;
+    memset(out, 0, sizeof(double) * (size_t)(n * n));
+    for (int d = 0; d < 2; ++d)
+        for (int64_t j = (d == 0 ? 0 : -1); j < n; ++j)
+            for (int64_t i = (d == 0 ? -1 : 0); i < n; ++i) {
+                const int64_t i2 = i + (d == 0), j2 = j + (d == 1), e = face_index(f, d, i, j);
+                add_to(f, out, i2, j2, normal[d][e] * inv);
+                add_to(f, out, i, j, -normal[d][e] * inv);
+                const double t = 0.5 * half * transverse[d][e];
+                for (int side = 0; side < 2; ++side) {
+                    const int64_t a = side ? i2 : i, b = side ? j2 : j;
+                    if (!inside(f, a, b)) continue;
+                    if (d == 0) {
+                        add_to(f, out, a, b + 1, t);
+                        add_to(f, out, a, b - 1, -t);
+                    } else {
+                        add_to(f, out, a + 1, b, t);
+                        add_to(f, out, a - 1, b, -t);
+                    }
+                }
+            }
+}
+
+/* The L2 projection of h onto {every face gradient no longer than tan(theta)}:
+ * h = h0 - G^T p with p minimising 1/2 |h0 - G^T p|^2 + tan(theta) sum |p_f|,
+ * by FISTA (step 1 / |G|^2, |G|^2 <= 8 / dx^2). Stops when no face exceeds
+ * the rest threshold or after max_iterations. Returns the iterations; the
+ * projection keeps the volume (the set does not change when a constant is
+ * added; here the frame's zeros break that only beyond the open sides). */
+static int64_t project_to_rest(double *h, int64_t n, double dx, double theta, double tolerance, int64_t max_iterations,
+                               int *at_rest) {
+    const face_grid f = {n, dx};
+    const int64_t cells = n * n, faces = (n + 1) * n;
+    const double alpha = tan(theta), threshold = alpha * (1.0 + tolerance), step = dx * dx / 8.5;
+    double *h0 = xcalloc((size_t)cells, sizeof(double));
+    memcpy(h0, h, sizeof(double) * (size_t)cells);
+    double *p[2][2], *p_prev[2][2], *q[2][2], *g[2][2];
+    for (int d = 0; d < 2; ++d)
+        for (int c = 0; c < 2; ++c) {
+            p[d][c] = xcalloc((size_t)faces, sizeof(double));
+            p_prev[d][c] = xcalloc((size_t)faces, sizeof(double));
+            q[d][c] = xcalloc((size_t)faces, sizeof(double));
+            g[d][c] = xcalloc((size_t)faces, sizeof(double));
+        }
+    double t_k = 1.0;
+    int64_t it = 0;
+    *at_rest = 0;
+    for (; it < max_iterations; ++it) {
+        /* Every 50 iterations: is h = h0 - G^T p at rest? */
+        if (it % 50 == 0) {
+            double *pn[2] = {p[0][0], p[1][0]}, *pt[2] = {p[0][1], p[1][1]};
+            double *gn[2] = {g[0][0], g[1][0]}, *gt[2] = {g[0][1], g[1][1]};
+            face_gradients_transposed(&f, pn, pt, h);
+            for (int64_t c = 0; c < cells; ++c) h[c] = h0[c] - h[c];
+            face_gradients(&f, h, gn, gt);
+            double worst = 0.0;
+            for (int d = 0; d < 2; ++d)
+                for (int64_t e = 0; e < faces; ++e) worst = fmax(worst, hypot(g[d][0][e], g[d][1][e]));
+            if (worst <= threshold) {
+                *at_rest = 1;
+                break;
+            }
+        }
+        double *qn[2] = {q[0][0], q[1][0]}, *qt[2] = {q[0][1], q[1][1]};
+        double *gn[2] = {g[0][0], g[1][0]}, *gt[2] = {g[0][1], g[1][1]};
+        face_gradients_transposed(&f, qn, qt, h);
+        for (int64_t c = 0; c < cells; ++c) h[c] = h0[c] - h[c];
+        face_gradients(&f, h, gn, gt);
+        const double t_next = 0.5 * (1.0 + sqrt(1.0 + 4.0 * t_k * t_k)), w = (t_k - 1.0) / t_next;
+        t_k = t_next;
+        for (int d = 0; d < 2; ++d)
+            for (int64_t e = 0; e < faces; ++e) {
+                const double a = q[d][0][e] + step * g[d][0][e], b = q[d][1][e] + step * g[d][1][e];
+                const double m = hypot(a, b), shrink = m > step * alpha ? 1.0 - step * alpha / m : 0.0;
+                p_prev[d][0][e] = p[d][0][e];
+                p_prev[d][1][e] = p[d][1][e];
+                p[d][0][e] = shrink * a;
+                p[d][1][e] = shrink * b;
+                q[d][0][e] = p[d][0][e] + w * (p[d][0][e] - p_prev[d][0][e]);
+                q[d][1][e] = p[d][1][e] + w * (p[d][1][e] - p_prev[d][1][e]);
+            }
+    }
+    double *pn[2] = {p[0][0], p[1][0]}, *pt[2] = {p[0][1], p[1][1]};
+    face_gradients_transposed(&f, pn, pt, h);
+    for (int64_t c = 0; c < cells; ++c) h[c] = h0[c] - h[c];
+    for (int d = 0; d < 2; ++d)
+        for (int c = 0; c < 2; ++c) {
+            free(p[d][c]);
+            free(p_prev[d][c]);
+            free(q[d][c]);
+            free(g[d][c]);
+        }
+    free(h0);
+    return it;
+}
+
 int cmd_steps(int argc, char **argv) {
     (void)argc;
     (void)argv;
@@ -218,6 +426,33 @@ int cmd_steps(int argc, char **argv) {
                 printf("%s,rkc-%d,%g,%.4f,%lld,%.4f,%.3f,%.1e,%d\n", sc->name, stages, tolerances[t], rkc_seconds,
                        (long long)evaluations, rkc_top, 100.0 * (rkc_top - sc->exact_top) / sc->exact_top,
                        fabs(v - v0) / v0, at_rest);
+            }
+            const double caps[] = {0.9, 0.95};
+            for (size_t m = 0; m < sizeof caps / sizeof *caps; ++m) {
+                memcpy(h, h0, sizeof(double) * (size_t)cells);
+                const double t3 = now_seconds();
+                int at_rest;
+                const int64_t evaluations = momentum_to_rest(h, n, sc->dx, sc->theta, tolerances[t], caps[m], &at_rest);
+                const double momentum_seconds = now_seconds() - t3;
+                v = 0.0;
+                for (int64_t c = 0; c < cells; ++c) v += h[c];
+                const double momentum_top = top_of(h, cells);
+                printf("%s,momentum-%g,%g,%.4f,%lld,%.4f,%.3f,%.1e,%d\n", sc->name, caps[m], tolerances[t],
+                       momentum_seconds, (long long)evaluations, momentum_top,
+                       100.0 * (momentum_top - sc->exact_top) / sc->exact_top, fabs(v - v0) / v0, at_rest);
+            }
+            {
+                memcpy(h, h0, sizeof(double) * (size_t)cells);
+                const double t4 = now_seconds();
+                int at_rest;
+                const int64_t iterations = project_to_rest(h, n, sc->dx, sc->theta, tolerances[t], 5000, &at_rest);
+                const double projection_seconds = now_seconds() - t4;
+                v = 0.0;
+                for (int64_t c = 0; c < cells; ++c) v += h[c];
+                const double projection_top = top_of(h, cells);
+                printf("%s,projection,%g,%.4f,%lld,%.4f,%.3f,%.1e,%d\n", sc->name, tolerances[t], projection_seconds,
+                       (long long)iterations, projection_top,
+                       100.0 * (projection_top - sc->exact_top) / sc->exact_top, fabs(v - v0) / v0, at_rest);
             }
             fflush(stdout);
         }
