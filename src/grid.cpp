@@ -78,6 +78,11 @@ void Grid::write_heights(const Block &block, const double *values, bool add) {
     ledger_.external.add(change.value());
     if (open_cells_ > 0) update_open_levels();
     if (active_) active_->mark_block(block.i0, block.j0, block.ni, block.nj);
+    if (tiled_ && active_) {
+        CellBox box;
+        box.add(block.i0, block.i0 + block.ni, block.j0, block.j0 + block.nj);
+        tiled_workspace_changed(*tiled_, *active_, box);
+    }
 }
 
 void Grid::read_heights(const Block &block, double *values) const {
@@ -101,6 +106,7 @@ void Grid::set_cell_kinds(const std::uint8_t *kinds) {
     }
     wall_cells_ = walls;
     open_cells_ = opens;
+    if (tiled_) tiled_->all_stale = true;  // residuals were reset where kinds changed
     ++masks_version_;
     ledger_.external.add(change.value());
     update_source_summary();
@@ -131,6 +137,7 @@ void Grid::restore(GridState &&s) {
     static_angle_ = s.static_angle;
     tan_static_ = s.static_angle > 0.0 ? std::tan(s.static_angle) : 0.0;
     moving_ = std::move(s.moving);
+    if (tiled_) tiled_->all_stale = true;
     std::int64_t walls = 0, opens = 0;
     for (const std::uint8_t k : kinds_) {
         walls += k == kWall;
@@ -191,6 +198,7 @@ void Grid::set_static_angle(double theta) {
     tan_static_ = std::tan(theta);
     // Every cell starts at rest: sand moves first where the static angle is exceeded.
     moving_.assign(heights_.size(), 0);
+    if (tiled_) tiled_->all_stale = true;
     touched_everywhere();
 }
 

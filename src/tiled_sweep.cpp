@@ -190,7 +190,51 @@ void gather_halo(const Grid &grid, const HaloStore &halo, TileBuffers &b, std::i
     }
 }
 
+// Calls part(b) for the boxes that together make the cells of `from` outside `cut`.
+template <class Part>
+void for_parts_outside(const CellBox &from, const CellBox &cut, Part &&part) {
+    if (from.empty()) return;
+    auto box = [](std::int64_t i0, std::int64_t i1, std::int64_t j0, std::int64_t j1) {
+        CellBox b;
+        b.add(i0, i1, j0, j1);
+        return b;
+    };
+    if (cut.empty()) {
+        part(from);
+        return;
+    }
+    const std::int64_t j_lo = std::clamp(cut.j0, from.j0, from.j1), j_hi = std::clamp(cut.j1, j_lo, from.j1);
+    if (from.j0 < j_lo) part(box(from.i0, from.i1, from.j0, j_lo));
+    if (j_hi < from.j1) part(box(from.i0, from.i1, j_hi, from.j1));
+    if (j_lo < j_hi) {
+        if (from.i0 < cut.i0) part(box(from.i0, std::min(cut.i0, from.i1), j_lo, j_hi));
+        if (cut.i1 < from.i1) part(box(std::max(cut.i1, from.i0), from.i1, j_lo, j_hi));
+    }
+}
+
+// Copies the grid's cells of a box into the scratch.
+void refresh_scratch(const Grid &grid, TiledWorkspace &ws, const CellBox &box, bool hysteresis) {
+    const std::int64_t nx = grid.geometry().nx;
+    for (std::int64_t j = box.j0; j < box.j1; ++j) {
+        const std::size_t at = static_cast<std::size_t>(j * nx + box.i0);
+        const std::size_t count = static_cast<std::size_t>(box.i1 - box.i0);
+        std::memcpy(ws.heights.data() + at, grid.heights().data() + at, sizeof(double) * count);
+        std::memcpy(ws.residuals.data() + at, grid.residuals().data() + at, sizeof(float) * count);
+        if (hysteresis) std::memcpy(ws.moving.data() + at, grid.moving().data() + at, count);
+    }
+}
+
 }  // namespace
+
+void tiled_workspace_changed(TiledWorkspace &ws, const ActiveSet &active, const CellBox &box) {
+    if (ws.all_stale || box.empty()) return;
+    for (std::int64_t t = 0; t < active.tiles(); ++t) {
+        const CellBox part = box.grown_within(0, active.tile_cells(t));
+        if (part.empty()) continue;
+        if (ws.stale[static_cast<std::size_t>(t)].empty()) ws.stale_tiles.push_back(t);
+        ws.stale[static_cast<std::size_t>(t)].add(part);
+    }
+}
 
 void prepare_tiled_sweep(Grid &grid, int threads) {
     TiledWorkspace &ws = grid.tiled_workspace();
@@ -198,6 +242,7 @@ void prepare_tiled_sweep(Grid &grid, int threads) {
     if (ws.heights.size() != cells) {
         ws.heights.assign(cells, 0.0);
         ws.residuals.assign(cells, 0.0f);
+        ws.all_stale = true;
     }
     const std::size_t want = static_cast<std::size_t>(thread_count(threads));
     while (ws.buffers.size() < want) {
@@ -206,8 +251,14 @@ void prepare_tiled_sweep(Grid &grid, int threads) {
     }
     if (grid.uses_physics())
         for (TileBuffers &b : ws.buffers) b.resize_physics();
-    if (grid.hysteresis() && ws.moving.size() != cells) ws.moving.assign(cells, 0);
+    if (grid.hysteresis() && ws.moving.size() != cells) {
+        ws.moving.assign(cells, 0);
+        ws.all_stale = true;
+    }
     const std::size_t tiles = static_cast<std::size_t>(grid.active_set().tiles());
+    ws.stale.resize(tiles);
+    ws.written.resize(tiles);
+    ws.stale_tiles.reserve(tiles);
     ws.visit.reserve(tiles);
     ws.boxes.reserve(tiles);
     ws.seeds.reserve(tiles);
@@ -308,9 +359,30 @@ std::int64_t tiled_sweep(Grid &grid, int levels, double dt, std::vector<LevelSum
         ws.origin[2 * k + 1] = gj0;
     };
 
+    // The scratch becomes the grid at the end: where this sweep does not write
+    // it, it must hold the grid's cells. It does, but in its stale boxes.
+    if (ws.all_stale) {
+        ws.heights = grid.heights();
+        ws.residuals = grid.residuals();
+        if (hysteresis) ws.moving = grid.moving();
+        for (const std::int64_t t : ws.stale_tiles) ws.stale[static_cast<std::size_t>(t)] = CellBox{};
+        ws.stale_tiles.clear();
+        ws.all_stale = false;
+    }
+    for (std::int64_t k = 0; k < visits; ++k) ws.written[static_cast<std::size_t>(ws.visit[k])] = ws.boxes[k];
+    const std::int64_t stale_count = static_cast<std::int64_t>(ws.stale_tiles.size());
+    auto refresh_tile = [&](std::int64_t k) {
+        const std::size_t t = static_cast<std::size_t>(ws.stale_tiles[static_cast<std::size_t>(k)]);
+        for_parts_outside(ws.stale[t], ws.written[t],
+                          [&](const CellBox &part) { refresh_scratch(grid, ws, part, hysteresis); });
+    };
+
+    // Both loops read only the grid and write disjoint cells of the scratch.
 #if defined(_OPENMP)
 #pragma omp parallel num_threads(threads) if (parallel)
     {
+#pragma omp for schedule(dynamic, 4) nowait
+        for (std::int64_t k = 0; k < stale_count; ++k) refresh_tile(k);
         TileBuffers &b = ws.buffers[static_cast<std::size_t>(omp_get_thread_num())];
 #pragma omp for schedule(dynamic, 1)
         for (std::int64_t k = 0; k < visits; ++k) visit_tile(k, b);
@@ -318,30 +390,21 @@ std::int64_t tiled_sweep(Grid &grid, int levels, double dt, std::vector<LevelSum
 #else
     (void)threads;
     (void)parallel;
+    for (std::int64_t k = 0; k < stale_count; ++k) refresh_tile(k);
     for (std::int64_t k = 0; k < visits; ++k) visit_tile(k, ws.buffers[0]);
 #endif
 
-    // Write back; when every tile was visited whole the output is the whole grid.
-    if (visited_cells == geo.cells()) {
-        grid.swap_heights(ws.heights, ws.residuals);
-        if (hysteresis) grid.moving_for_stepping().swap(ws.moving);
-    } else {
-        std::vector<double> &h = grid.heights_for_stepping();
-        std::vector<float> &res = grid.residuals_for_stepping();
-        std::vector<std::uint8_t> &moving = grid.moving_for_stepping();
-#if defined(_OPENMP)
-#pragma omp parallel for num_threads(threads) schedule(static) if (parallel)
-#endif
-        for (std::int64_t k = 0; k < visits; ++k) {
-            const CellBox &cells = ws.boxes[k];
-            for (std::int64_t j = cells.j0; j < cells.j1; ++j) {
-                const std::size_t at = static_cast<std::size_t>(j * geo.nx + cells.i0);
-                const std::size_t count = static_cast<std::size_t>(cells.i1 - cells.i0);
-                std::memcpy(h.data() + at, ws.heights.data() + at, sizeof(double) * count);
-                std::memcpy(res.data() + at, ws.residuals.data() + at, sizeof(float) * count);
-                if (hysteresis) std::memcpy(moving.data() + at, ws.moving.data() + at, count);
-            }
-        }
+    grid.swap_heights(ws.heights, ws.residuals);
+    if (hysteresis) grid.moving_for_stepping().swap(ws.moving);
+    // The old grid, now the scratch, differs from the new one where this sweep wrote.
+    for (const std::int64_t t : ws.stale_tiles) ws.stale[static_cast<std::size_t>(t)] = CellBox{};
+    ws.stale_tiles.clear();
+    for (std::int64_t k = 0; k < visits; ++k) {
+        const std::size_t t = static_cast<std::size_t>(ws.visit[k]);
+        ws.written[t] = CellBox{};
+        if (ws.boxes[k].empty()) continue;
+        ws.stale[t] = ws.boxes[k];
+        ws.stale_tiles.push_back(ws.visit[k]);
     }
 
     // New hot boxes: the cells touching moving faces in any level, grown by the

@@ -22,11 +22,21 @@ struct LevelSummary {
     double unmet_mass = 0.0;    // erosion asked for where no sand lay above the bed
 };
 
-// Scratch of the 2D sweep, kept by the grid between steps.
+// Scratch of the 2D sweep, kept by the grid between steps. A sweep writes
+// the visited cells into heights (residuals, moving) and then swaps them with
+// the grid's: the old grid becomes this scratch. So that a sparse sweep does
+// not copy its cells back, the scratch is kept equal to the grid except in
+// the stale boxes (per tile: the cells the last sweep wrote, and those the
+// host changed since), which the next sweep copies from the grid where it
+// does not write them itself.
 struct TiledWorkspace {
-    std::vector<double> heights;     // the new heights of visited tiles
+    std::vector<double> heights;     // the grid's heights but in the stale boxes
     std::vector<float> residuals;
-    std::vector<std::uint8_t> moving;  // the new moving cells (hysteresis)
+    std::vector<std::uint8_t> moving;  // the moving cells (hysteresis)
+    bool all_stale = true;             // nothing of the scratch can be trusted
+    std::vector<CellBox> stale;        // per tile: where the scratch may differ from the grid
+    std::vector<std::int64_t> stale_tiles;  // the tiles whose stale box is not empty
+    std::vector<CellBox> written;      // per tile, during a sweep: the cells it writes
     std::vector<TileBuffers> buffers;  // one per thread
     std::vector<std::int64_t> visit;
     std::vector<CellBox> boxes;         // per visited tile: the cells that can change
@@ -38,6 +48,10 @@ struct TiledWorkspace {
 // Makes sure the workspace can run a sweep with `threads` threads (0: the
 // OpenMP default). Allocates; call before changing anything.
 void prepare_tiled_sweep(Grid &grid, int threads);
+
+// The host changed the cells of box (heights or residuals): the scratch no
+// longer holds them.
+void tiled_workspace_changed(TiledWorkspace &ws, const ActiveSet &active, const CellBox &box);
 
 // Advances a 2D grid `levels` (1 .. ActiveSet::kMaxLevels) sub-steps of dt and
 // fills one summary per level; returns the number of cells it visited.
