@@ -12,6 +12,9 @@
  *  - the limit of backward Euler as dt -> infinity, the L2 projection of the
  *    surface onto the surfaces whose every face is no steeper than the angle
  *    of repose, solved by FISTA on its dual (a first-order solver),
+ *  - nested iteration from coarser grids (1 and 2 levels): rest on a grid of
+ *    cells twice as wide first, its change added to the finer surface, then
+ *    the explicit sub-steps there ("sweeps" in sub-steps of the finest grid),
  * all written here as plain loops on the isotropic scheme. "sweeps" counts
  * rate evaluations (explicit: sub-steps; projection: applications of the
  * face gradients and their transpose). */
@@ -30,6 +33,7 @@ typedef struct {
     int64_t n;
     double dx, theta, exact_top;
     void (*fill)(double *h, int64_t n, double dx);
+    double (*exact)(double r, double theta); /* the exact deposit at distance r from the centre */
 } scene;
 
 static void fill_cone(double *h, int64_t n, double dx) {
@@ -365,17 +369,91 @@ static int64_t project_to_rest(double *h, int64_t n, double dx, double theta, do
     return it;
 }
 
+/* Explicit sub-steps of the reference loop on h (n x n, open sides) until
+ * rest; adds the work, in cells, to *cell_updates. */
+static void explicit_rest(double *h, int64_t n, double dx, double theta, double tolerance, double *cell_updates) {
+    reference_grid r;
+    if (!reference_init(&r, n, n, dx, dx, 1.0, theta, tolerance, h)) exit(1);
+    const double dt = dx * dx / (4.0 * cos(theta));
+    int64_t substeps = 1;
+    while (reference_substep(&r, dt) != 0.0 && substeps < 1000000) ++substeps;
+    for (int64_t j = 0; j < n; ++j)
+        for (int64_t i = 0; i < n; ++i) h[i + n * j] = reference_height(&r, i, j);
+    reference_free(&r);
+    *cell_updates += (double)substeps * (double)(n * n);
+}
+
+/* Nested iteration: the surface averaged onto cells twice as wide (a coarse
+ * cell holds the mass of its four), brought to rest there (recursively, from
+ * `levels` coarser grids), the change added back to each of its four fine
+ * cells (which keeps the mass), then explicit sub-steps to rest here. */
+static void cascade_to_rest(double *h, int64_t n, double dx, double theta, double tolerance, int levels,
+                            double *cell_updates) {
+    if (levels > 0 && n >= 16) {
+        const int64_t nc = (n + 1) / 2;
+        double *coarse = xcalloc((size_t)(nc * nc), sizeof(double)), *start = xcalloc((size_t)(nc * nc), sizeof(double));
+        for (int64_t j = 0; j < n; ++j)
+            for (int64_t i = 0; i < n; ++i) coarse[i / 2 + nc * (j / 2)] += 0.25 * h[i + n * j];
+        memcpy(start, coarse, sizeof(double) * (size_t)(nc * nc));
+        cascade_to_rest(coarse, nc, 2.0 * dx, theta, tolerance, levels - 1, cell_updates);
+        for (int64_t j = 0; j < n; ++j)
+            for (int64_t i = 0; i < n; ++i) {
+                const int64_t c = i / 2 + nc * (j / 2);
+                h[i + n * j] += coarse[c] - start[c];
+            }
+        free(coarse);
+        free(start);
+    }
+    explicit_rest(h, n, dx, theta, tolerance, cell_updates);
+}
+
+/* The exact deposits, at a cell's centre: the cone's (a cone of slope
+ * tan(theta) with the volume of the cone 40 high of slope 1.5) and the
+ * column's (a truncated cone of height 0.5 whose foot lies at
+ * r_f = (a + sqrt(4 alpha^2 - a^2 / 3)) / (2 alpha), a = 0.5, radius 1). */
+static double exact_cone(double r, double theta) {
+    const double alpha = tan(theta), foot = (40.0 / 1.5) * cbrt(1.5 / alpha);
+    return fmax(0.0, alpha * (foot - r));
+}
+
+static double exact_column(double r, double theta) {
+    const double alpha = tan(theta), a = 0.5, foot = (a + sqrt(4.0 * alpha * alpha - a * a / 3.0)) / (2.0 * alpha);
+    return fmin(0.5, fmax(0.0, alpha * (foot - r)));
+}
+
+/* Prints a row: the top against the exact top, and the deposit's L1
+ * difference from the exact deposit over the exact deposit's volume. */
+static void report(const scene *sc, const char *method, double tolerance, double seconds, double sweeps,
+                   const double *h, double v0, int at_rest) {
+    const int64_t n = sc->n, cells = n * n;
+    double v = 0.0, difference = 0.0, exact_volume = 0.0;
+    for (int64_t j = 0; j < n; ++j)
+        for (int64_t i = 0; i < n; ++i) {
+            const double r = hypot((double)(i - n / 2), (double)(j - n / 2)) * sc->dx;
+            const double want = sc->exact(r, sc->theta);
+            v += h[i + n * j];
+            difference += fabs(h[i + n * j] - want);
+            exact_volume += want;
+        }
+    const double top = top_of(h, cells);
+    printf("%s,%s,%g,%.4f,%.0f,%.4f,%.3f,%.2f,%.1e,%d\n", sc->name, method, tolerance, seconds, sweeps, top,
+           100.0 * (top - sc->exact_top) / sc->exact_top, 100.0 * difference / exact_volume, fabs(v - v0) / v0,
+           at_rest);
+    fflush(stdout);
+}
+
 int cmd_steps(int argc, char **argv) {
     (void)argc;
     (void)argv;
     const scene scenes[] = {
-        {"cone", 101, 1.0, 33.0 * kPi / 180.0, 22.89, fill_cone},
+        {"cone", 101, 1.0, 33.0 * kPi / 180.0, 22.89, fill_cone, exact_cone},
         /* column a = 0.5 at 30 deg: a truncated cone, top stays at h0 = 0.5; its
          * runout is the quantity that moves, the top is checked for damage. */
-        {"column", 128, 4.0 / 128, 30.0 * kPi / 180.0, 0.5, fill_column},
+        {"column", 128, 4.0 / 128, 30.0 * kPi / 180.0, 0.5, fill_column, exact_column},
     };
     const double tolerances[] = {1e-6, 1e-3, 1e-2};
-    printf("scene,method,tolerance,seconds,sweeps,top,top_error_percent,volume_change,at_rest\n");
+    printf("scene,method,tolerance,seconds,sweeps,top,top_error_percent,deposit_error_percent,volume_change,"
+           "at_rest\n");
     for (size_t s = 0; s < sizeof scenes / sizeof *scenes; ++s) {
         const scene *sc = &scenes[s];
         const int64_t n = sc->n, cells = n * n;
@@ -384,77 +462,56 @@ int cmd_steps(int argc, char **argv) {
         double v0 = 0.0;
         for (int64_t c = 0; c < cells; ++c) v0 += h0[c];
         for (size_t t = 0; t < sizeof tolerances / sizeof *tolerances; ++t) {
+            const double tol = tolerances[t];
             dpsm_grid *g = NULL;
             CHECK(NULL, dpsm_create_2d(n, n, sc->dx, sc->dx, &g));
             CHECK(g, dpsm_set_repose_angle(g, sc->theta));
-            CHECK(g, dpsm_set_rest_tolerance(g, tolerances[t]));
+            CHECK(g, dpsm_set_rest_tolerance(g, tol));
             for (int side = DPSM_XMIN; side <= DPSM_YMAX; ++side) CHECK(g, dpsm_set_boundary(g, side, DPSM_OPEN));
             CHECK(g, dpsm_set_heights(g, h0));
-            const double t0 = now_seconds();
+            double t0 = now_seconds();
             CHECK(g, dpsm_step(g, 1e6));
-            const double seconds = now_seconds() - t0;
-            double substeps;
+            double seconds = now_seconds() - t0, substeps, rest;
             CHECK(g, dpsm_get_step_info(g, DPSM_INFO_SUBSTEPS, &substeps));
-            CHECK(g, dpsm_get_heights(g, h));
-            double v = 0.0;
-            for (int64_t c = 0; c < cells; ++c) v += h[c];
-            const double top = top_of(h, cells);
-            double rest;
             CHECK(g, dpsm_get_step_info(g, DPSM_INFO_AT_REST, &rest));
-            printf("%s,explicit,%g,%.4f,%.0f,%.4f,%.3f,%.1e,%d\n", sc->name, tolerances[t], seconds, substeps, top,
-                   100.0 * (top - sc->exact_top) / sc->exact_top, fabs(v - v0) / v0, rest == 1.0);
+            CHECK(g, dpsm_get_heights(g, h));
             dpsm_destroy(g);
+            report(sc, "explicit", tol, seconds, substeps, h, v0, rest == 1.0);
 
             memcpy(h, h0, sizeof(double) * (size_t)cells);
-            const double t1 = now_seconds();
-            const int64_t sweeps = relax(h, n, sc->dx, sc->theta, tolerances[t]);
-            const double relax_seconds = now_seconds() - t1;
-            v = 0.0;
-            for (int64_t c = 0; c < cells; ++c) v += h[c];
-            const double relax_top = top_of(h, cells);
-            printf("%s,bounded-exchange,%g,%.4f,%lld,%.4f,%.3f,%.1e,1\n", sc->name, tolerances[t], relax_seconds,
-                   (long long)sweeps, relax_top, 100.0 * (relax_top - sc->exact_top) / sc->exact_top, fabs(v - v0) / v0);
+            t0 = now_seconds();
+            const int64_t sweeps = relax(h, n, sc->dx, sc->theta, tol);
+            report(sc, "bounded-exchange", tol, now_seconds() - t0, (double)sweeps, h, v0, 1);
+
+            char method[32];
+            int at_rest;
             for (int stages = 10; stages <= 40; stages *= 2) {
                 memcpy(h, h0, sizeof(double) * (size_t)cells);
-                const double t2 = now_seconds();
-                int at_rest;
-                const int64_t evaluations = rkc_to_rest(h, n, sc->dx, sc->theta, tolerances[t], stages, &at_rest);
-                const double rkc_seconds = now_seconds() - t2;
-                v = 0.0;
-                for (int64_t c = 0; c < cells; ++c) v += h[c];
-                const double rkc_top = top_of(h, cells);
-                printf("%s,rkc-%d,%g,%.4f,%lld,%.4f,%.3f,%.1e,%d\n", sc->name, stages, tolerances[t], rkc_seconds,
-                       (long long)evaluations, rkc_top, 100.0 * (rkc_top - sc->exact_top) / sc->exact_top,
-                       fabs(v - v0) / v0, at_rest);
+                t0 = now_seconds();
+                const int64_t evaluations = rkc_to_rest(h, n, sc->dx, sc->theta, tol, stages, &at_rest);
+                snprintf(method, sizeof method, "rkc-%d", stages);
+                report(sc, method, tol, now_seconds() - t0, (double)evaluations, h, v0, at_rest);
             }
             const double caps[] = {0.9, 0.95};
             for (size_t m = 0; m < sizeof caps / sizeof *caps; ++m) {
                 memcpy(h, h0, sizeof(double) * (size_t)cells);
-                const double t3 = now_seconds();
-                int at_rest;
-                const int64_t evaluations = momentum_to_rest(h, n, sc->dx, sc->theta, tolerances[t], caps[m], &at_rest);
-                const double momentum_seconds = now_seconds() - t3;
-                v = 0.0;
-                for (int64_t c = 0; c < cells; ++c) v += h[c];
-                const double momentum_top = top_of(h, cells);
-                printf("%s,momentum-%g,%g,%.4f,%lld,%.4f,%.3f,%.1e,%d\n", sc->name, caps[m], tolerances[t],
-                       momentum_seconds, (long long)evaluations, momentum_top,
-                       100.0 * (momentum_top - sc->exact_top) / sc->exact_top, fabs(v - v0) / v0, at_rest);
+                t0 = now_seconds();
+                const int64_t evaluations = momentum_to_rest(h, n, sc->dx, sc->theta, tol, caps[m], &at_rest);
+                snprintf(method, sizeof method, "momentum-%g", caps[m]);
+                report(sc, method, tol, now_seconds() - t0, (double)evaluations, h, v0, at_rest);
             }
-            {
+            for (int levels = 1; levels <= 2; ++levels) {
                 memcpy(h, h0, sizeof(double) * (size_t)cells);
-                const double t4 = now_seconds();
-                int at_rest;
-                const int64_t iterations = project_to_rest(h, n, sc->dx, sc->theta, tolerances[t], 5000, &at_rest);
-                const double projection_seconds = now_seconds() - t4;
-                v = 0.0;
-                for (int64_t c = 0; c < cells; ++c) v += h[c];
-                const double projection_top = top_of(h, cells);
-                printf("%s,projection,%g,%.4f,%lld,%.4f,%.3f,%.1e,%d\n", sc->name, tolerances[t], projection_seconds,
-                       (long long)iterations, projection_top,
-                       100.0 * (projection_top - sc->exact_top) / sc->exact_top, fabs(v - v0) / v0, at_rest);
+                t0 = now_seconds();
+                double updates = 0.0;
+                cascade_to_rest(h, n, sc->dx, sc->theta, tol, levels, &updates);
+                snprintf(method, sizeof method, "cascade-%d", levels);
+                report(sc, method, tol, now_seconds() - t0, updates / (double)cells, h, v0, 1);
             }
-            fflush(stdout);
+            memcpy(h, h0, sizeof(double) * (size_t)cells);
+            t0 = now_seconds();
+            const int64_t iterations = project_to_rest(h, n, sc->dx, sc->theta, tol, 5000, &at_rest);
+            report(sc, "projection", tol, now_seconds() - t0, (double)iterations, h, v0, at_rest);
         }
         free(h0);
         free(h);

@@ -178,6 +178,64 @@ static void test_active_set_at_tile_edges(void **state) {
     }
 }
 
+/* With hysteresis a cell can stop moving, and change its flag, in a sweep that
+ * changes no height: the last sweep over a pile that came to rest. Between
+ * sweeps the library keeps a scratch copy of the grid; the flags written by
+ * that last sweep must survive a later sweep that visits other tiles only.
+ * Piles of several sizes come to rest (so that motion ends at every sub-step
+ * of a sweep), the host wakes a far tile, then sprinkles sand over the rested
+ * piles: faces between the angles of repose and static move only next to a
+ * moving cell, so a stale flag would change the result. */
+static double *run_hysteresis_scene(int visit_all, ledger_t *ledger) {
+    if (visit_all)
+        setenv("DPSM_VISIT_ALL_TILES", "1", 1);
+    else
+        unsetenv("DPSM_VISIT_ALL_TILES");
+    enum { W = 256, H = 64 };
+    dpsm_grid *g = NULL;
+    CHECK_OK(NULL, dpsm_create_2d(W, H, 1.0, 1.0, &g));
+    CHECK_OK(g, dpsm_set_threads(g, 1));
+    CHECK_OK(g, dpsm_set_repose_angle(g, 30.0 * 3.14159265358979323846 / 180.0));
+    CHECK_OK(g, dpsm_set_static_angle(g, 35.0 * 3.14159265358979323846 / 180.0));
+    double *h = malloc(sizeof(double) * W * H);
+    for (int c = 0; c < W * H; ++c) h[c] = 1.0;
+    CHECK_OK(g, dpsm_set_heights(g, h));
+    double *sprinkle = malloc(sizeof(double) * 48 * 48);
+    for (int c = 0; c < 48 * 48; ++c) sprinkle[c] = 0.06 * (double)((c * 7919) % 5) / 4.0;
+    for (int size = 4; size <= 11; ++size) {
+        const int i0 = 8 + 24 * (size % 2), j0 = 8;  /* alternating places in the first tile */
+        double pile[24 * 24];
+        for (int j = 0; j < 24; ++j)
+            for (int i = 0; i < 24; ++i) pile[i + 24 * j] = fmax(0.0, 1.2 * (size - hypot(i - 11.5, j - 11.5)));
+        CHECK_OK(g, dpsm_add_heights_region(g, i0, j0, 24, 24, pile));
+        CHECK_OK(g, dpsm_step(g, 1e6)); /* to rest */
+        const double far[4] = {3.0, 2.0, 2.5, 3.5};
+        CHECK_OK(g, dpsm_add_heights_region(g, 200 + size, 30, 2, 2, far));
+        CHECK_OK(g, dpsm_step(g, 1e6)); /* sweeps only near the far tile */
+        CHECK_OK(g, dpsm_add_heights_region(g, 0, 0, 48, 48, sprinkle));
+        CHECK_OK(g, dpsm_step(g, 1e6));
+    }
+    CHECK_OK(g, dpsm_get_heights(g, h));
+    *ledger = read_ledger(g);
+    free(sprinkle);
+    dpsm_destroy(g);
+    unsetenv("DPSM_VISIT_ALL_TILES");
+    return h;
+}
+
+static void test_hysteresis_flags_survive_skipped_sweeps(void **state) {
+    (void)state;
+    ledger_t skip, all;
+    double *a = run_hysteresis_scene(0, &skip);
+    double *b = run_hysteresis_scene(1, &all);
+    size_t differ = 0;
+    for (size_t c = 0; c < 256 * 64; ++c) differ += memcmp(&a[c], &b[c], sizeof(double)) != 0;
+    assert_int_equal(differ, 0);
+    assert_memory_equal(&skip, &all, sizeof skip);
+    free(a);
+    free(b);
+}
+
 /* A surface at rest costs no cell update, however large; a few cells changed
  * by the host wake only the tiles around them. */
 static void test_idle_and_local_updates(void **state) {
@@ -218,6 +276,7 @@ int main(void) {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_active_set_changes_no_result),
         cmocka_unit_test(test_active_set_at_tile_edges),
+        cmocka_unit_test(test_hysteresis_flags_survive_skipped_sweeps),
         cmocka_unit_test(test_results_do_not_depend_on_threads),
         cmocka_unit_test(test_idle_and_local_updates),
     };
