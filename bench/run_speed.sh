@@ -3,7 +3,7 @@
 # the speed benchmarks (throughput, sparse, idle, cone, steps) into
 # docs/data/speed_*.csv and plots the throughput into docs/figures/.
 #
-#   bash bench/run_speed.sh        # about 2-3 minutes on 2 cores, on a quiet machine
+#   bash bench/run_speed.sh        # about 8 minutes on 2 cores (the steps study takes 4-5), on a quiet machine
 #
 # BUILD_DIR (default build-bench) is the build tree; PYTHON (default
 # /usr/bin/python3) runs the plot, which needs python3-matplotlib.
