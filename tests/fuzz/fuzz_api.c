@@ -19,7 +19,10 @@
  *     figure; the grid and its twin are bit-identical;
  *   - after a step without a source: no new extremum (sand, held levels of
  *     open cells, 0 beyond an open side), held cells unchanged; at rest (and
- *     not driven): no face steeper than tan(theta) (1 + tol);
+ *     not driven, without a bed, an angle field or a static angle, which
+ *     change what rest means): no face steeper than tan(theta) (1 + tol);
+ *   - with a bed: no height below it after any operation, and the height
+ *     setters refuse heights below it;
  *   - every fourth operation, when it is a step: the grid saved before it
  *     (dpsm_save) and loaded (dpsm_load) reads back bit for bit, and after the
  *     same step matches the grid bit for bit (all but the cell updates, which
@@ -99,6 +102,9 @@ static const double kAnglesBad[] = {0.0, -0.1, 1.5707963267948966, 2.0, 3.14159,
 static const double kMobilities[] = {1.0, 0.5, 2.0, 1e-6, 1e6, 1e-3, 1e3, 0.1};
 static const double kPositiveBad[] = {0.0, -0.0, -1.0, NAN, INFINITY, -INFINITY, -1e-300};
 
+static const double kExponents[] = {1.0, 1.5, 2.0, 1.25, 1.0000000001, DPSM_MAX_FLUX_EXPONENT};
+static const double kExponentsBad[] = {0.5, 0.999, 2.0000001, 3.0, 0.0, -1.0, NAN, INFINITY, -INFINITY};
+
 static const double kTolerances[] = {1e-6, 1e-9, 1e-3, 1e-15, 0.1, 1.0, 1e3, 1e-12};
 
 static const double kDtFactors[] = {1e-12, 1e-6, 0.1, 0.5, 1.0, 1.5, 2.0, 4.0, 10.0, 100.0, 1000.0, 0.999, 3.7};
@@ -157,6 +163,8 @@ typedef struct {
     int open[4];
     uint8_t *kinds;
     double *source; /* NULL: none */
+    double *bed;    /* NULL: none */
+    int angle_field, static_angle; /* set: the rest check no longer applies as written */
     double mass_scale;
 } slot_t;
 
@@ -260,6 +268,10 @@ static void check_state(slot_t *s, const snap_t *now) {
             "(%.3g relative)",
             now->mass[0], now->mass[1], now->mass[2], now->mass[3], residual, residual / scale);
     if (!(now->stable_dt > 0.0)) die("stable_dt = %g", now->stable_dt);
+    if (s->bed)
+        for (int64_t c = 0; c < s->n; ++c)
+            if (now->h[c] < s->bed[c])
+                die("height %lld is %.17g, below its bed %.17g", (long long)c, now->h[c], s->bed[c]);
     (void)gross;
 }
 
@@ -326,6 +338,7 @@ static void destroy_slot(slot_t *s) {
     dpsm_destroy(s->twin);
     free(s->kinds);
     free(s->source);
+    free(s->bed);
     memset(s, 0, sizeof *s);
 }
 
@@ -552,7 +565,10 @@ static void op_heights(reader_t *r) {
     const int planted = fill(r, h, s->n, s->nx, 0);
     const int null_array = u8(r) == 0xfe;
     const double *arg = null_array ? NULL : h;
-    const int want = null_array ? DPSM_ERR_NULL_POINTER : planted ? DPSM_ERR_INVALID_VALUE : DPSM_OK;
+    int want = null_array ? DPSM_ERR_NULL_POINTER : planted ? DPSM_ERR_INVALID_VALUE : DPSM_OK;
+    if (want == DPSM_OK && s->bed)
+        for (int64_t c = 0; c < s->n; ++c)
+            if (h[c] < s->bed[c]) want = DPSM_ERR_INVALID_VALUE;
     ON_BOTH(s, want, g_op, dpsm_set_heights(g_, arg));
     free(h);
 }
@@ -612,6 +628,9 @@ static void op_region(reader_t *r, unsigned which) {
     if (which == 0) {
         g_op = "dpsm_set_heights_region";
         if (want == DPSM_OK && planted) want = DPSM_ERR_INVALID_VALUE;
+        if (want == DPSM_OK && s->bed)
+            for (int64_t k = 0; k < m; ++k)
+                if (v[k] < s->bed[(i0 + k % ni) + s->nx * (j0 + k / ni)]) want = DPSM_ERR_INVALID_VALUE;
         ON_BOTH(s, want, g_op, dpsm_set_heights_region(g_, i0, j0, ni, nj, arg));
     } else if (which == 1) {
         g_op = "dpsm_add_heights_region";
@@ -619,8 +638,11 @@ static void op_region(reader_t *r, unsigned which) {
         if (want == DPSM_OK) { /* a sum that overflows fails too */
             snap_t now;
             snap(s->g, s, &now);
-            for (int64_t k = 0; k < m; ++k)
-                if (!isfinite(now.h[(i0 + k % ni) + s->nx * (j0 + k / ni)] + v[k])) want = DPSM_ERR_INVALID_VALUE;
+            for (int64_t k = 0; k < m; ++k) {
+                const int64_t c = (i0 + k % ni) + s->nx * (j0 + k / ni);
+                if (!isfinite(now.h[c] + v[k])) want = DPSM_ERR_INVALID_VALUE;
+                if (s->bed && now.h[c] + v[k] < s->bed[c]) want = DPSM_ERR_INVALID_VALUE;
+            }
             unsnap(&now);
         }
         ON_BOTH(s, want, g_op, dpsm_add_heights_region(g_, i0, j0, ni, nj, arg));
@@ -790,7 +812,7 @@ static void op_step(reader_t *r) {
     }
     const double at_rest = after.info[DPSM_INFO_AT_REST];
     if (at_rest != 0.0 && at_rest != 1.0) die("AT_REST = %g", at_rest);
-    if (at_rest == 1.0 && !drives) {
+    if (at_rest == 1.0 && !drives && !s->bed && !s->angle_field && !s->static_angle) {
         const double excess = rest_excess(s, after.h);
         if (excess > 1e-12) die("reported at rest with a face steeper than tan(theta)(1+tol) by %.3g", excess);
     }
@@ -807,6 +829,87 @@ static void op_step(reader_t *r) {
     }
     unsnap(&after);
     unsnap(&before);
+}
+
+/* The physics of real scenes: a bed under the sand, an angle of repose per
+ * cell, the flux exponent, the static angle. */
+static void op_physics(reader_t *r) {
+    slot_t *s = pick_slot(r);
+    if (!s) return;
+    const unsigned which = u8(r);
+    switch (which % 4) {
+        case 0: {
+            g_op = "dpsm_set_bedrock";
+            const unsigned mode = u8(r);
+            if (mode % 4 == 0) {
+                ON_BOTH(s, DPSM_OK, g_op, dpsm_set_bedrock(g_, NULL));
+                free(s->bed);
+                s->bed = NULL;
+                break;
+            }
+            /* A bed some depth below the surface, or (planted) one cell above it. */
+            double *zb = malloc(sizeof(double) * (size_t)s->n);
+            if (!zb) die("out of memory");
+            const int planted = fill(r, zb, s->n, s->nx, 0);
+            snap_t now;
+            snap(s->g, s, &now);
+            int want = planted ? DPSM_ERR_INVALID_VALUE : DPSM_OK;
+            for (int64_t c = 0; c < s->n; ++c) zb[c] = now.h[c] - fabs(zb[c]);
+            if ((mode & 0xc0) == 0x40) {
+                const int64_t c = (int64_t)(u16(r) % (unsigned)s->n);
+                if (isfinite(zb[c])) zb[c] = now.h[c] + 0.5 * fabs(now.h[c]) + 1e-3;
+                want = DPSM_ERR_INVALID_VALUE;
+            }
+            for (int64_t c = 0; c < s->n; ++c)
+                if (!(fabs(zb[c]) <= 1e50)) want = DPSM_ERR_INVALID_VALUE;
+            unsnap(&now);
+            ON_BOTH(s, want, g_op, dpsm_set_bedrock(g_, zb));
+            if (want == DPSM_OK) {
+                free(s->bed);
+                s->bed = zb;
+                zb = NULL;
+            }
+            free(zb);
+            break;
+        }
+        case 1: {
+            g_op = "dpsm_set_repose_angle_field";
+            const unsigned mode = u8(r);
+            if (mode % 4 == 0) {
+                ON_BOTH(s, DPSM_OK, g_op, dpsm_set_repose_angle_field(g_, NULL));
+                s->angle_field = 0;
+                break;
+            }
+            double *theta = malloc(sizeof(double) * (size_t)s->n);
+            if (!theta) die("out of memory");
+            const double a = kAngles[u8(r) % COUNT(kAngles)], b = kAngles[u8(r) % COUNT(kAngles)];
+            for (int64_t c = 0; c < s->n; ++c) theta[c] = (c % s->nx) * 2 < s->nx ? a : b;
+            int want = DPSM_OK;
+            if ((mode & 0xc0) == 0x40) {
+                theta[u16(r) % (unsigned)s->n] = kAnglesBad[u8(r) % COUNT(kAnglesBad)];
+                want = DPSM_ERR_INVALID_VALUE;
+            }
+            ON_BOTH(s, want, g_op, dpsm_set_repose_angle_field(g_, theta));
+            if (want == DPSM_OK) s->angle_field = 1;
+            free(theta);
+            break;
+        }
+        case 2: {
+            g_op = "dpsm_set_flux_exponent";
+            const double p = pick(r, kExponents, COUNT(kExponents), kExponentsBad, COUNT(kExponentsBad));
+            const int ok = p >= 1.0 && p <= DPSM_MAX_FLUX_EXPONENT;
+            ON_BOTH(s, ok ? DPSM_OK : DPSM_ERR_INVALID_VALUE, g_op, dpsm_set_flux_exponent(g_, p));
+            break;
+        }
+        default: {
+            g_op = "dpsm_set_static_angle";
+            const double v = pick(r, kAngles, COUNT(kAngles), kAnglesBad, COUNT(kAnglesBad));
+            const int ok = isfinite(v) && v > 0.0 && v < 0.5 * 3.14159265358979323846;
+            ON_BOTH(s, ok ? DPSM_OK : DPSM_ERR_INVALID_VALUE, g_op, dpsm_set_static_angle(g_, v));
+            if (ok) s->static_angle = 1;
+            break;
+        }
+    }
 }
 
 static void op_getters(reader_t *r) {
@@ -878,7 +981,7 @@ static void op_null_grid(reader_t *r) {
     int64_t a, c;
     int st;
     const char *fn;
-    switch (b % 20) {
+    switch (b % 24) {
         case 0: st = dpsm_set_repose_angle(NULL, 0.5), fn = "dpsm_set_repose_angle"; break;
         case 1: st = dpsm_set_mobility(NULL, 1.0), fn = "dpsm_set_mobility"; break;
         case 2: st = dpsm_set_scheme(NULL, 0), fn = "dpsm_set_scheme"; break;
@@ -898,6 +1001,10 @@ static void op_null_grid(reader_t *r) {
         case 16: st = dpsm_set_rest_tolerance(NULL, 1e-6), fn = "dpsm_set_rest_tolerance"; break;
         case 17: st = dpsm_set_max_substeps(NULL, 10), fn = "dpsm_set_max_substeps"; break;
         case 18: st = dpsm_set_threads(NULL, 1), fn = "dpsm_set_threads"; break;
+        case 19: st = dpsm_set_bedrock(NULL, NULL), fn = "dpsm_set_bedrock"; break;
+        case 20: st = dpsm_set_repose_angle_field(NULL, NULL), fn = "dpsm_set_repose_angle_field"; break;
+        case 21: st = dpsm_set_flux_exponent(NULL, 1.0), fn = "dpsm_set_flux_exponent"; break;
+        case 22: st = dpsm_set_static_angle(NULL, 0.6), fn = "dpsm_set_static_angle"; break;
         default: {
             dpsm_destroy(NULL);
             const int code = (int)(int8_t)u8(r);
@@ -948,7 +1055,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
         else if (op == 22)
             op_destroy(&r);
         else
-            op_create(&r);
+            op_physics(&r);
         /* Every live grid: the state invariants and the twin. */
         for (int k = 0; k < NSLOTS; ++k) {
             slot_t *s = &g_slots[k];

@@ -14,7 +14,12 @@ OUT = os.path.join(HERE, "corpus")
 # Opcodes (first byte of an operation, taken modulo 24 by the harness).
 CREATE, ANGLE, MOBILITY, SCHEME, BOUNDARY, TOLERANCE, MAX_SUBSTEPS, THREADS = 0, 2, 3, 4, 5, 6, 7, 8
 KINDS, HEIGHTS, SET_REGION, ADD_REGION, GET_REGION, SOURCE, STEP = 9, 10, 12, 13, 14, 15, 16
-GETTERS, NULL_GRID, DESTROY = 20, 21, 22
+GETTERS, NULL_GRID, DESTROY, PHYSICS = 20, 21, 22, 23
+# PHYSICS, slot, which (0 bed, 1 angle field, 2 flux exponent, 3 static angle), then:
+#   bed: mode (0 removes; else a fill pattern of depths below the surface follows;
+#        mode 0x40 + a u16 cell plants one cell above its height)
+#   angle field: mode (0 removes), two kAngles indices (west half, east half)
+#   exponent: kExponents index {1, 1.5, 2, 1.25, 1+1e-10, 2}; static angle: kAngles index
 GEOM = {"1d": 0, "2d": 1, "axi": 2}
 # kSpacings = {1.0, 0.5, 2.0, 0.1, 10.0, 0.25, 3.0, 1e-3, 1e3, 0.37}
 SPACING = {1.0: 0, 0.5: 1, 2.0: 2, 0.1: 3, 10.0: 4, 0.25: 5, 3.0: 6, 1e-3: 7, 1e3: 8, 0.37: 9}
@@ -175,13 +180,31 @@ seed("tiny_dt", create(0, "2d", 5, 5), heights(0, 2, 10.0, 0.0), step_abs(0, 1e-
 seed("negative_below_open", create(0, "1d", 9), all_open(0, "1d"), heights(0, 0, -1e3, 0.0), step(0, 1000.0),
      create(1, "2d", 6, 6), all_open(1, "2d"), heights(1, 1, -3.0, -1.0), step(1, 1000.0))
 
+# The physics of issue 8: a bed under the sand (eroded, refilled, removed), an
+# angle field with a static angle and a flux exponent, and each setter's bad values.
+for geom in ("1d", "axi", "2d"):
+    seed(f"physics_bed_{geom}", create(0, geom, 9, 9), heights(0, 2, 10.0, 1.0),
+         [PHYSICS, 0, 0, 1] + fill(0, H[1.0], H[0.0]), step(0, 10.0), source(0, 0, -0.1, 0.0),
+         step(0, 100.0), step(0, 1000.0), heights(0, 0, -3.0, 0.0), source(0, 0, 0.1, 0.0), step(0, 10.0),
+         [PHYSICS, 0, 0, 0], step(0, 10.0))
+seed("physics_field_static_2d", create(0, "2d", 9, 9), heights(0, 3, 0.0, 1.0),
+     [PHYSICS, 0, 1, 1, 0, 7], [PHYSICS, 0, 3, 9], [PHYSICS, 0, 2, 1], step(0, 10.0), step(0, 1000.0),
+     [PHYSICS, 0, 3, 0], heights(0, 3, 0.0, 2.0), step(0, 1000.0), [PHYSICS, 0, 1, 0], [PHYSICS, 0, 2, 2],
+     step(0, 1000.0))
+seed("physics_bad_2d", create(0, "2d", 6, 6), heights(0, 0, 3.0, 0.0),
+     [PHYSICS, 0, 0, 0x41] + fill(0, H[0.5], H[0.0]) + [5, 0], [PHYSICS, 0, 0, 1] + fill(0, H[1.0], H[0.0], plant=7),
+     [PHYSICS, 0, 1, 0x41, 0, 0, 3, 0, 3], [PHYSICS, 0, 2, 0x83], [PHYSICS, 0, 2, 0x80], [PHYSICS, 0, 3, 0x85],
+     [NULL_GRID, 19], [NULL_GRID, 20], [NULL_GRID, 21], [NULL_GRID, 22], step(0, 10.0))
+
 rng = random.Random(20240611)
 for k in range(8):
     SEEDS[f"random_{k}"] = bytes(rng.randrange(256) for _ in range(rng.choice((16, 40, 100, 300))))
 
 os.makedirs(OUT, exist_ok=True)
+# Inputs the fuzzer found (regression_*) are kept; the seeds are written anew.
 for name in os.listdir(OUT):
-    os.remove(os.path.join(OUT, name))
+    if not name.startswith("regression_"):
+        os.remove(os.path.join(OUT, name))
 for name, data in sorted(SEEDS.items()):
     with open(os.path.join(OUT, name), "wb") as f:
         f.write(data)
