@@ -12,6 +12,10 @@
  *  - the limit of backward Euler as dt -> infinity, the L2 projection of the
  *    surface onto the surfaces whose every face is no steeper than the angle
  *    of repose, solved by FISTA on its dual (a first-order solver),
+ *  - the same projection by Newton's method on a penalty (tau/2) sum
+ *    (|g_f| - tan(theta))_+^2, tau raised a thousandfold per stage from 1,
+ *    each Newton step solved by conjugate gradients without a
+ *    preconditioner, with a backtracking line search,
  *  - nested iteration from coarser grids (1 and 2 levels): rest on a grid of
  *    cells twice as wide first, its change added to the finer surface, then
  *    the explicit sub-steps there ("sweeps" in sub-steps of the finest grid),
@@ -369,6 +373,178 @@ static int64_t project_to_rest(double *h, int64_t n, double dx, double theta, do
     return it;
 }
 
+/* Newton's method for the projection, on the penalty
+ * F(h) = 1/2 |h - h0|^2 + tau/2 sum_f (|g_f| - tan(theta))_+^2, whose
+ * minimiser tends to the projection as tau grows: stages of tau = 1, 1e3,
+ * 1e6, ... until no face exceeds the rest threshold; in each, Newton steps
+ * (conjugate gradients on the Hessian I + tau G^T D G to a relative residual
+ * of 0.1, a backtracking line search) until the gradient has fallen by 1e3.
+ * Returns the Hessian and gradient evaluations (each one application of G and
+ * one of G^T, like a sweep). */
+typedef struct {
+    face_grid f;
+    int64_t cells, faces;
+    double alpha, tau;
+    const double *h0;
+    double *g[2][2], *p[2][2];          /* face gradients, face work */
+    double *unit[2][2], *weight[2];     /* per active face: g / |g|, (|g| - alpha) / |g| */
+    uint8_t *active[2];
+} penalty;
+
+static void penalty_gradients(penalty *w, const double *h) {
+    double *gn[2] = {w->g[0][0], w->g[1][0]}, *gt[2] = {w->g[0][1], w->g[1][1]};
+    face_gradients(&w->f, h, gn, gt);
+}
+
+static double penalty_value(penalty *w, const double *h) {
+    penalty_gradients(w, h);
+    double value = 0.0;
+    for (int64_t c = 0; c < w->cells; ++c) value += 0.5 * (h[c] - w->h0[c]) * (h[c] - w->h0[c]);
+    for (int d = 0; d < 2; ++d)
+        for (int64_t e = 0; e < w->faces; ++e) {
+            const double m = hypot(w->g[d][0][e], w->g[d][1][e]);
+            if (m > w->alpha) value += 0.5 * w->tau * (m - w->alpha) * (m - w->alpha);
+        }
+    return value;
+}
+
+/* out = grad F(h); remembers the active faces and their D for the Hessian. */
+static void penalty_gradient(penalty *w, const double *h, double *out) {
+    penalty_gradients(w, h);
+    for (int d = 0; d < 2; ++d)
+        for (int64_t e = 0; e < w->faces; ++e) {
+            const double gn = w->g[d][0][e], gt = w->g[d][1][e], m = hypot(gn, gt);
+            w->active[d][e] = m > w->alpha;
+            if (w->active[d][e]) {
+                const double k = w->tau * (m - w->alpha) / m;
+                w->p[d][0][e] = k * gn;
+                w->p[d][1][e] = k * gt;
+                w->unit[d][0][e] = gn / m;
+                w->unit[d][1][e] = gt / m;
+                w->weight[d][e] = (m - w->alpha) / m;
+            } else {
+                w->p[d][0][e] = w->p[d][1][e] = 0.0;
+            }
+        }
+    double *pn[2] = {w->p[0][0], w->p[1][0]}, *pt[2] = {w->p[0][1], w->p[1][1]};
+    face_gradients_transposed(&w->f, pn, pt, out);
+    for (int64_t c = 0; c < w->cells; ++c) out[c] += h[c] - w->h0[c];
+}
+
+/* out = (I + tau G^T D G) v, D = u u^T + weight (I - u u^T) on active faces. */
+static void penalty_hessian(penalty *w, const double *v, double *out) {
+    penalty_gradients(w, v);
+    for (int d = 0; d < 2; ++d)
+        for (int64_t e = 0; e < w->faces; ++e) {
+            if (!w->active[d][e]) {
+                w->p[d][0][e] = w->p[d][1][e] = 0.0;
+                continue;
+            }
+            const double a = w->unit[d][0][e], b = w->unit[d][1][e], gn = w->g[d][0][e], gt = w->g[d][1][e];
+            const double along = a * gn + b * gt, k = w->weight[d][e];
+            w->p[d][0][e] = w->tau * (along * a + k * (gn - along * a));
+            w->p[d][1][e] = w->tau * (along * b + k * (gt - along * b));
+        }
+    double *pn[2] = {w->p[0][0], w->p[1][0]}, *pt[2] = {w->p[0][1], w->p[1][1]};
+    face_gradients_transposed(&w->f, pn, pt, out);
+    for (int64_t c = 0; c < w->cells; ++c) out[c] += v[c];
+}
+
+static int64_t newton_to_rest(double *h, int64_t n, double dx, double theta, double tolerance, int *at_rest) {
+    penalty w;
+    w.f.n = n;
+    w.f.dx = dx;
+    w.cells = n * n;
+    w.faces = (n + 1) * n;
+    w.alpha = tan(theta);
+    const size_t cells = (size_t)w.cells, faces = (size_t)w.faces;
+    double *h0 = xcalloc(cells, sizeof(double));
+    memcpy(h0, h, sizeof(double) * cells);
+    w.h0 = h0;
+    for (int d = 0; d < 2; ++d) {
+        for (int c = 0; c < 2; ++c) {
+            w.g[d][c] = xcalloc(faces, sizeof(double));
+            w.p[d][c] = xcalloc(faces, sizeof(double));
+            w.unit[d][c] = xcalloc(faces, sizeof(double));
+        }
+        w.weight[d] = xcalloc(faces, sizeof(double));
+        w.active[d] = xcalloc(faces, 1);
+    }
+    double *grad = xcalloc(cells, sizeof(double)), *step = xcalloc(cells, sizeof(double));
+    double *res = xcalloc(cells, sizeof(double)), *dir = xcalloc(cells, sizeof(double));
+    double *hd = xcalloc(cells, sizeof(double)), *trial = xcalloc(cells, sizeof(double));
+    const double threshold = w.alpha * (1.0 + tolerance);
+    int64_t evaluations = 0;
+    *at_rest = 0;
+    for (w.tau = 1.0; w.tau < 1e16 && !*at_rest; w.tau *= 1e3) {
+        double first = -1.0;
+        for (int k = 0; k < 30; ++k) {
+            penalty_gradient(&w, h, grad);
+            ++evaluations;
+            double norm = 0.0;
+            for (size_t c = 0; c < cells; ++c) norm += grad[c] * grad[c];
+            norm = sqrt(norm);
+            if (first < 0.0) first = norm;
+            if (norm <= 1e-3 * first) break;
+            /* Conjugate gradients on H step = -grad, to a relative residual of 0.1. */
+            double rr = 0.0;
+            for (size_t c = 0; c < cells; ++c) {
+                step[c] = 0.0;
+                res[c] = dir[c] = -grad[c];
+                rr += res[c] * res[c];
+            }
+            const double rr0 = rr;
+            for (int it = 0; it < 5000 && rr > 1e-2 * rr0; ++it) {
+                penalty_hessian(&w, dir, hd);
+                ++evaluations;
+                double curvature = 0.0;
+                for (size_t c = 0; c < cells; ++c) curvature += dir[c] * hd[c];
+                const double a = rr / curvature;
+                double next = 0.0;
+                for (size_t c = 0; c < cells; ++c) {
+                    step[c] += a * dir[c];
+                    res[c] -= a * hd[c];
+                    next += res[c] * res[c];
+                }
+                for (size_t c = 0; c < cells; ++c) dir[c] = res[c] + (next / rr) * dir[c];
+                rr = next;
+            }
+            /* Backtracking (Armijo) on F; F was left at the Hessian's gradients, so evaluate afresh. */
+            const double f0 = penalty_value(&w, h);
+            double slope = 0.0, t = 1.0;
+            for (size_t c = 0; c < cells; ++c) slope += grad[c] * step[c];
+            for (int ls = 0; ls < 40; ++ls, t *= 0.5) {
+                for (size_t c = 0; c < cells; ++c) trial[c] = h[c] + t * step[c];
+                ++evaluations;
+                if (penalty_value(&w, trial) <= f0 + 1e-4 * t * slope) break;
+            }
+            memcpy(h, trial, sizeof(double) * cells);
+        }
+        penalty_gradients(&w, h);
+        double worst = 0.0;
+        for (int d = 0; d < 2; ++d)
+            for (int64_t e = 0; e < w.faces; ++e) worst = fmax(worst, hypot(w.g[d][0][e], w.g[d][1][e]));
+        *at_rest = worst <= threshold;
+    }
+    for (int d = 0; d < 2; ++d) {
+        for (int c = 0; c < 2; ++c) {
+            free(w.g[d][c]);
+            free(w.p[d][c]);
+            free(w.unit[d][c]);
+        }
+        free(w.weight[d]);
+        free(w.active[d]);
+    }
+    free(h0);
+    free(grad);
+    free(step);
+    free(res);
+    free(dir);
+    free(hd);
+    free(trial);
+    return evaluations;
+}
+
 /* Explicit sub-steps of the reference loop on h (n x n, open sides) until
  * rest; adds the work, in cells, to *cell_updates. */
 static void explicit_rest(double *h, int64_t n, double dx, double theta, double tolerance, double *cell_updates) {
@@ -512,6 +688,10 @@ int cmd_steps(int argc, char **argv) {
             t0 = now_seconds();
             const int64_t iterations = project_to_rest(h, n, sc->dx, sc->theta, tol, 5000, &at_rest);
             report(sc, "projection", tol, now_seconds() - t0, (double)iterations, h, v0, at_rest);
+            memcpy(h, h0, sizeof(double) * (size_t)cells);
+            t0 = now_seconds();
+            const int64_t newton = newton_to_rest(h, n, sc->dx, sc->theta, tol, &at_rest);
+            report(sc, "projection-newton", tol, now_seconds() - t0, (double)newton, h, v0, at_rest);
         }
         free(h0);
         free(h);
