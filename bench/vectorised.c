@@ -68,34 +68,28 @@ static void fill_frame(vgrid *g) {
     }
 }
 
-static void substeps_generic(vgrid *g, int substeps, int threads) {
-    (void)threads;
-    for (int s = 0; s < substeps; ++s) {
-        fill_frame(g);
-#pragma omp parallel for num_threads(threads) schedule(static)
-        for (int64_t j = 1; j <= g->n; ++j) row_fluxes(g, j);
-#pragma omp parallel for num_threads(threads) schedule(static)
-        for (int64_t j = 1; j <= g->n; ++j) row_update(g, j);
-        double *t = g->h;
-        g->h = g->next;
-        g->next = t;
+/* The sub-steps, defined twice, once built for AVX-512: OpenMP outlines the
+ * parallel regions before the compiler inlines, so a body shared by an inline
+ * function would not be built with the target attribute. */
+#define DEFINE_SUBSTEPS(name, attributes)                                  \
+    attributes static void name(vgrid *g, int substeps, int threads) {     \
+        (void)threads;                                                     \
+        for (int s = 0; s < substeps; ++s) {                               \
+            fill_frame(g);                                                 \
+            _Pragma("omp parallel for num_threads(threads) schedule(static)") \
+            for (int64_t j = 1; j <= g->n; ++j) row_fluxes(g, j);          \
+            _Pragma("omp parallel for num_threads(threads) schedule(static)") \
+            for (int64_t j = 1; j <= g->n; ++j) row_update(g, j);          \
+            double *t = g->h;                                              \
+            g->h = g->next;                                                \
+            g->next = t;                                                   \
+        }                                                                  \
     }
-}
+
+DEFINE_SUBSTEPS(substeps_generic, )
 
 #if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
-__attribute__((target("avx512f,avx512dq,fma"))) static void substeps_avx512(vgrid *g, int substeps, int threads) {
-    (void)threads;
-    for (int s = 0; s < substeps; ++s) {
-        fill_frame(g);
-#pragma omp parallel for num_threads(threads) schedule(static)
-        for (int64_t j = 1; j <= g->n; ++j) row_fluxes(g, j);
-#pragma omp parallel for num_threads(threads) schedule(static)
-        for (int64_t j = 1; j <= g->n; ++j) row_update(g, j);
-        double *t = g->h;
-        g->h = g->next;
-        g->next = t;
-    }
-}
+DEFINE_SUBSTEPS(substeps_avx512, __attribute__((target("avx512f,avx512dq,fma"))))
 static int has_avx512(void) {
     __builtin_cpu_init();
     return __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512dq");

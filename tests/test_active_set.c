@@ -18,6 +18,15 @@
 
 enum { NX = 260, NY = 140 };
 
+/* DPSM_VISIT_ALL_TILES=1 makes the library visit every tile whole: the
+ * reference the active set is compared with. */
+static void visit_all_tiles(int on) {
+    if (on)
+        setenv("DPSM_VISIT_ALL_TILES", "1", 1);
+    else
+        unsetenv("DPSM_VISIT_ALL_TILES");
+}
+
 /* A scene that uses everything: a resting rough bed, three steep patches far
  * apart, a source patch, an obstacle, an open cell and two open sides. */
 static dpsm_grid *make_scene(int scheme, int threads) {
@@ -53,10 +62,7 @@ static dpsm_grid *make_scene(int scheme, int threads) {
 /* Runs the scene: steps, then the source off and a region edit, then rest.
  * Returns the heights (caller frees) and the ledger and the work done. */
 static double *run_scene(int scheme, int threads, int visit_all, ledger_t *ledger, double *updates) {
-    if (visit_all)
-        setenv("DPSM_VISIT_ALL_TILES", "1", 1);
-    else
-        unsetenv("DPSM_VISIT_ALL_TILES");
+    visit_all_tiles(visit_all);
     dpsm_grid *g = make_scene(scheme, threads);
     double u, dt;
     *updates = 0.0;
@@ -77,7 +83,7 @@ static double *run_scene(int scheme, int threads, int visit_all, ledger_t *ledge
     *ledger = read_ledger(g);
     assert_true(ledger_residual(g) < 1e-13);
     dpsm_destroy(g);
-    unsetenv("DPSM_VISIT_ALL_TILES");
+    visit_all_tiles(0);
     return h;
 }
 
@@ -128,10 +134,7 @@ static void test_results_do_not_depend_on_threads(void **state) {
  * host edits next to one, stepped in sweeps of 1 to 4 sub-steps. The heights
  * and ledger must match visiting every tile, bit for bit. */
 static double *run_tile_edge_scene(int scheme, int visit_all, ledger_t *ledger) {
-    if (visit_all)
-        setenv("DPSM_VISIT_ALL_TILES", "1", 1);
-    else
-        unsetenv("DPSM_VISIT_ALL_TILES");
+    visit_all_tiles(visit_all);
     enum { N = 200 };
     dpsm_grid *g = NULL;
     CHECK_OK(NULL, dpsm_create_2d(N, N, 1.0, 1.0, &g));
@@ -159,7 +162,7 @@ static double *run_tile_edge_scene(int scheme, int visit_all, ledger_t *ledger) 
     *ledger = read_ledger(g);
     dpsm_destroy(g);
     free(q);
-    unsetenv("DPSM_VISIT_ALL_TILES");
+    visit_all_tiles(0);
     return h;
 }
 
@@ -187,10 +190,7 @@ static void test_active_set_at_tile_edges(void **state) {
  * piles: faces between the angles of repose and static move only next to a
  * moving cell, so a stale flag would change the result. */
 static double *run_hysteresis_scene(int visit_all, ledger_t *ledger) {
-    if (visit_all)
-        setenv("DPSM_VISIT_ALL_TILES", "1", 1);
-    else
-        unsetenv("DPSM_VISIT_ALL_TILES");
+    visit_all_tiles(visit_all);
     enum { W = 256, H = 64 };
     dpsm_grid *g = NULL;
     CHECK_OK(NULL, dpsm_create_2d(W, H, 1.0, 1.0, &g));
@@ -219,7 +219,7 @@ static double *run_hysteresis_scene(int visit_all, ledger_t *ledger) {
     *ledger = read_ledger(g);
     free(sprinkle);
     dpsm_destroy(g);
-    unsetenv("DPSM_VISIT_ALL_TILES");
+    visit_all_tiles(0);
     return h;
 }
 
