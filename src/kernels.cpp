@@ -128,7 +128,7 @@ private:
         const Geometry &geo = grid.geometry();
         available_.assign(n, 0.0);
         const double film = bed_film(grid);
-        CompensatedSum unmet;
+        CompensatedSum unmet, sourced;
         for (std::size_t c = 0; c < n; ++c) {
             if (kind_[c] != kSand) continue;
             double sand = std::max(0.0, h_[c] - zb[c]);
@@ -139,10 +139,12 @@ private:
                 unmet.add((applied - asked) * geo.cell_area(static_cast<std::int64_t>(c)));
                 sand += applied;
             }
+            sourced.add(applied * geo.cell_area(static_cast<std::int64_t>(c)));
             rate_[c] += applied / dt_;
             available_[c] = sand > film ? sand : 0.0;
         }
         result.unmet_mass = unmet.value();
+        result.sourced_mass = sourced.value();
     }
 
     static constexpr double kFaces = 2.0;  // faces of a cell on a line or a radius

@@ -18,6 +18,7 @@ struct SweepResult {
     double max_excess_slope = 0.0;  // max over faces that carried sand of |slope| - tan(theta)
     double outflow_rate = 0.0;      // mass per unit time leaving through open sides and cells
     double unmet_mass = 0.0;        // erosion asked for in this sub-step where no sand lay above the bed
+    double sourced_mass = 0.0;      // with a bed: what the source put on (or took from) the sand
 };
 
 // Fills the grid's rate workspace with dh/dt from the slide fluxes for every

@@ -87,18 +87,22 @@ void step(Grid &grid, double dt) {
     // Books one sub-step; false once the surface is found at rest (nothing
     // moved and no source acts: no later sub-step can change anything).
     StepInfo info;
-    auto book = [&](bool moved, double outflow_rate, double max_excess, double unmet_mass) {
+    // With a bed, erosion takes at most the sand there, so the source booked is
+    // what the sweep applied, cell by cell: the rate asked for less the unmet
+    // part would cancel two large figures when erosion asks far more than lies there.
+    const bool source_capped = source_active && !grid.bed().empty();
+    auto book = [&](bool moved, double outflow_rate, double max_excess, double unmet_mass, double sourced_mass) {
         info.max_excess_slope = max_excess;
         if (!moved && !source_active) {
             info.at_rest = true;
             return false;
         }
         ledger.outflow.add(outflow_rate * sub_dt);
-        if (source_active) ledger.sourced.add(grid.source_mass_rate() * sub_dt);
-        if (unmet_mass != 0.0) {  // erosion that found no sand above the bed was not applied
-            ledger.sourced.add(unmet_mass);
-            ledger.unmet.add(unmet_mass);
-        }
+        if (source_capped)
+            ledger.sourced.add(sourced_mass);
+        else if (source_active)
+            ledger.sourced.add(grid.source_mass_rate() * sub_dt);
+        if (unmet_mass != 0.0) ledger.unmet.add(unmet_mass);  // erosion that found no sand above the bed
         ++info.substeps;
         return true;
     };
@@ -113,7 +117,8 @@ void step(Grid &grid, double dt) {
                 const int count = static_cast<int>(std::min<std::int64_t>(ActiveSet::kMaxLevels, substeps - k));
                 const double visited = static_cast<double>(tiled_sweep(grid, count, sub_dt, levels));
                 for (const LevelSummary &level : levels) {
-                    if (!book(level.moved, level.outflow_rate, level.max_excess, level.unmet_mass)) break;
+                    if (!book(level.moved, level.outflow_rate, level.max_excess, level.unmet_mass, level.sourced_mass))
+                        break;
                     info.cell_updates += visited;
                 }
             }
@@ -121,7 +126,8 @@ void step(Grid &grid, double dt) {
     } else {
         for (std::int64_t k = 0; k < substeps; ++k) {
             const SweepResult sweep = slide_rates_1d(grid, sub_dt);
-            if (!book(sweep.moved, sweep.outflow_rate, sweep.max_excess_slope, sweep.unmet_mass)) break;
+            if (!book(sweep.moved, sweep.outflow_rate, sweep.max_excess_slope, sweep.unmet_mass, sweep.sourced_mass))
+                break;
             apply_rates(grid, sub_dt);
             info.cell_updates += static_cast<double>(grid.geometry().cells());
         }

@@ -40,6 +40,7 @@ struct TileLevelStats {
     double max_excess = 0.0;    // largest |grad h| - tan(theta) over faces that carried sand
     double outflow_rate = 0.0;  // mass per unit time into sinks from the tile's sand cells
     double unmet_mass = 0.0;    // erosion asked for on the tile's cells where no sand lay above the bed
+    double sourced_mass = 0.0;  // with a bed: what the source put on (or took from) the tile's cells
     int hot_r0 = 1 << 30, hot_r1 = -1, hot_c0 = 1 << 30, hot_c1 = -1;  // cells of the tile touching moving faces
 };
 

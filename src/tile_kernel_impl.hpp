@@ -81,7 +81,10 @@ void advance_tile_level(TileBuffers &b, int in, const TileRect &reg, const TileR
         const V r1 = rsqrt(max(u, threshold2));
         const V r2 = rsqrt_fast(one + u);
         const V flux = select(hot, nu * gn * (one - tan_theta * r1) * r2, zero);
-        steepest2 = max(steepest2, select(hot, u, zero));
+        // Only faces that carry sand count: a face that is steep only across
+        // its normal (gn = 0) carries none, and a tile at rest is not visited,
+        // so counting it would make the figure depend on the active set.
+        steepest2 = max(steepest2, select(flux != zero, u, zero));
         store(flux_out, flux, m);
     };
     // Central differences along x of row r, for the faces across it.

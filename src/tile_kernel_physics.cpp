@@ -160,7 +160,10 @@ void advance_tile_level_physics(TileBuffers &b, int in, const TileRect &reg, con
             if (kind[c + W] == kOpen) rate += north * p.y_face_length;
             if (kind[c - W] == kOpen) rate -= south * p.y_face_length;
             st.outflow_rate += rate;
-            if (Source && p.bed && q[c] < 0.0) st.unmet_mass += (applied[c] - q[c] * p.dt) * p.cell_area;
+            if (Source && p.bed) {
+                st.sourced_mass += applied[c] * p.cell_area;
+                if (q[c] < 0.0) st.unmet_mass += (applied[c] - q[c] * p.dt) * p.cell_area;
+            }
         }
     }
     st.moved = st.moved || moved;

@@ -418,6 +418,7 @@ std::int64_t tiled_sweep(Grid &grid, int levels, double dt, std::vector<LevelSum
             sum.moved = sum.moved || st.moved;
             sum.outflow_rate += st.outflow_rate;
             sum.unmet_mass += st.unmet_mass;
+            sum.sourced_mass += st.sourced_mass;
             sum.max_excess = std::max(sum.max_excess, st.max_excess);
             if (st.hot_r0 < st.hot_r1)
                 moved.add(ws.origin[2 * k] + st.hot_c0 - 1, ws.origin[2 * k] + st.hot_c1 + 1,

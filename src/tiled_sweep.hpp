@@ -20,6 +20,7 @@ struct LevelSummary {
     double outflow_rate = 0.0;  // mass per unit time into sinks
     double max_excess = 0.0;    // largest |grad h| - tan(theta) over faces that carried sand
     double unmet_mass = 0.0;    // erosion asked for where no sand lay above the bed
+    double sourced_mass = 0.0;  // with a bed: what the source put on (or took from) the sand
 };
 
 // Scratch of the 2D sweep, kept by the grid between steps. A sweep writes

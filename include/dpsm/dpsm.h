@@ -159,9 +159,11 @@ typedef struct dpsm_grid dpsm_grid;
  *  do), 0 if it integrated all of `dt`; a surface that came to rest in the last
  *  sub-step reads 0 here, and the next step returns at once with 1. */
 #define DPSM_INFO_AT_REST 2
-/** The largest slope excess `|grad h| - tan(theta)` over all faces, measured
- *  at the start of its last sub-step, or when it found rest (0 when no face is
- *  steeper than the angle of repose). */
+/** The largest slope excess `|grad h| - tan(theta)` over the faces that
+ *  carried sand in its last sub-step, measured at the start of that sub-step:
+ *  how far from rest the surface still was. 0 when the step found the surface
+ *  at rest, since then no face carried sand (a face steep only across its
+ *  normal, or held by hysteresis or a bare bed, carries none). */
 #define DPSM_INFO_MAX_EXCESS_SLOPE 3
 /** The cell updates it computed: cells visited times sub-steps. On 2D grids
  *  only the tiles of 64 x 64 cells near moving sand or a source are visited, so

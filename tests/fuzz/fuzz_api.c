@@ -822,6 +822,9 @@ static void op_step(reader_t *r) {
     if (at_rest == 0.0 && after.info[DPSM_INFO_TIME_INTEGRATED] != dt)
         die("TIME_INTEGRATED = %.17g, dt = %.17g, not at rest", after.info[DPSM_INFO_TIME_INTEGRATED], dt);
     if (!(after.info[DPSM_INFO_MAX_EXCESS_SLOPE] >= 0.0)) die("MAX_EXCESS_SLOPE = %g", after.info[DPSM_INFO_MAX_EXCESS_SLOPE]);
+    /* Found at rest: no face carried sand in the sub-step that found it. */
+    if (at_rest == 1.0 && after.info[DPSM_INFO_MAX_EXCESS_SLOPE] != 0.0)
+        die("MAX_EXCESS_SLOPE = %.17g at rest", after.info[DPSM_INFO_MAX_EXCESS_SLOPE]);
     compare_twin(s, &after);
     if (restored) {
         check_restart_continues(s, restored, dt, &after);
