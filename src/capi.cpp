@@ -11,6 +11,7 @@
 #include <string>
 #include <utility>
 
+#include "decomposition.hpp"
 #include "dpsm/dpsm.h"
 #include "error.hpp"
 #include "limits.hpp"
@@ -346,6 +347,16 @@ int dpsm_step(dpsm_grid *g, double dt) {
     const char *fn = "dpsm_step";
     return guarded(g, fn, [&] {
         require_grid(g, fn);
+        dpsm::Decomposition *decomposition = g->core.decomposition();
+        if (decomposition && !(std::isfinite(dt) && dt > 0.0)) {
+            // The other ranks wait in the step's first agreement: take part,
+            // refusing, so that they fail too instead of waiting for ever.
+            try {
+                decomposition->agree_before_step(g->core, 0.0, true);
+            } catch (const dpsm::Error &) {
+                // every rank throws; this one reports its own reason below
+            }
+        }
         require_positive(dt, fn, "dt");
         dpsm::step(g->core, dt);
     });
@@ -355,21 +366,34 @@ int dpsm_get_mass(const dpsm_grid *g, int quantity, double *value) {
     const char *fn = "dpsm_get_mass";
     return guarded(g, fn, [&] {
         require_grid(g, fn);
-        require_pointer(value, fn, "value");
         const dpsm::MassLedger &ledger = g->core.ledger();
         double local = 0.0;
+        bool known = true;
         switch (quantity) {
             case DPSM_MASS_TOTAL: local = g->core.total_mass(); break;
             case DPSM_MASS_SOURCED: local = ledger.sourced.value(); break;
             case DPSM_MASS_EXTERNAL: local = ledger.external.value(); break;
             case DPSM_MASS_OUTFLOW: local = ledger.outflow.value(); break;
             case DPSM_MASS_UNMET: local = ledger.unmet.value(); break;
-            default:
-                fail(DPSM_ERR_UNKNOWN_ENUM, fn, "quantity = ", quantity,
-                     " is not DPSM_MASS_TOTAL, DPSM_MASS_SOURCED, DPSM_MASS_EXTERNAL, DPSM_MASS_OUTFLOW"
-                     " or DPSM_MASS_UNMET");
+            default: known = false;
         }
-        *value = g->core.global_sum(local);  // a distributed grid's figure is global
+        const bool refused = !value || !known;
+        double total = local;
+        // A distributed grid's figure is global. Every rank takes part in the
+        // sum, a refusing one too, so that none waits for ever.
+        bool all_agreed = true;
+        if (dpsm::Decomposition *decomposition = g->core.decomposition())
+            all_agreed = decomposition->sum_unless_refused(local, refused, total);
+        require_pointer(value, fn, "value");
+        if (!known)
+            fail(DPSM_ERR_UNKNOWN_ENUM, fn, "quantity = ", quantity,
+                 " is not DPSM_MASS_TOTAL, DPSM_MASS_SOURCED, DPSM_MASS_EXTERNAL, DPSM_MASS_OUTFLOW"
+                 " or DPSM_MASS_UNMET");
+        if (!all_agreed)
+            fail(DPSM_ERR_INVALID_VALUE, fn,
+                 "another rank of the distributed grid refused its arguments (a NULL value or an unknown quantity), "
+                 "so no rank has the global figure");
+        *value = total;
     });
 }
 

@@ -91,7 +91,10 @@ public:
     // that every rank steps the same dt with the same parameters (throws Error
     // otherwise, on every rank alike), gives the grid the smallest angle of
     // repose of all blocks (it sets the sub-step), and returns the global flags.
-    virtual StepAgreement agree_before_step(Grid &grid, double dt) = 0;
+    // A rank whose own dt was refused still takes part, with `refused`, so
+    // that the others do not wait for it: then every rank throws, before
+    // anything changed (the refusing rank's caller reports its own reason).
+    virtual StepAgreement agree_before_step(Grid &grid, double dt, bool refused) = 0;
     // Collective, before each sweep: refreshes the halo's heights and
     // residuals and the active set's view of the neighbours' activity.
     virtual void before_sweep(Grid &grid) = 0;
@@ -99,6 +102,9 @@ public:
     virtual void after_sweep(std::vector<LevelSummary> &levels) = 0;
     // Collective: the sum over all ranks, the same on every rank.
     virtual double sum(double local) const = 0;
+    // Collective: as sum(), for a call that a rank may have refused (its
+    // `local` is then ignored): false on every rank when any rank refused.
+    virtual bool sum_unless_refused(double local, bool refused, double &total) const = 0;
 
 protected:
     HaloStore halo_;

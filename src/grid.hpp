@@ -115,9 +115,10 @@ public:
     void set_angle_field(const double *theta);                               // NULL: uniform
     // The smallest angle of repose of any cell: it sets the stable sub-step.
     double min_repose_angle() const {
-        if (distributed_min_angle_ > 0.0) return distributed_min_angle_;
-        return angle_field_.empty() ? repose_angle_ : min_angle_field_;
+        return distributed_min_angle_ > 0.0 ? distributed_min_angle_ : own_min_repose_angle();
     }
+    // The same over this grid's own cells alone (on a block: the block's).
+    double own_min_repose_angle() const { return angle_field_.empty() ? repose_angle_ : min_angle_field_; }
     // On a block of a distributed grid: the smallest angle over all blocks,
     // set by the Decomposition before each step.
     void set_distributed_min_repose_angle(double theta) { distributed_min_angle_ = theta; }

@@ -47,7 +47,7 @@ bool can_flow_forever(const Grid &grid, const StepAgreement &state) {
 // What decides the step's work: the grid's own figures, or on a block of a
 // distributed grid the same figures over all blocks (decomposition.hpp).
 StepAgreement agree_before_step(Grid &grid, double dt) {
-    if (Decomposition *decomposition = grid.decomposition()) return decomposition->agree_before_step(grid, dt);
+    if (Decomposition *decomposition = grid.decomposition()) return decomposition->agree_before_step(grid, dt, false);
     StepAgreement state;
     state.source_active = grid.source_active();
     state.has_open_cells = grid.has_open_cells();

@@ -27,7 +27,10 @@
  * tolerance, sub-step limit, sides, flux exponent, static angle) and the same
  * features (a bed on every rank or none, an angle field on every rank or
  * none; their values are the rank's own block); dpsm_step() checks this and
- * fails on every rank alike when they differ. All other calls are local to the
+ * fails on every rank alike when they differ. A rank whose own arguments to
+ * dpsm_step() or dpsm_get_mass() are refused (a `dt` that is not finite or not
+ * positive, a NULL `value`, an unknown quantity) still takes part, and the
+ * call fails on every rank: no rank waits for it. All other calls are local to the
  * rank. dpsm_save() refuses a distributed grid (::DPSM_ERR_NOT_APPLICABLE):
  * restart files hold one grid.
  *

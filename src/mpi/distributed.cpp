@@ -121,7 +121,7 @@ public:
         if (!finalized) MPI_Comm_free(&comm_);
     }
 
-    StepAgreement agree_before_step(Grid &grid, double dt) override {
+    StepAgreement agree_before_step(Grid &grid, double dt, bool refused) override {
         // Everything as a maximum: minima are maxima of the negated values.
         const double none = -std::numeric_limits<double>::infinity();
         const bool open = grid.has_open_cells();
@@ -131,10 +131,10 @@ public:
                                  grid.masks_version() != exchanged_masks_ ? 1.0 : 0.0,
                                  open ? -grid.open_level_min() : none,
                                  open ? grid.open_level_max() : none};
-        grid.set_distributed_min_repose_angle(0.0);  // this block's own, to find the smallest of all
-        v.push_back(-grid.min_repose_angle());
+        v.push_back(-grid.own_min_repose_angle());
+        v.push_back(refused ? 1.0 : 0.0);
         const std::size_t first_parameter = v.size();
-        const double parameters[] = {dt,
+        const double parameters[] = {refused ? 0.0 : dt,
                                      grid.repose_angle(),
                                      grid.mobility(),
                                      grid.rest_tolerance(),
@@ -155,6 +155,10 @@ public:
         }
         check_mpi(MPI_Allreduce(MPI_IN_PLACE, v.data(), static_cast<int>(v.size()), MPI_DOUBLE, MPI_MAX, comm_),
                   "MPI_Allreduce before dpsm_step");
+        if (v[7] != 0.0)
+            throw Error(DPSM_ERR_INVALID_VALUE,
+                        "dpsm_step: another rank of the distributed grid refused its dt (not finite, or not "
+                        "positive), so no rank stepped; every rank must step the same dt");
         static const char *const names[] = {"dt",         "the repose angle (dpsm_set_repose_angle)",
                                             "the mobility (dpsm_set_mobility)",
                                             "the rest tolerance (dpsm_set_rest_tolerance)",
@@ -261,6 +265,20 @@ public:
             levels[s].moved = v[2 * s] != 0.0;
             levels[s].max_excess = v[2 * s + 1];
         }
+    }
+
+    bool sum_unless_refused(double local, bool refused, double &total) const override {
+        std::vector<double> mine = {refused ? 0.0 : local, refused ? 1.0 : 0.0}, all(2 * static_cast<std::size_t>(ranks()));
+        check_mpi(MPI_Allgather(mine.data(), 2, MPI_DOUBLE, all.data(), 2, MPI_DOUBLE, comm_),
+                  "MPI_Allgather of a sum");
+        CompensatedSum sum;
+        bool any_refused = false;
+        for (std::size_t r = 0; r < all.size(); r += 2) {
+            sum.add(all[r]);
+            any_refused = any_refused || all[r + 1] != 0.0;
+        }
+        total = sum.value();
+        return !any_refused;
     }
 
     double sum(double local) const override {

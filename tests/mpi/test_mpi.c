@@ -514,6 +514,75 @@ static void disagreeing_ranks(void) {
     dpsm_destroy(g);
 }
 
+/* The same figure on every rank: its smallest and largest agree. */
+static int same_on_every_rank(double x) {
+    double lo = x, hi = x;
+    MPI_Allreduce(MPI_IN_PLACE, &lo, 1, MPI_DOUBLE, MPI_MIN, MPI_COMM_WORLD);
+    MPI_Allreduce(MPI_IN_PLACE, &hi, 1, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
+    return lo == hi;
+}
+
+/* A rank whose own arguments are refused does not leave the others waiting
+ * in a collective call: a dt that is NaN on one rank only, or a NULL pointer
+ * or an unknown quantity given to dpsm_get_mass on one rank only, fails on
+ * every rank, the refusing one with its own reason. Nothing changes, and the
+ * stable sub-step (set by the smallest angle of all blocks) stays the same on
+ * every rank after a refused step. */
+static void refusing_rank(void) {
+    if (size_ < 2) return;
+    const int64_t nx = 60, ny = 50;
+    block_t b = block_of(GRID_2D, rank_, size_, nx, ny);
+    dpsm_grid *g = NULL;
+    OK(NULL, dpsm_create_2d_mpi(MPI_COMM_WORLD, nx, ny, b.i0, b.j0, b.ni, b.nj, 1.0, 1.0, &g));
+    if (!g) return;
+    const size_t cells = (size_t)(b.ni * b.nj);
+    double *h = calloc(cells, sizeof(double)), *theta = calloc(cells, sizeof(double)),
+           *after = calloc(cells, sizeof(double));
+    for (size_t c = 0; c < cells; ++c) {
+        h[c] = (double)((c * 37) % 17);
+        theta[c] = rank_ == 0 ? 0.5 : 0.6; /* each block's own smallest angle differs */
+    }
+    OK(g, dpsm_set_heights(g, h));
+    OK(g, dpsm_set_repose_angle_field(g, theta));
+    OK(g, dpsm_step(g, 1.0));
+    OK(g, dpsm_get_heights(g, h));
+    double sdt = 0.0, sdt_after = 0.0, mass = 0.0, mass_after = 0.0;
+    OK(g, dpsm_stable_dt(g, &sdt));
+    OK(g, dpsm_get_mass(g, DPSM_MASS_TOTAL, &mass));
+    require(same_on_every_rank(sdt), "stable_dt differs between ranks after a step");
+
+    int status = dpsm_step(g, rank_ == 1 ? NAN : 1.0);
+    const char *want = rank_ == 1 ? "not finite" : "another rank";
+    require(status == DPSM_ERR_INVALID_VALUE && strstr(dpsm_last_error(g), want) != NULL,
+            "NaN dt on rank 1 only: status %s, message \"%s\"", dpsm_status_string(status), dpsm_last_error(g));
+    if (rank_ == 0) printf("  a rank's dt refused, on every rank: %s\n", dpsm_last_error(g));
+    status = dpsm_step(g, rank_ == 1 ? 2.0 : 1.0);
+    require(status == DPSM_ERR_INVALID_VALUE, "different dt: status %s", dpsm_status_string(status));
+    OK(g, dpsm_get_heights(g, after));
+    require(memcmp(h, after, cells * sizeof(double)) == 0, "a refused step changed the heights");
+    OK(g, dpsm_stable_dt(g, &sdt_after));
+    require(sdt_after == sdt && same_on_every_rank(sdt_after),
+            "stable_dt after refused steps: %.17g, before %.17g (or it differs between ranks)", sdt_after, sdt);
+
+    double *out = rank_ == 0 ? NULL : &mass_after;
+    status = dpsm_get_mass(g, DPSM_MASS_TOTAL, out);
+    require(rank_ == 0 ? status == DPSM_ERR_NULL_POINTER
+                       : status == DPSM_ERR_INVALID_VALUE && strstr(dpsm_last_error(g), "another rank") != NULL,
+            "NULL value on rank 0 only: status %s, message \"%s\"", dpsm_status_string(status), dpsm_last_error(g));
+    status = dpsm_get_mass(g, rank_ == 1 ? 99 : DPSM_MASS_TOTAL, &mass_after);
+    require(rank_ == 1 ? status == DPSM_ERR_UNKNOWN_ENUM : status == DPSM_ERR_INVALID_VALUE,
+            "unknown quantity on rank 1 only: status %s, message \"%s\"", dpsm_status_string(status),
+            dpsm_last_error(g));
+    if (rank_ == 0) printf("  a rank's dpsm_get_mass refused, on every rank: %s\n", dpsm_last_error(g));
+    OK(g, dpsm_get_mass(g, DPSM_MASS_TOTAL, &mass_after));
+    require(mass_after == mass, "the global mass after refused calls: %.17g, before %.17g", mass_after, mass);
+    OK(g, dpsm_step(g, 1.0)); /* all agree again */
+    free(h);
+    free(theta);
+    free(after);
+    dpsm_destroy(g);
+}
+
 /* Restart files are not distributed yet: dpsm_save refuses a distributed
  * grid. The physics setters work, but every rank must use the same features:
  * a bed on some ranks only is refused by the next step, on every rank. */
@@ -560,6 +629,7 @@ int main(int argc, char **argv) {
     }
     bad_decompositions();
     disagreeing_ranks();
+    refusing_rank();
     physics_agreement();
 
     long total = 0, all_checks = 0;
