@@ -7,6 +7,7 @@
 // (2) every face once, (3) every cell's update.
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "closure.hpp"
 #include "grid.hpp"
@@ -30,6 +31,7 @@ void TileBuffers::resize_physics() {
 namespace {
 
 constexpr double kFacesPerCell = 4.0;  // a face takes at most this share of its upstream cell's sand
+constexpr double kLevelWithinRounding = 4.0 * std::numeric_limits<double>::epsilon();
 
 template <bool Isotropic, bool Source>
 void advance_tile_level_physics(TileBuffers &b, int in, const TileRect &reg, const TileRect &tile,
@@ -91,6 +93,13 @@ void advance_tile_level_physics(TileBuffers &b, int in, const TileRect &reg, con
         if (p.hysteresis && !moving[a] && !moving[c]) threshold = std::max(threshold, p.tan_static);
         const double u = gn * gn + gt * gt;
         if (!(u > threshold * threshold)) return 0.0;
+        // A face steep only across its normal, its two cells level to within
+        // the rounding of their heights, carries nothing. Where the cells'
+        // angles differ (a field, hysteresis), the faces across it may rest
+        // steeper than its own threshold, and a flux of an ulp's difference
+        // would pass an ulp back and forth between the two cells for ever.
+        if (Isotropic && std::fabs(h[a] - h[c]) <= kLevelWithinRounding * std::max(std::fabs(h[a]), std::fabs(h[c])))
+            return 0.0;
         const double s = std::sqrt(u);
         double flux = p.nu * excess_power(s - tan_face, p.flux_exponent) / std::sqrt(1.0 + u) * (gn / s);
         if (p.bed) {

@@ -235,6 +235,47 @@ static void test_physics_kernel_matches_plain_kernel(void **state) {
 /* Angle of repose per cell                                                  */
 /* ------------------------------------------------------------------------ */
 
+/* Angles that change from cell to cell (here drawn from 0.5 to 89.5 degrees)
+ * let the faces across a face rest steeper than that face's own threshold, so
+ * on the isotropic scheme a face can be supercritical by its transverse slope
+ * alone. Its flux levels its two cells; once they are level to within the
+ * rounding of their heights it carries nothing, and the scene comes to rest.
+ * (It did not: an ulp went back and forth between two cells for ever, and
+ * dpsm_step(huge dt) never returned; found by the stress suite. These seeds
+ * were not at rest after 6e6 sub-steps then; they rest after 3e4 to 8e4 now.)
+ * Bounded work here, so that a regression fails instead of hanging. */
+static void test_angle_field_comes_to_rest_isotropic(void **state) {
+    (void)state;
+    enum { NX = 24, NY = 27 };
+    for (int seed = 1; seed < 4; ++seed) {
+        dpsm_grid *g = NULL;
+        CHECK_OK(NULL, dpsm_create_2d(NX, NY, 0.5, 0.5, &g));
+        double h[NX * NY], theta[NX * NY];
+        uint64_t r = 0x9E3779B97F4A7C15ull * (uint64_t)(seed + 1);
+        for (int j = 0; j < NY; ++j)
+            for (int i = 0; i < NX; ++i) {
+                r = r * 6364136223846793005ull + 1442695040888963407ull;
+                const double u = (double)(r >> 11) / 9007199254740992.0;
+                r = r * 6364136223846793005ull + 1442695040888963407ull;
+                const double v = (double)(r >> 11) / 9007199254740992.0;
+                const int column = 3 * i >= NX && 3 * i < 2 * NX && 3 * j >= NY && 3 * j < 2 * NY;
+                h[i + NX * j] = 0.1 * (2.0 * u - 1.0) + (column ? 4.0 : 0.0);
+                theta[i + NX * j] = (0.5 + 89.0 * v) * kDeg;
+            }
+        CHECK_OK(g, dpsm_set_heights(g, h));
+        CHECK_OK(g, dpsm_set_repose_angle_field(g, theta));
+        double dt = 0.0;
+        CHECK_OK(g, dpsm_stable_dt(g, &dt));
+        CHECK_OK(g, dpsm_step(g, 1e6 * dt));
+        const double substeps = step_info(g, DPSM_INFO_SUBSTEPS);
+        REQUIRE(step_info(g, DPSM_INFO_AT_REST) == 1.0, "seed %d: not at rest after 1e6 sub-steps", seed);
+        printf("angle field 0.5 .. 89.5 deg, seed %d: at rest after %.0f sub-steps, ledger residual %.2e\n", seed,
+               substeps, ledger_residual(g));
+        REQUIRE(ledger_residual(g) < 1e-12, "ledger residual %.3g", ledger_residual(g));
+        dpsm_destroy(g);
+    }
+}
+
 /* Two patches, 25 and 40 degrees, each with a column that collapses into a
  * cone: each pile takes the height of the exact volume-conserving cone at its
  * own patch's angle, h_f = tan(theta) r0 (3 a / tan(theta))^(1/3). */
@@ -562,6 +603,7 @@ int main(void) {
         cmocka_unit_test(test_bed_axisymmetric),
         cmocka_unit_test(test_physics_kernel_matches_plain_kernel),
         cmocka_unit_test(test_angle_field_gives_a_pile_per_patch),
+        cmocka_unit_test(test_angle_field_comes_to_rest_isotropic),
         cmocka_unit_test(test_angle_field_1d),
         cmocka_unit_test(test_flux_exponent_sets_the_speed),
         cmocka_unit_test(test_flux_exponent_same_rest_state),

@@ -140,6 +140,8 @@ void scene_destroy(scene_t *s) {
     free(s->kinds);
     free(s->h);
     free(s->held);
+    free(s->bed);
+    free(s->tan_field);
     memset(s, 0, sizeof *s);
 }
 
@@ -205,6 +207,33 @@ void scene_set_source(scene_t *s, const double *q) {
             if (s->kinds[c] == DPSM_CELL_SAND && q[c] != 0.0) s->source = 1;
 }
 
+void scene_set_bed(scene_t *s, const double *zb) {
+    OK(s, dpsm_set_bedrock(s->g, zb));
+    free(s->bed);
+    s->bed = NULL;
+    if (!zb) return;
+    s->bed = malloc(sizeof(double) * (size_t)s->n);
+    REQUIRE(s->bed != NULL, "out of memory");
+    memcpy(s->bed, zb, sizeof(double) * (size_t)s->n);
+}
+
+void scene_set_angle_field(scene_t *s, const double *theta) {
+    OK(s, dpsm_set_repose_angle_field(s->g, theta));
+    free(s->tan_field);
+    s->tan_field = NULL;
+    if (!theta) return;
+    s->tan_field = malloc(sizeof(double) * (size_t)s->n);
+    REQUIRE(s->tan_field != NULL, "out of memory");
+    for (int64_t c = 0; c < s->n; ++c) s->tan_field[c] = tan(theta[c]);
+}
+
+void scene_set_static_angle(scene_t *s, double theta) {
+    OK(s, dpsm_set_static_angle(s->g, theta));
+    s->tan_static = tan(theta);
+}
+
+void scene_set_flux_exponent(scene_t *s, double p) { OK(s, dpsm_set_flux_exponent(s->g, p)); }
+
 double scene_ledger_residual(const scene_t *s) {
     double m[4];
     for (int q = 0; q < 4; ++q) OK(s, dpsm_get_mass(s->g, q, &m[q]));
@@ -217,12 +246,34 @@ double scene_ledger_residual(const scene_t *s) {
     return fabs(m[0] - (m[1] + m[2] - m[3])) / scale;
 }
 
+/* The rest threshold of the face between a and b (b < 0: outside, of kind kb):
+ * tan(theta) (1 + tol), with an angle field the mean of the two cells' tan
+ * (a sand cell's own where the other is not sand), and at least the static
+ * angle's tan: at rest no cell is moving. */
+static double face_threshold(const scene_t *s, int64_t a, int64_t b, int kb) {
+    double tan_face = tan(s->theta);
+    if (s->tan_field) {
+        const int a_sand = s->kinds[a] == DPSM_CELL_SAND, b_sand = kb == DPSM_CELL_SAND;
+        const double ta = a_sand ? s->tan_field[a] : s->tan_field[b];
+        const double tb = b_sand ? s->tan_field[b] : ta;
+        tan_face = 0.5 * (ta + tb);
+    }
+    return fmax(tan_face * (1.0 + s->tol), s->tan_static);
+}
+
 /* The largest |dh| / d over faces that can carry sand, relative to
  * tan(theta) (1 + tol), minus 1, with the rounding of the slope itself
  * allowed for. */
 static double rest_excess(const scene_t *s, int64_t *where) {
-    const double threshold = tan(s->theta) * (1.0 + s->tol);
     double worst = -INFINITY;
+    /* The film of sand above the bed that dpsm leaves in place: tol tan of
+     * the smallest angle times the smaller spacing (a little more, for the
+     * rounding of the comparison). */
+    double smallest_tan = tan(s->theta);
+    if (s->tan_field)
+        for (int64_t c = 0; c < s->n; ++c) smallest_tan = fmin(smallest_tan, s->tan_field[c]);
+    const double spacing = s->geom == GEOM_2D ? fmin(s->dx, s->dy) : s->dx;
+    const double film = s->tol * smallest_tan * spacing * (1.0 + 1e-9);
     const double *h = s->h;
     const uint8_t *k = s->kinds;
     /* face between cells a and b (b < 0: the outside of an open side, at 0) */
@@ -233,6 +284,9 @@ static double rest_excess(const scene_t *s, int64_t *where) {
         const int kb_ = b_ < 0 ? DPSM_CELL_OPEN : k[b_];                                              \
         if (k[a_] == DPSM_CELL_WALL || kb_ == DPSM_CELL_WALL) break;                                  \
         if (k[a_] != DPSM_CELL_SAND && kb_ != DPSM_CELL_SAND) break;                                  \
+        const double threshold = face_threshold(s, a_, b_, kb_);                                       \
+        const int64_t up_ = h[a_] >= hb_ ? a_ : b_;                                                    \
+        if (s->bed && up_ >= 0 && k[up_] == DPSM_CELL_SAND && h[up_] - s->bed[up_] <= film) break;     \
         const double slope_ = fabs(h[a_] - hb_) / (d);                                                \
         const double slack_ = 4.0 * DBL_EPSILON * fmax(fabs(h[a_]), fabs(hb_)) / (d);                 \
         const double r_ = (slope_ - slack_) / threshold - 1.0;                                        \
@@ -269,6 +323,10 @@ static void check_state(scene_t *s, stress_worst_t *w, int stepped, double hi, d
     REQUIRE(bad == 0, "[%s] %ld heights are not finite, the first at cell %lld: %g", s->name, bad,
             (long long)first_bad, first_bad >= 0 ? s->h[first_bad] : 0.0);
 
+    if (s->bed)
+        for (int64_t c = 0; c < s->n; ++c)
+            REQUIRE(s->kinds[c] != DPSM_CELL_SAND || s->h[c] >= s->bed[c],
+                    "[%s] sand cell %lld at %.17g is below its bed %.17g", s->name, (long long)c, s->h[c], s->bed[c]);
     for (int64_t c = 0; c < s->n; ++c)
         if (s->kinds[c] != DPSM_CELL_SAND)
             REQUIRE(memcmp(&s->h[c], &s->held[c], sizeof(double)) == 0,

@@ -9,6 +9,7 @@
  *    higher, and its lowest no lower, than the highest and lowest of the sand
  *    cells, the held levels of open cells and 0 when a side is open before it;
  *  - wall and open cells keep their heights;
+ *  - no sand cell below the bed, when there is one;
  *  - when the step reports the surface at rest and nothing drives it (no
  *    source, every held level the same), no face is steeper than
  *    tan(theta) * (1 + tol) along an axis (sand-sand and sand-open faces, and
@@ -39,6 +40,10 @@ typedef struct {
     double *h;      /* heights after the last check */
     double *held;   /* heights of wall and open cells at the last host change */
     double mass_scale; /* the largest gross mass sum |h| * area at a host change */
+    /* The physics of real scenes, NULL or 0 when not set. */
+    double *bed;       /* no sand cell below it, ever */
+    double *tan_field; /* tan of each cell's angle of repose */
+    double tan_static; /* hysteresis */
 } scene_t;
 
 /* The worst figures seen so far (over every scene of the process). */
@@ -82,6 +87,14 @@ void scene_set_all_sides(scene_t *s, int open);
 void scene_set_kinds(scene_t *s, const uint8_t *kinds);
 void scene_set_heights(scene_t *s, const double *h);
 void scene_set_source(scene_t *s, const double *q); /* NULL: none */
+/* The physics setters; the rest check then uses each face's own law: the
+ * mean tan of its cells' angles, the static angle between cells at rest, and
+ * no bound where the upper cell holds no more sand above its bed than the
+ * film dpsm leaves in place. */
+void scene_set_bed(scene_t *s, const double *zb);
+void scene_set_angle_field(scene_t *s, const double *theta);
+void scene_set_static_angle(scene_t *s, double theta);
+void scene_set_flux_exponent(scene_t *s, double p);
 
 /* Steps dt (must succeed) and checks every invariant against w. Returns 1 if
  * the step reported the surface at rest. */
