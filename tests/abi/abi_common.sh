@@ -1,11 +1,13 @@
 # shellcheck shell=bash
 # Shared by tests/abi/check and tests/abi/update-baseline (source it).
 #
-# The ABI baseline is two files:
+# The ABI baseline is three files:
 #   libdpsm.abi    abidw's description of libdpsm.so: the exported functions and
 #                  the public types they use (types defined outside the public
 #                  headers, such as the inside of the opaque dpsm_grid, are
 #                  dropped), from a build with debug information;
+#   libdpsm_mpi.abi the same of libdpsm_mpi.so (every function of libdpsm and
+#                  those of dpsm_mpi.h), checked when MPI is found;
 #   constants.txt  the values of the header's enumeration macros (status codes,
 #                  sides, kinds, ...), which compiled hosts carry in their own
 #                  code and abidw cannot see.
@@ -39,6 +41,14 @@ dpsm_abi_build() {
         echo "error: building the debug build of the library failed" >&2
         return 1
     }
+    # The MPI component too, where the configuration found MPI (its target exists).
+    if grep -q '/src/mpi/' "$work/CMakeFiles/TargetDirectories.txt" 2>/dev/null; then
+        cmake --build "$work" --target dpsm_mpi >>"$work/build.log" 2>&1 || {
+            cat "$work/build.log" >&2
+            echo "error: building the debug build of libdpsm_mpi failed" >&2
+            return 1
+        }
+    fi
     local lib
     lib=$(find "$work/src" -maxdepth 1 -name 'libdpsm.so.*.*.*' -type f | head -n 1)
     [[ -n $lib ]] || {
@@ -46,6 +56,12 @@ dpsm_abi_build() {
         return 1
     }
     printf '%s\n' "$lib"
+}
+
+# dpsm_abi_mpi_lib <work dir>: the path of libdpsm_mpi.so.X.Y.Z that
+# dpsm_abi_build made, or nothing when MPI was not found.
+dpsm_abi_mpi_lib() {
+    find "$1/src/mpi" -maxdepth 1 -name 'libdpsm_mpi.so.*.*.*' -type f 2>/dev/null | head -n 1
 }
 
 # dpsm_abi_headers <source dir> <work dir> [suffix]: the --headers-dir and
