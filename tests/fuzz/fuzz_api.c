@@ -164,7 +164,8 @@ typedef struct {
     uint8_t *kinds;
     double *source; /* NULL: none */
     double *bed;    /* NULL: none */
-    int angle_field, static_angle; /* set: the rest check no longer applies as written */
+    double *tan_field; /* tan of each cell's angle of repose; NULL: uniform */
+    double tan_static; /* hysteresis; 0: none */
     double mass_scale;
 } slot_t;
 
@@ -339,6 +340,7 @@ static void destroy_slot(slot_t *s) {
     free(s->kinds);
     free(s->source);
     free(s->bed);
+    free(s->tan_field);
     memset(s, 0, sizeof *s);
 }
 
@@ -663,10 +665,27 @@ static void op_region(reader_t *r, unsigned which) {
     free(v);
 }
 
-/* The largest face slope over tan(theta) (1 + tol), minus 1. */
+/* The rest threshold of the face between cell a and b (b < 0: the outside,
+ * of kind kb), as dpsm_step documents it: tan(theta) (1 + tol), with an angle
+ * field the mean of the two cells' tan (the sand cell's own where the other
+ * is not sand), and at least the static angle's tan (at rest no cell moves). */
+static double face_threshold(const slot_t *s, int64_t a, int64_t b, int kb) {
+    double tan_face = tan(s->theta);
+    if (s->tan_field) {
+        const double ta = s->kinds[a] == DPSM_CELL_SAND ? s->tan_field[a] : s->tan_field[b];
+        tan_face = 0.5 * (ta + (kb == DPSM_CELL_SAND ? s->tan_field[b] : ta));
+    }
+    return fmax(tan_face * (1.0 + s->tol), s->tan_static);
+}
+
+/* The largest face slope over its rest threshold, minus 1. With a bed, faces
+ * whose upper cell holds no more than the film of sand dpsm leaves in place
+ * (tol tan(smallest angle) times the smaller spacing) carry nothing. */
 static double rest_excess(const slot_t *s, const double *h) {
-    const double threshold = tan(s->theta) * (1.0 + s->tol);
-    double worst = -INFINITY;
+    double worst = -INFINITY, smallest_tan = tan(s->theta);
+    if (s->tan_field)
+        for (int64_t c = 0; c < s->n; ++c) smallest_tan = fmin(smallest_tan, s->tan_field[c]);
+    const double film = s->tol * smallest_tan * (s->geom == GEOM_2D ? fmin(s->dx, s->dy) : s->dx) * (1.0 + 1e-9);
     for (int64_t j = 0; j < s->ny; ++j)
         for (int64_t i = 0; i < s->nx; ++i) {
             const int64_t c = i + s->nx * j;
@@ -684,9 +703,11 @@ static double rest_excess(const slot_t *s, const double *h) {
                 const double hb = b < 0 ? 0.0 : h[b];
                 if (s->kinds[c] == DPSM_CELL_WALL || kb == DPSM_CELL_WALL) continue;
                 if (s->kinds[c] != DPSM_CELL_SAND && kb != DPSM_CELL_SAND) continue;
+                const int64_t up = h[c] >= hb ? c : b;
+                if (s->bed && up >= 0 && s->kinds[up] == DPSM_CELL_SAND && h[up] - s->bed[up] <= film) continue;
                 const double slope = fabs(h[c] - hb) / d;
                 const double slack = 4.0 * DBL_EPSILON * fmax(fabs(h[c]), fabs(hb)) / d;
-                worst = fmax(worst, (slope - slack) / threshold - 1.0);
+                worst = fmax(worst, (slope - slack) / face_threshold(s, c, b, kb) - 1.0);
             }
         }
     return worst;
@@ -812,7 +833,7 @@ static void op_step(reader_t *r) {
     }
     const double at_rest = after.info[DPSM_INFO_AT_REST];
     if (at_rest != 0.0 && at_rest != 1.0) die("AT_REST = %g", at_rest);
-    if (at_rest == 1.0 && !drives && !s->bed && !s->angle_field && !s->static_angle) {
+    if (at_rest == 1.0 && !drives) {
         const double excess = rest_excess(s, after.h);
         if (excess > 1e-12) die("reported at rest with a face steeper than tan(theta)(1+tol) by %.3g", excess);
     }
@@ -880,7 +901,8 @@ static void op_physics(reader_t *r) {
             const unsigned mode = u8(r);
             if (mode % 4 == 0) {
                 ON_BOTH(s, DPSM_OK, g_op, dpsm_set_repose_angle_field(g_, NULL));
-                s->angle_field = 0;
+                free(s->tan_field);
+                s->tan_field = NULL;
                 break;
             }
             double *theta = malloc(sizeof(double) * (size_t)s->n);
@@ -893,7 +915,10 @@ static void op_physics(reader_t *r) {
                 want = DPSM_ERR_INVALID_VALUE;
             }
             ON_BOTH(s, want, g_op, dpsm_set_repose_angle_field(g_, theta));
-            if (want == DPSM_OK) s->angle_field = 1;
+            if (want == DPSM_OK) {
+                if (!s->tan_field && !(s->tan_field = malloc(sizeof(double) * (size_t)s->n))) die("out of memory");
+                for (int64_t c = 0; c < s->n; ++c) s->tan_field[c] = tan(theta[c]);
+            }
             free(theta);
             break;
         }
@@ -909,7 +934,7 @@ static void op_physics(reader_t *r) {
             const double v = pick(r, kAngles, COUNT(kAngles), kAnglesBad, COUNT(kAnglesBad));
             const int ok = isfinite(v) && v > 0.0 && v < 0.5 * 3.14159265358979323846;
             ON_BOTH(s, ok ? DPSM_OK : DPSM_ERR_INVALID_VALUE, g_op, dpsm_set_static_angle(g_, v));
-            if (ok) s->static_angle = 1;
+            if (ok) s->tan_static = tan(v);
             break;
         }
     }
