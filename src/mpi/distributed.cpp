@@ -282,11 +282,9 @@ public:
     }
 
     double sum(double local) const override {
-        std::vector<double> all(static_cast<std::size_t>(ranks()));
-        check_mpi(MPI_Allgather(&local, 1, MPI_DOUBLE, all.data(), 1, MPI_DOUBLE, comm_), "MPI_Allgather of a sum");
-        CompensatedSum total;
-        for (double x : all) total.add(x);
-        return total.value();
+        double total = 0.0;
+        sum_unless_refused(local, false, total);
+        return total;
     }
 
 private:
