@@ -154,11 +154,38 @@ void require_above_bed(const dpsm_grid *g, const dpsm::Grid::Block &b, const dou
     }
 }
 
-// Restart files hold one grid; a distributed grid is many (not supported yet).
-void require_serial(const dpsm_grid *g, const char *function) {
-    if (g->core.decomposition())
-        fail(DPSM_ERR_NOT_APPLICABLE, function,
-             "is not supported on a distributed grid (dpsm_create_2d_mpi) in this version");
+// dpsm_save on a distributed grid: every rank writes its own block to its own
+// path, all with the same mark, and every rank fails when any rank did. A rank
+// whose own path is refused still takes part, so that no rank waits for it.
+void save_block(const dpsm::Grid &grid, const dpsm::Decomposition &d, const char *path, const char *fn) {
+    dpsm::RestartBlock block;
+    block.present = true;
+    block.save_mark = d.shared_mark();
+    block.global_nx = d.halo().global_nx;
+    block.global_ny = d.halo().global_ny;
+    block.i0 = d.halo().i0;
+    block.j0 = d.halo().j0;
+    block.rank = d.rank();
+    block.ranks = d.ranks();
+    int status = DPSM_OK;
+    std::string reason;
+    try {
+        require_pointer(path, fn, "path");
+        dpsm::save_restart(grid, path, fn, block);
+    } catch (const Error &e) {
+        status = e.status();
+        reason = e.what();
+    } catch (const std::bad_alloc &) {
+        status = DPSM_ERR_OUT_OF_MEMORY;
+        reason = std::string(fn) + ": out of memory";
+    }
+    int failed_rank = -1, failed_status = DPSM_OK;
+    d.first_failure(status, failed_rank, failed_status);
+    if (status != DPSM_OK) throw Error(status, reason);
+    if (failed_rank >= 0)
+        fail(failed_status, fn, "rank ", failed_rank, " of the distributed grid could not save its block (",
+             dpsm_status_string(failed_status), "; its dpsm_last_error says why), so this save is not a complete set "
+             "of files; this rank's block went to ", path);
 }
 
 void require_angle(double theta, const char *function, const char *name) {
@@ -512,7 +539,10 @@ int dpsm_save(const dpsm_grid *g, const char *path) {
     const char *fn = "dpsm_save";
     return guarded(g, fn, [&] {
         require_grid(g, fn);
-        require_serial(g, fn);
+        if (const dpsm::Decomposition *decomposition = g->core.decomposition()) {
+            save_block(g->core, *decomposition, path, fn);
+            return;
+        }
         require_pointer(path, fn, "path");
         dpsm::save_restart(g->core, path, fn);
     });
@@ -526,7 +556,12 @@ int dpsm_load(const char *path, dpsm_grid **out) {
         require_pointer(out, fn, "out");
         dpsm::Geometry geometry{};
         dpsm::GridState state;
-        dpsm::load_restart(path, geometry, state, fn);
+        dpsm::RestartBlock block;
+        dpsm::load_restart(path, geometry, state, block, fn);
+        if (block.present)
+            fail(DPSM_ERR_NOT_APPLICABLE, fn, path, " holds the block of rank ", block.rank, " of a grid distributed over ",
+                 block.ranks, " ranks (written by dpsm_save on a distributed grid); load it with dpsm_load_mpi on ",
+                 block.ranks, " ranks");
         // Built completely before it is handed out: a failure leaves *out NULL.
         auto grid = std::make_unique<dpsm_grid>(geometry);
         grid->core.restore(std::move(state));

@@ -12,7 +12,9 @@
 //    where the neighbours' cells may move (ActiveSet::set_remote_activity);
 //  - after a sweep it makes every level's "moved" and largest excess slope global;
 //  - before a step it makes the flags that decide the step's work global;
-//  - sums (the ledger, cell updates) are taken over all blocks.
+//  - sums (the ledger, cell updates) are taken over all blocks;
+//  - dpsm_save writes each block to its own file, with its place and a mark
+//    that all the files of one save share, and agrees on success.
 //
 // Coordinates are the block's own (0 .. nx-1, 0 .. ny-1); the block starts at
 // (i0, j0) of the global grid of global_nx x global_ny cells.
@@ -105,6 +107,16 @@ public:
     // Collective: as sum(), for a call that a rank may have refused (its
     // `local` is then ignored): false on every rank when any rank refused.
     virtual bool sum_unless_refused(double local, bool refused, double &total) const = 0;
+
+    // This block's place: its rank, the number of ranks, the global grid.
+    virtual int rank() const = 0;
+    virtual int ranks() const = 0;
+    // Collective: a number that every rank gets alike and that differs from
+    // one call to the next (and between runs): the mark of one save.
+    virtual std::uint64_t shared_mark() const = 0;
+    // Collective: the lowest rank whose `status` is not DPSM_OK (0), with that
+    // status; rank -1 when every rank succeeded.
+    virtual void first_failure(int status, int &failed_rank, int &failed_status) const = 0;
 
 protected:
     HaloStore halo_;

@@ -35,13 +35,17 @@ constexpr std::array<std::uint8_t, 8> kMagic{0x89, 'D', 'P', 'S', 'M', '\r', '\n
 // The fixed header of version 1, its checksum included (docs/guide_restart.md).
 constexpr std::size_t kHeaderBytes = 220;
 constexpr std::size_t kChecksumBytes = 4;
+// The block record of version 2, right after the fixed header.
+constexpr std::size_t kBlockBytes = 48;
 
 // Which optional per-cell arrays follow the mandatory ones.
 constexpr std::uint32_t kHasSource = 1u << 0;
 constexpr std::uint32_t kHasBed = 1u << 1;
 constexpr std::uint32_t kHasAngleField = 1u << 2;
 constexpr std::uint32_t kHasMoving = 1u << 3;
-constexpr std::uint32_t kKnownFlags = kHasSource | kHasBed | kHasAngleField | kHasMoving;
+// Version 2: a block record follows the header (one rank's block of a distributed grid).
+constexpr std::uint32_t kIsBlock = 1u << 4;
+constexpr std::uint32_t kKnownFlags = kHasSource | kHasBed | kHasAngleField | kHasMoving | kIsBlock;
 
 
 // ---- CRC-32 (ISO-HDLC, as zlib, PNG and gzip: reflected 0xEDB88320) -------
@@ -138,10 +142,10 @@ std::uint32_t flags_of(const Grid &g) {
     return flags;
 }
 
-void write_header(Writer &w, const Grid &g) {
+void write_header(Writer &w, const Grid &g, const RestartBlock &block) {
     const Geometry &geo = g.geometry();
     for (const std::uint8_t b : kMagic) w.u8(b);
-    w.u32(kRestartVersion);
+    w.u32(block.present ? 2u : 1u);
     w.u32(static_cast<std::uint32_t>(geo.dim));
     w.u32(geo.axisymmetric ? 1u : 0u);
     w.i64(geo.nx);
@@ -157,7 +161,7 @@ void write_header(Writer &w, const Grid &g) {
     for (int side = 0; side < 4; ++side) w.u8(g.side_open(side) ? 1 : 0);
     w.f64(g.flux_exponent());
     w.f64(g.static_angle());
-    w.u32(flags_of(g));
+    w.u32(flags_of(g) | (block.present ? kIsBlock : 0u));
     const MassLedger &ledger = g.ledger();
     for (const CompensatedSum *account : {&ledger.sourced, &ledger.external, &ledger.outflow, &ledger.unmet}) {
         w.f64(account->sum());
@@ -170,6 +174,17 @@ void write_header(Writer &w, const Grid &g) {
     w.f64(info.max_excess_slope);
     w.f64(info.cell_updates);
     w.checksum();
+}
+
+void write_block(Writer &w, const RestartBlock &block) {
+    if (!block.present) return;
+    w.u64(block.save_mark);
+    w.i64(block.global_nx);
+    w.i64(block.global_ny);
+    w.i64(block.i0);
+    w.i64(block.j0);
+    w.i32(block.rank);
+    w.i32(block.ranks);
 }
 
 void write_body(Writer &w, const Grid &g) {
@@ -295,6 +310,19 @@ void read_header(Reader &r, Header &h, GridState &s) {
     r.u32();  // the header's checksum, checked already
 }
 
+void read_block(Reader &r, const Header &h, RestartBlock &block) {
+    block = RestartBlock{};
+    if (!(h.flags & kIsBlock)) return;
+    block.present = true;
+    block.save_mark = r.u64();
+    block.global_nx = r.i64();
+    block.global_ny = r.i64();
+    block.i0 = r.i64();
+    block.j0 = r.i64();
+    block.rank = r.i32();
+    block.ranks = r.i32();
+}
+
 void read_body(Reader &r, const Header &h, std::size_t n, GridState &s) {
     r.array(s.heights, n, &Reader::f64);
     r.array(s.residuals, n, &Reader::f32);
@@ -338,8 +366,12 @@ void check_layout(const Header &h, const std::string &path, const char *fn) {
     if (h.nx > kMaxCells / h.ny)
         bad("nx * ny = ", h.nx, " * ", h.ny, " cells is more than this library can address (", kMaxCells, ")");
     if (h.flags & ~kKnownFlags) bad("unknown array flags ", hex32(h.flags & ~kKnownFlags));
+    if ((h.flags & kIsBlock) && h.version < 2)
+        bad("the block flag ", hex32(kIsBlock), " is set in a file of version ", h.version, " (it needs version 2)");
+    if ((h.flags & kIsBlock) && h.dim != 2) bad("a block of a distributed grid must have dim = 2, not ", h.dim);
     const std::uint64_t cells = static_cast<std::uint64_t>(h.nx) * static_cast<std::uint64_t>(h.ny);
-    if (cells > (std::numeric_limits<std::size_t>::max() - kHeaderBytes - kChecksumBytes) / bytes_per_cell(h.flags))
+    if (cells > (std::numeric_limits<std::size_t>::max() - kHeaderBytes - kBlockBytes - kChecksumBytes) /
+                    bytes_per_cell(h.flags))
         bad(cells, " cells do not fit in this machine's memory");
 }
 
@@ -405,6 +437,19 @@ void check_values(const Header &h, const GridState &s, std::size_t n, const std:
     }
 }
 
+// The block record against the block's own size: its place in the global grid.
+void check_block(const Header &h, const RestartBlock &b, const std::string &path, const char *fn) {
+    if (!b.present) return;
+    const auto bad = [&](const auto &...parts) { fail(DPSM_ERR_BAD_FILE, fn, path, ": ", parts...); };
+    if (b.ranks < 1) bad("the block record says ", b.ranks, " ranks; at least 1");
+    if (b.rank < 0 || b.rank >= b.ranks) bad("the block record's rank ", b.rank, " is not one of its ", b.ranks, " ranks");
+    if (b.global_nx < 1 || b.global_ny < 1 || b.global_nx > kMaxCells / b.global_ny)
+        bad("the block record's global grid of ", b.global_nx, " x ", b.global_ny, " cells is not valid");
+    if (b.i0 < 0 || b.j0 < 0 || b.i0 > b.global_nx - h.nx || b.j0 > b.global_ny - h.ny)
+        bad("the block [", b.i0, ", ", b.i0 + h.nx, ") x [", b.j0, ", ", b.j0 + h.ny, ") does not lie in its global grid [0, ",
+            b.global_nx, ") x [0, ", b.global_ny, ")");
+}
+
 // Reads up to `want` more bytes onto `bytes`; false at the end of the file.
 bool read_more(std::FILE *file, std::vector<std::uint8_t> &bytes, std::size_t want, const std::string &path,
                const char *fn) {
@@ -418,7 +463,7 @@ bool read_more(std::FILE *file, std::vector<std::uint8_t> &bytes, std::size_t wa
 
 }  // namespace
 
-void save_restart(const Grid &grid, const char *path, const char *function) {
+void save_restart(const Grid &grid, const char *path, const char *function, const RestartBlock &block) {
     const std::string target(path);
     TempFile tmp;
     tmp.path = target + ".tmp";
@@ -429,9 +474,10 @@ void save_restart(const Grid &grid, const char *path, const char *function) {
         fail(DPSM_ERR_IO, function, "cannot write ", target, ": cannot create ", tmp.path, ": ", system_reason(errno));
     }
     Writer w(tmp.file, target, function);
-    write_header(w, grid);
+    write_header(w, grid, block);
     if (w.buffered() != kHeaderBytes)
         fail(DPSM_ERR_INTERNAL, function, "the header takes ", w.buffered(), " bytes, not ", kHeaderBytes);
+    write_block(w, block);
     write_body(w, grid);
     // On disk before it replaces the old file: a crash leaves one or the other.
     if (std::fflush(tmp.file) != 0) fail(DPSM_ERR_IO, function, "cannot write ", target, ": ", system_reason(errno));
@@ -450,7 +496,7 @@ void save_restart(const Grid &grid, const char *path, const char *function) {
     tmp.keep = true;  // it is the target now
 }
 
-void load_restart(const char *path, Geometry &geometry, GridState &state, const char *fn) {
+void load_restart(const char *path, Geometry &geometry, GridState &state, RestartBlock &block, const char *fn) {
     const std::string source(path);
     errno = 0;
     struct Closer {
@@ -492,7 +538,8 @@ void load_restart(const char *path, Geometry &geometry, GridState &state, const 
     // Then exactly as many bytes as the header implies, read as they come (a
     // short file allocates no more than it holds).
     const std::size_t n = static_cast<std::size_t>(header.nx) * static_cast<std::size_t>(header.ny);
-    const std::size_t expected = kHeaderBytes + n * bytes_per_cell(header.flags) + kChecksumBytes;
+    const std::size_t block_bytes = (header.flags & kIsBlock) ? kBlockBytes : 0;
+    const std::size_t expected = kHeaderBytes + block_bytes + n * bytes_per_cell(header.flags) + kChecksumBytes;
     constexpr std::size_t kChunk = std::size_t{1} << 22;
     while (bytes.size() <= expected) {
         const std::size_t want = expected + 1 - bytes.size();
@@ -517,10 +564,12 @@ void load_restart(const char *path, Geometry &geometry, GridState &state, const 
         bad(" is corrupted: checksum mismatch (stored ", hex32(stored), ", computed ", hex32(computed), ")");
 
     Reader body(bytes, kHeaderBytes, source, fn);
+    read_block(body, header, block);
     read_body(body, header, n, state);
     if (body.at() != expected - kChecksumBytes)
         fail(DPSM_ERR_INTERNAL, fn, "read ", body.at(), " bytes of ", source, ", expected ", expected - kChecksumBytes);
     check_values(header, state, n, source, fn);
+    check_block(header, block, source, fn);
     state.scheme = header.scheme == kIsotropic ? kIsotropic : kPairwise;
     state.last_step.at_rest = header.at_rest != 0;
     for (int side = 0; side < 4; ++side) state.side_open[side] = header.side_open[side] != 0;

@@ -10,16 +10,32 @@
 
 namespace dpsm {
 
-// The format version this library writes, and the newest it reads.
-constexpr std::uint32_t kRestartVersion = 1;
+// The newest format version this library reads. It writes the oldest that
+// holds the grid: version 1 for a grid of its own, version 2 (version 1 and a
+// block record) for one rank's block of a distributed grid, so that older
+// libraries still read every file they could hold.
+constexpr std::uint32_t kRestartVersion = 2;
+
+// Where a block file's grid lies in its distributed grid (version 2): its
+// place, which of how many ranks saved it, and the mark that all the files
+// of one collective save share, so that files of different saves never mix.
+struct RestartBlock {
+    bool present = false;  // false: a grid of its own
+    std::uint64_t save_mark = 0;
+    std::int64_t global_nx = 0, global_ny = 0, i0 = 0, j0 = 0;
+    std::int32_t rank = 0, ranks = 0;
+};
 
 // Writes the grid to `path` through `path + ".tmp"`, renamed over `path` only
-// once complete. Throws Error (DPSM_ERR_IO) naming the path and the reason.
-void save_restart(const Grid &grid, const char *path, const char *function);
+// once complete; with `block`, as that block of a distributed grid. Throws
+// Error (DPSM_ERR_IO) naming the path and the reason.
+void save_restart(const Grid &grid, const char *path, const char *function, const RestartBlock &block = {});
 
 // Reads and checks a whole file: on return `geometry` and `state` hold values
-// the setters would accept. Throws Error: DPSM_ERR_IO when the file cannot be
-// read, DPSM_ERR_BAD_FILE when its contents are wrong in any way.
-void load_restart(const char *path, Geometry &geometry, GridState &state, const char *function);
+// the setters would accept, and `block` says whether the file holds a block
+// of a distributed grid and where (checked against its geometry only). Throws
+// Error: DPSM_ERR_IO when the file cannot be read, DPSM_ERR_BAD_FILE when its
+// contents are wrong in any way.
+void load_restart(const char *path, Geometry &geometry, GridState &state, RestartBlock &block, const char *function);
 
 }  // namespace dpsm

@@ -27,6 +27,7 @@ enum {
     kOffsetVersion = 8,
     kOffsetNx = 20,
     kOffsetRepose = 52,
+    kOffsetFlags = 112,
     kHeaderChecksum = 216,
     kHeaderBytes = 220,
 };
@@ -436,10 +437,10 @@ static void test_values_are_checked_behind_the_checksum(void **state) {
     unsigned char *bytes = malloc(size);
 
     memcpy(bytes, good, size);
-    put_u32(bytes + kOffsetVersion, 2);
+    put_u32(bytes + kOffsetVersion, 3);
     reseal(bytes, size);
     write_file(bad, bytes, size);
-    require_refused(bad, "written by a newer dpsm, version 2", "version 2");
+    require_refused(bad, "written by a newer dpsm, version 3", "version 3");
 
     memcpy(bytes, good, size);
     put_f64(bytes + kOffsetRepose, 2.0);
@@ -472,6 +473,94 @@ static void test_values_are_checked_behind_the_checksum(void **state) {
     reseal(bytes, size);
     write_file(bad, bytes, size);
     require_refused(bad, "truncated: expected", "nx = 2^30");
+    free(bytes);
+    free(good);
+}
+
+static void put_u64(unsigned char *p, uint64_t v) {
+    for (int k = 0; k < 8; ++k) p[k] = (unsigned char)(v >> (8 * k));
+}
+
+/* The small file as rank `rank` of `ranks` would have saved it at (i0, j0) of
+ * a global grid: version 2, the block flag, the block record after the header. */
+static unsigned char *as_block(const unsigned char *good, size_t size, uint32_t version, int64_t nxg, int64_t nyg,
+                               int64_t i0, int64_t j0, int32_t rank, int32_t ranks, size_t *block_size) {
+    *block_size = size + 48;
+    unsigned char *b = malloc(*block_size);
+    memcpy(b, good, kHeaderBytes);
+    memcpy(b + kHeaderBytes + 48, good + kHeaderBytes, size - kHeaderBytes);
+    put_u32(b + kOffsetVersion, version);
+    put_u32(b + kOffsetFlags, get_u32(b + kOffsetFlags) | 16u);
+    unsigned char *r = b + kHeaderBytes;
+    put_u64(r, 0x1234abcdu);
+    put_u64(r + 8, (uint64_t)nxg);
+    put_u64(r + 16, (uint64_t)nyg);
+    put_u64(r + 24, (uint64_t)i0);
+    put_u64(r + 32, (uint64_t)j0);
+    put_u32(r + 40, (uint32_t)rank);
+    put_u32(r + 44, (uint32_t)ranks);
+    reseal(b, *block_size);
+    return b;
+}
+
+/* A block of a distributed grid (version 2, written by dpsm_save on one rank
+ * of a distributed grid) is not a grid of its own: dpsm_load refuses it and
+ * names dpsm_load_mpi; a damaged block record is refused as a bad file. */
+static void test_block_files_need_dpsm_load_mpi(void **state) {
+    (void)state;
+    char path[300], bad[300];
+    path_of(path, sizeof path, "small.dpsm");
+    path_of(bad, sizeof bad, "block.dpsm");
+    size_t size, n;
+    unsigned char *good = small_file(path, &size); /* 5 x 4 cells */
+
+    unsigned char *b = as_block(good, size, 2, 10, 8, 5, 4, 1, 2, &n);
+    write_file(bad, b, n);
+    dpsm_grid *out = (dpsm_grid *)&out;
+    int status = dpsm_load(bad, &out);
+    const char *message = dpsm_last_error(NULL);
+    REQUIRE(status == DPSM_ERR_NOT_APPLICABLE && out == NULL, "a block file: dpsm_load returned %s (%s)",
+            dpsm_status_string(status), message);
+    REQUIRE(strstr(message, "rank 1 of a grid distributed over 2 ranks") && strstr(message, "dpsm_load_mpi"),
+            "a block file: the message does not say what it is and what reads it: %s", message);
+    free(b);
+
+    struct {
+        uint32_t version;
+        int64_t nxg, nyg, i0, j0;
+        int32_t rank, ranks;
+        const char *phrase;
+    } wrong[] = {
+        {1, 10, 8, 5, 4, 1, 2, "needs version 2"},
+        {2, 10, 8, 5, 4, 2, 2, "rank 2 is not one of its 2 ranks"},
+        {2, 10, 8, 5, 4, 0, 0, "says 0 ranks"},
+        {2, 10, 8, 6, 4, 1, 2, "does not lie in its global grid"},
+        {2, 10, 8, 5, -1, 1, 2, "does not lie in its global grid"},
+        {2, 0, 8, 0, 0, 1, 2, "global grid of 0 x 8 cells is not valid"},
+    };
+    for (size_t k = 0; k < sizeof wrong / sizeof *wrong; ++k) {
+        b = as_block(good, size, wrong[k].version, wrong[k].nxg, wrong[k].nyg, wrong[k].i0, wrong[k].j0,
+                     wrong[k].rank, wrong[k].ranks, &n);
+        write_file(bad, b, n);
+        require_refused(bad, wrong[k].phrase, wrong[k].phrase);
+        free(b);
+    }
+    /* The flag without the record: the file is 48 bytes short. */
+    unsigned char *bytes = malloc(size);
+    memcpy(bytes, good, size);
+    put_u32(bytes + kOffsetVersion, 2);
+    put_u32(bytes + kOffsetFlags, get_u32(bytes + kOffsetFlags) | 16u);
+    reseal(bytes, size);
+    write_file(bad, bytes, size);
+    require_refused(bad, "truncated", "the block flag without its record");
+    /* Version 2 without the flag is a grid of its own. */
+    memcpy(bytes, good, size);
+    put_u32(bytes + kOffsetVersion, 2);
+    reseal(bytes, size);
+    write_file(bad, bytes, size);
+    out = NULL;
+    CHECK_OK(NULL, dpsm_load(bad, &out));
+    dpsm_destroy(out);
     free(bytes);
     free(good);
 }
@@ -613,6 +702,7 @@ int main(void) {
         cmocka_unit_test(test_every_changed_byte_is_refused),
         cmocka_unit_test(test_every_truncation_is_refused),
         cmocka_unit_test(test_values_are_checked_behind_the_checksum),
+        cmocka_unit_test(test_block_files_need_dpsm_load_mpi),
         cmocka_unit_test(test_files_that_cannot_be_used),
         cmocka_unit_test(test_failed_save_leaves_the_old_file),
         cmocka_unit_test(test_null_arguments),

@@ -14,13 +14,19 @@
 !> MPI_Comm (dpsm_create_2d_mpi_f, MPI_Comm_f2c). i0 and j0 are 0-based, as
 !> every block offset of module dpsm; sizes are integer(c_int64_t) or default
 !> integers. Without ierr a failure stops the program with the message.
+!>
+!>     call dpsm_load_mpi(g, comm, path[, ierr])
+!>
+!> reads back this rank's block of a distributed grid from the file path that
+!> this rank wrote with dpsm_save (collective over comm, on as many ranks as
+!> saved it; trailing blanks of path are dropped).
 module dpsm_mpi
-  use, intrinsic :: iso_c_binding, only: c_ptr, c_int, c_int32_t, c_int64_t, c_double
+  use, intrinsic :: iso_c_binding, only: c_ptr, c_int, c_int32_t, c_int64_t, c_double, c_char, c_null_char
   use dpsm, only: dpsm_grid, dpsm_adopt_handle, dpsm_status_string, dpsm_last_error, DPSM_OK
   implicit none
   private
 
-  public :: dpsm_create_2d_mpi
+  public :: dpsm_create_2d_mpi, dpsm_load_mpi
 
   interface dpsm_create_2d_mpi
     module procedure create_2d_mpi_i64, create_2d_mpi_i32
@@ -37,6 +43,14 @@ module dpsm_mpi
       type(c_ptr), intent(out) :: out
       integer(c_int) :: status
     end function c_dpsm_create_2d_mpi_f
+
+    function c_dpsm_load_mpi_f(comm, path, out) bind(C, name='dpsm_load_mpi_f') result(status)
+      import :: c_int, c_char, c_ptr
+      integer(c_int), value :: comm
+      character(kind=c_char), intent(in) :: path(*)
+      type(c_ptr), intent(out) :: out
+      integer(c_int) :: status
+    end function c_dpsm_load_mpi_f
   end interface
 
 contains
@@ -70,5 +84,25 @@ contains
     call create_2d_mpi_i64(g, comm, int(nx_global, c_int64_t), int(ny_global, c_int64_t), int(i0, c_int64_t), &
                            int(j0, c_int64_t), int(nx_local, c_int64_t), int(ny_local, c_int64_t), dx, dy, ierr)
   end subroutine create_2d_mpi_i32
+
+  !> dpsm_load_mpi(g, comm, path[, ierr]): this rank's block of the distributed
+  !> grid saved by dpsm_save, from the file path this rank wrote. Collective
+  !> over comm. On failure g holds no grid on any rank, and the message is
+  !> dpsm_last_error() (without a grid).
+  subroutine dpsm_load_mpi(g, comm, path, ierr)
+    type(dpsm_grid), intent(out) :: g
+    integer, intent(in) :: comm
+    character(len=*), intent(in) :: path
+    integer, intent(out), optional :: ierr
+    type(c_ptr) :: ptr
+    integer(c_int) :: status
+    status = c_dpsm_load_mpi_f(int(comm, c_int), trim(path)//c_null_char, ptr)
+    call dpsm_adopt_handle(g, ptr, status)
+    if (present(ierr)) then
+      ierr = int(status)
+    else if (status /= DPSM_OK) then
+      error stop 'dpsm_load_mpi failed: '//dpsm_status_string(status)//': '//dpsm_last_error()
+    end if
+  end subroutine dpsm_load_mpi
 
 end module dpsm_mpi

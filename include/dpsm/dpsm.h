@@ -592,6 +592,11 @@ DPSM_API int dpsm_set_static_angle(dpsm_grid *g, double radians);
  * CRC-32 checksum. The file is written to `path` through a temporary file
  * that replaces it only when complete.
  *
+ * On a distributed grid (dpsm_mpi.h) the call is collective: each rank writes
+ * its own block to the path it passes (each rank its own file), and when any
+ * rank fails every rank returns that rank's status (its message says why, the
+ * others' name it); read the files back with dpsm_load_mpi().
+ *
  * @param g     the grid.
  * @param path  the file to write.
  * @return ::DPSM_OK, ::DPSM_ERR_NULL_POINTER or ::DPSM_ERR_IO (the message
@@ -605,12 +610,15 @@ DPSM_API int dpsm_save(const dpsm_grid *g, const char *path);
  * The new grid continues exactly as the saved one would have: the same calls
  * give bit-identical heights and ledger. A file that is truncated, corrupted
  * (any byte changed), of another format or of a newer version is refused with
- * a message that says which; no grid is made.
+ * a message that says which; no grid is made. A file that holds one rank's
+ * block of a distributed grid is refused with ::DPSM_ERR_NOT_APPLICABLE: it is
+ * read by dpsm_load_mpi() on as many ranks.
  *
  * @param path  the file to read.
  * @param out   receives the new grid, or NULL on failure.
  * @return ::DPSM_OK, ::DPSM_ERR_NULL_POINTER, ::DPSM_ERR_IO,
- *         ::DPSM_ERR_BAD_FILE or ::DPSM_ERR_OUT_OF_MEMORY. On failure the
+ *         ::DPSM_ERR_BAD_FILE, ::DPSM_ERR_NOT_APPLICABLE or
+ *         ::DPSM_ERR_OUT_OF_MEMORY. On failure the
  *         message is read with `dpsm_last_error(NULL)`.
  */
 DPSM_API int dpsm_load(const char *path, dpsm_grid **out);

@@ -21,7 +21,8 @@
  *    on every rank.
  *
  * Collective calls: dpsm_create_2d_mpi(), dpsm_create_2d_mpi_f(), dpsm_step(),
- * dpsm_get_mass() and dpsm_destroy(). Every rank
+ * dpsm_get_mass(), dpsm_save(), dpsm_load_mpi(), dpsm_load_mpi_f() and
+ * dpsm_destroy(). Every rank
  * of the communicator must call the collective ones, in the same order, with
  * the same `dt` and the same parameters (repose angle, mobility, scheme, rest
  * tolerance, sub-step limit, sides, flux exponent, static angle) and the same
@@ -31,8 +32,14 @@
  * dpsm_step() or dpsm_get_mass() are refused (a `dt` that is not finite or not
  * positive, a NULL `value`, an unknown quantity) still takes part, and the
  * call fails on every rank: no rank waits for it. All other calls are local to the
- * rank. dpsm_save() refuses a distributed grid (::DPSM_ERR_NOT_APPLICABLE):
- * restart files hold one grid.
+ * rank.
+ *
+ * Restart files: dpsm_save() on a distributed grid writes each rank's block to
+ * the path that rank passes (one file per rank, e.g. `run.0003.dpsm` for rank
+ * 3: each rank its own path), and dpsm_load_mpi() reads them back on as many
+ * ranks, each rank the file it saved; the run continues bit for bit. The
+ * files of one save carry a mark of that save, so that a set mixing files of
+ * different saves, ranks or decompositions is refused on every rank.
  *
  * Link with `-ldpsm_mpi` (pkg-config: `dpsm-mpi`; CMake: `dpsm::dpsm_mpi`)
  * instead of `-ldpsm`: libdpsm_mpi holds the whole library. This header
@@ -109,6 +116,51 @@ DPSM_API int dpsm_create_2d_mpi(MPI_Comm comm, int64_t nx_global, int64_t ny_glo
  */
 DPSM_API int dpsm_create_2d_mpi_f(MPI_Fint comm, int64_t nx_global, int64_t ny_global, int64_t i0, int64_t j0,
                                   int64_t nx_local, int64_t ny_local, double dx, double dy, dpsm_grid **out);
+
+/**
+ * @brief Loads this rank's block of a distributed grid from a file that
+ *        dpsm_save() wrote on a distributed grid.
+ *
+ * Collective over @p comm: every rank calls it once with the path of the file
+ * it saved (the same rank of a communicator of the same size as the one the
+ * grid was saved on). Each rank reads and checks its own file as dpsm_load()
+ * does; then the ranks check together that their files are the blocks of one
+ * save and tile the global grid. The grid made is the one that was saved,
+ * block by block, with its parameters, masks, physics, ledger and last step's
+ * figures; it continues bit for bit, as the saved grid would have, as long
+ * as the host makes the same calls. The grid keeps a duplicate of @p comm.
+ *
+ * When any rank fails, every rank fails and no grid is made (`*out` is NULL
+ * on every rank): the failing rank's dpsm_last_error(NULL) names its file and
+ * the problem, the others name the rank that failed and carry its status.
+ *
+ * @param comm the host's communicator (an intracommunicator of as many ranks
+ *             as saved the grid); MPI must be initialized.
+ * @param path this rank's file (NUL-terminated).
+ * @param out  receives the handle (NULL on failure); release it with dpsm_destroy() on every rank.
+ * @return #DPSM_OK; #DPSM_ERR_NULL_POINTER (@p path or @p out NULL on some rank);
+ *         #DPSM_ERR_IO (a file cannot be read); #DPSM_ERR_BAD_FILE (a file is
+ *         damaged, or the files are of different saves);
+ *         #DPSM_ERR_NOT_APPLICABLE (a file holds a grid of its own: see dpsm_load());
+ *         #DPSM_ERR_INVALID_SIZE (the grid was saved on another number of ranks);
+ *         #DPSM_ERR_INVALID_VALUE (a rank was given another rank's file; MPI
+ *         not initialized or @p comm MPI_COMM_NULL); #DPSM_ERR_OUT_OF_MEMORY;
+ *         #DPSM_ERR_INTERNAL (an MPI call failed).
+ */
+DPSM_API int dpsm_load_mpi(MPI_Comm comm, const char *path, dpsm_grid **out);
+
+/**
+ * @brief dpsm_load_mpi() for a Fortran communicator.
+ *
+ * The same as dpsm_load_mpi(MPI_Comm_f2c(comm), path, out); the Fortran module
+ * `dpsm_mpi` calls it.
+ *
+ * @param comm the Fortran handle of the host's communicator.
+ * @param path this rank's file (NUL-terminated).
+ * @param out  receives the handle (NULL on failure).
+ * @return as dpsm_load_mpi().
+ */
+DPSM_API int dpsm_load_mpi_f(MPI_Fint comm, const char *path, dpsm_grid **out);
 
 #ifdef __cplusplus
 }

@@ -9,6 +9,10 @@
 //    and sources go the same way, but only when the host changed them on some
 //    rank. Neighbours are found from the rectangles alone, so blocks narrower
 //    than the halo simply have more of them;
+//  - restart files: each rank saves its block to its own file, which records
+//    the block's place and a mark shared by all files of that save; a load
+//    reads them back on as many ranks, checks that they are the blocks of one
+//    save, and builds the grid as dpsm_create_2d_mpi does;
 //  - agreement: one MAX all-reduce before a step (flags, and the parameters,
 //    so that ranks that disagree fail alike), one after each sweep (each
 //    level's "moved" and largest excess slope), and gathers for sums, which
@@ -21,12 +25,14 @@
 #include <mpi.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <limits>
 #include <memory>
 #include <new>
+#include <random>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -40,6 +46,7 @@
 #include "grid.hpp"
 #include "handle.hpp"
 #include "ledger.hpp"
+#include "restart.hpp"
 #include "tiled_sweep.hpp"
 
 namespace dpsm {
@@ -287,12 +294,49 @@ public:
         return total;
     }
 
-private:
-    int ranks() const {
+    int rank() const override {
+        int rank = 0;
+        MPI_Comm_rank(comm_, &rank);
+        return rank;
+    }
+
+    int ranks() const override {
         int size = 1;
         MPI_Comm_size(comm_, &size);
         return size;
     }
+
+    std::uint64_t shared_mark() const override {
+        std::uint64_t mark = 0;
+        if (rank() == 0) {
+            // The clock alone would do between saves of one run; the random
+            // bits tell apart runs that save at the same instant.
+            mark = static_cast<std::uint64_t>(std::chrono::system_clock::now().time_since_epoch().count());
+            try {
+                std::random_device device;
+                mark ^= (static_cast<std::uint64_t>(device()) << 32) ^ device();
+            } catch (const std::exception &) {
+                // No random device here: the clock's mark stands.
+            }
+        }
+        check_mpi(MPI_Bcast(&mark, 1, MPI_UINT64_T, 0, comm_), "MPI_Bcast of the save's mark");
+        return mark;
+    }
+
+    void first_failure(int status, int &failed_rank, int &failed_status) const override {
+        std::vector<int> all(static_cast<std::size_t>(ranks()));
+        check_mpi(MPI_Allgather(&status, 1, MPI_INT, all.data(), 1, MPI_INT, comm_), "MPI_Allgather of the statuses");
+        failed_rank = -1;
+        failed_status = DPSM_OK;
+        for (std::size_t r = 0; r < all.size(); ++r)
+            if (all[r] != DPSM_OK) {
+                failed_rank = static_cast<int>(r);
+                failed_status = all[r];
+                return;
+            }
+    }
+
+private:
 
     // Calls f(cell index in the block) for the cells of r (global coordinates, inside the block), x fastest.
     template <class F>
@@ -450,75 +494,165 @@ void check_decomposition(const std::vector<Arguments> &all, const char *fn) {
     }
 }
 
+// Checks that MPI is running and `comm` is an intracommunicator; its rank and size.
+void check_communicator(MPI_Comm comm, const char *fn, int &rank, int &size) {
+    int initialized = 0, finalized = 0;
+    MPI_Initialized(&initialized);
+    MPI_Finalized(&finalized);
+    if (!initialized || finalized)
+        fail(DPSM_ERR_INVALID_VALUE, fn, "MPI is ", finalized ? "finalized" : "not initialized", "; call ", fn,
+             " between MPI_Init and MPI_Finalize");
+    if (comm == MPI_COMM_NULL) fail(DPSM_ERR_INVALID_VALUE, fn, "comm is MPI_COMM_NULL");
+    int inter = 0;
+    check_mpi(MPI_Comm_test_inter(comm, &inter), "MPI_Comm_test_inter");
+    if (inter) fail(DPSM_ERR_INVALID_VALUE, fn, "comm is an intercommunicator; pass an intracommunicator");
+    check_mpi(MPI_Comm_rank(comm, &rank), "MPI_Comm_rank");
+    check_mpi(MPI_Comm_size(comm, &size), "MPI_Comm_size");
+}
+
+// Gathers every rank's arguments and checks them together, so that all fail alike.
+std::vector<Rect> agreed_blocks(MPI_Comm comm, int size, const Arguments &mine, const char *fn) {
+    std::vector<Arguments> all(static_cast<std::size_t>(size));
+    check_mpi(MPI_Allgather(&mine, static_cast<int>(sizeof(Arguments)), MPI_BYTE, all.data(),
+                            static_cast<int>(sizeof(Arguments)), MPI_BYTE, comm),
+              "MPI_Allgather of the blocks");
+    check_decomposition(all, fn);
+    std::vector<Rect> blocks;
+    for (const Arguments &a : all) blocks.push_back({a.i0, a.j0, a.nx_local, a.ny_local});
+    return blocks;
+}
+
+// Makes the block's grid with `build` (which may throw std::bad_alloc) and
+// ties it to a duplicate of `comm`. Allocation failures are agreed on before
+// the communicator is duplicated, so that no rank keeps a grid its peers do
+// not have.
+template <class Build>
+dpsm_grid *distributed_grid(MPI_Comm comm, int rank, const std::vector<Rect> &blocks, std::int64_t nx_global,
+                            std::int64_t ny_global, Build &&build, const char *fn) {
+    std::unique_ptr<dpsm_grid> made;
+    int failed = 0;
+    try {
+        made = build();
+    } catch (const std::bad_alloc &) {
+        failed = 1;
+    }
+    check_mpi(MPI_Allreduce(MPI_IN_PLACE, &failed, 1, MPI_INT, MPI_MAX, comm), "MPI_Allreduce");
+    if (failed) fail(DPSM_ERR_OUT_OF_MEMORY, fn, "out of memory for the block on some rank");
+    MPI_Comm own = MPI_COMM_NULL;
+    check_mpi(MPI_Comm_dup(comm, &own), "MPI_Comm_dup");
+    MPI_Comm_set_errhandler(own, MPI_ERRORS_RETURN);
+    try {
+        made->core.set_decomposition(std::make_unique<MpiDecomposition>(own, rank, blocks, nx_global, ny_global));
+    } catch (...) {
+        MPI_Comm_free(&own);
+        throw;
+    }
+    return made.release();
+}
+
+// Runs `body` (which makes a grid without a handle to report on) and turns
+// whatever it throws into a status and the message of dpsm_last_error(NULL).
+template <class Body>
+int without_grid(const char *fn, Body &&body) noexcept {
+    try {
+        body();
+        set_error_without_grid("");
+        return DPSM_OK;
+    } catch (const Error &e) {
+        set_error_without_grid(e.what());
+        return e.status();
+    } catch (const std::bad_alloc &) {
+        set_error_without_grid((std::string(fn) + ": out of memory").c_str());
+        return DPSM_ERR_OUT_OF_MEMORY;
+    } catch (const std::exception &e) {
+        set_error_without_grid(e.what());
+        return DPSM_ERR_INTERNAL;
+    } catch (...) {
+        set_error_without_grid("dpsm: internal error of unknown kind");
+        return DPSM_ERR_INTERNAL;
+    }
+}
+
 int create_distributed(MPI_Comm comm, std::int64_t nx_global, std::int64_t ny_global, std::int64_t i0,
                        std::int64_t j0, std::int64_t nx_local, std::int64_t ny_local, double dx, double dy,
                        dpsm_grid **out, const char *fn) noexcept {
     if (out) *out = nullptr;
-    dpsm_grid *made = nullptr;
-    try {
-        int initialized = 0, finalized = 0;
-        MPI_Initialized(&initialized);
-        MPI_Finalized(&finalized);
-        if (!initialized || finalized)
-            fail(DPSM_ERR_INVALID_VALUE, fn, "MPI is ", finalized ? "finalized" : "not initialized",
-                 "; call dpsm_create_2d_mpi between MPI_Init and MPI_Finalize");
-        if (comm == MPI_COMM_NULL) fail(DPSM_ERR_INVALID_VALUE, fn, "comm is MPI_COMM_NULL");
-        int inter = 0;
-        check_mpi(MPI_Comm_test_inter(comm, &inter), "MPI_Comm_test_inter");
-        if (inter) fail(DPSM_ERR_INVALID_VALUE, fn, "comm is an intercommunicator; pass an intracommunicator");
+    return without_grid(fn, [&] {
         int rank = 0, size = 0;
-        check_mpi(MPI_Comm_rank(comm, &rank), "MPI_Comm_rank");
-        check_mpi(MPI_Comm_size(comm, &size), "MPI_Comm_size");
-
-        // Every rank checks everyone's arguments, so that all fail alike.
+        check_communicator(comm, fn, rank, size);
         const Arguments mine{nx_global, ny_global, i0, j0, nx_local, ny_local, out == nullptr ? 1 : 0, dx, dy};
-        std::vector<Arguments> all(static_cast<std::size_t>(size));
-        check_mpi(MPI_Allgather(&mine, static_cast<int>(sizeof(Arguments)), MPI_BYTE, all.data(),
-                                static_cast<int>(sizeof(Arguments)), MPI_BYTE, comm),
-                  "MPI_Allgather of the blocks");
-        check_decomposition(all, fn);
+        const std::vector<Rect> blocks = agreed_blocks(comm, size, mine, fn);
+        *out = distributed_grid(comm, rank, blocks, nx_global, ny_global, [&] {
+            return std::make_unique<dpsm_grid>(Geometry{2, false, nx_local, ny_local, dx, dy});
+        }, fn);
+    });
+}
 
-        std::vector<Rect> blocks;
-        for (const Arguments &a : all) blocks.push_back({a.i0, a.j0, a.nx_local, a.ny_local});
-        // Allocation failures are agreed on before the communicator is
-        // duplicated, so that no rank keeps a grid its peers do not have.
-        int failed = 0;
+std::string hex64(std::uint64_t v) {
+    std::ostringstream s;
+    s << "0x" << std::hex << v;
+    return s.str();
+}
+
+// Each rank reads its own file, of the block it saved; then every rank learns
+// whether all could, and whether the files are the blocks of one save, before
+// any grid is made: every rank fails alike, none waits.
+int load_distributed(MPI_Comm comm, const char *path, dpsm_grid **out, const char *fn) noexcept {
+    if (out) *out = nullptr;
+    return without_grid(fn, [&] {
+        int rank = 0, size = 0;
+        check_communicator(comm, fn, rank, size);
+        Geometry geometry{};
+        GridState state;
+        RestartBlock block;
+        int status = DPSM_OK;
+        std::string reason;
         try {
-            made = new dpsm_grid(Geometry{2, false, nx_local, ny_local, dx, dy});
+            if (!path) fail(DPSM_ERR_NULL_POINTER, fn, "path is NULL");
+            if (!out) fail(DPSM_ERR_NULL_POINTER, fn, "out is NULL");
+            load_restart(path, geometry, state, block, fn);
+            if (!block.present)
+                fail(DPSM_ERR_NOT_APPLICABLE, fn, path,
+                     " holds a grid of its own, not a block of a distributed grid; load it with dpsm_load");
+            if (block.ranks != size)
+                fail(DPSM_ERR_INVALID_SIZE, fn, path, " holds a block of a grid saved on ", block.ranks,
+                     " ranks; this communicator has ", size, " (load a distributed grid on as many ranks as saved it)");
+            if (block.rank != rank)
+                fail(DPSM_ERR_INVALID_VALUE, fn, path, " holds the block of rank ", block.rank, "; this is rank ", rank,
+                     " (each rank loads the file it saved)");
+        } catch (const Error &e) {
+            status = e.status();
+            reason = e.what();
         } catch (const std::bad_alloc &) {
-            failed = 1;
+            status = DPSM_ERR_OUT_OF_MEMORY;
+            reason = std::string(fn) + ": out of memory for the file";
         }
-        check_mpi(MPI_Allreduce(MPI_IN_PLACE, &failed, 1, MPI_INT, MPI_MAX, comm), "MPI_Allreduce");
-        if (failed) fail(DPSM_ERR_OUT_OF_MEMORY, fn, "out of memory for the block on some rank");
-        MPI_Comm own = MPI_COMM_NULL;
-        check_mpi(MPI_Comm_dup(comm, &own), "MPI_Comm_dup");
-        MPI_Comm_set_errhandler(own, MPI_ERRORS_RETURN);
-        try {
-            made->core.set_decomposition(std::make_unique<MpiDecomposition>(own, rank, blocks, nx_global, ny_global));
-        } catch (...) {
-            MPI_Comm_free(&own);
-            throw;
-        }
-        *out = made;
-        set_error_without_grid("");
-        return DPSM_OK;
-    } catch (const Error &e) {
-        delete made;
-        set_error_without_grid(e.what());
-        return e.status();
-    } catch (const std::bad_alloc &) {
-        delete made;
-        set_error_without_grid((std::string(fn) + ": out of memory").c_str());
-        return DPSM_ERR_OUT_OF_MEMORY;
-    } catch (const std::exception &e) {
-        delete made;
-        set_error_without_grid(e.what());
-        return DPSM_ERR_INTERNAL;
-    } catch (...) {
-        delete made;
-        set_error_without_grid("dpsm: internal error of unknown kind");
-        return DPSM_ERR_INTERNAL;
-    }
+        std::vector<int> statuses(static_cast<std::size_t>(size));
+        check_mpi(MPI_Allgather(&status, 1, MPI_INT, statuses.data(), 1, MPI_INT, comm), "MPI_Allgather of the statuses");
+        if (status != DPSM_OK) throw Error(status, reason);
+        for (int r = 0; r < size; ++r)
+            if (statuses[static_cast<std::size_t>(r)] != DPSM_OK)
+                fail(statuses[static_cast<std::size_t>(r)], fn, "rank ", r, " could not load its file (",
+                     dpsm_status_string(statuses[static_cast<std::size_t>(r)]),
+                     "; its dpsm_last_error(NULL) says why), so no rank loaded");
+
+        std::vector<std::uint64_t> marks(static_cast<std::size_t>(size));
+        check_mpi(MPI_Allgather(&block.save_mark, 1, MPI_UINT64_T, marks.data(), 1, MPI_UINT64_T, comm),
+                  "MPI_Allgather of the saves' marks");
+        for (int r = 1; r < size; ++r)
+            if (marks[static_cast<std::size_t>(r)] != marks[0])
+                fail(DPSM_ERR_BAD_FILE, fn, "the files are not the blocks of one save: rank 0's file was written by the "
+                     "save marked ", hex64(marks[0]), ", rank ", r, "'s by the save marked ",
+                     hex64(marks[static_cast<std::size_t>(r)]), " (each rank must load the file of the same save)");
+        const Arguments mine{block.global_nx, block.global_ny, block.i0, block.j0, geometry.nx, geometry.ny, 0,
+                             geometry.dx, geometry.dy};
+        const std::vector<Rect> blocks = agreed_blocks(comm, size, mine, fn);
+        *out = distributed_grid(comm, rank, blocks, block.global_nx, block.global_ny, [&] {
+            auto grid = std::make_unique<dpsm_grid>(geometry);
+            grid->core.restore(std::move(state));
+            return grid;
+        }, fn);
+    });
 }
 
 }  // namespace
@@ -536,6 +670,14 @@ int dpsm_create_2d_mpi_f(MPI_Fint comm, int64_t nx_global, int64_t ny_global, in
                          int64_t nx_local, int64_t ny_local, double dx, double dy, dpsm_grid **out) {
     return dpsm::create_distributed(MPI_Comm_f2c(comm), nx_global, ny_global, i0, j0, nx_local, ny_local, dx, dy,
                                     out, "dpsm_create_2d_mpi_f");
+}
+
+int dpsm_load_mpi(MPI_Comm comm, const char *path, dpsm_grid **out) {
+    return dpsm::load_distributed(comm, path, out, "dpsm_load_mpi");
+}
+
+int dpsm_load_mpi_f(MPI_Fint comm, const char *path, dpsm_grid **out) {
+    return dpsm::load_distributed(MPI_Comm_f2c(comm), path, out, "dpsm_load_mpi_f");
 }
 
 }  // extern "C"

@@ -583,17 +583,14 @@ static void refusing_rank(void) {
     dpsm_destroy(g);
 }
 
-/* Restart files are not distributed yet: dpsm_save refuses a distributed
- * grid. The physics setters work, but every rank must use the same features:
- * a bed on some ranks only is refused by the next step, on every rank. */
+/* The physics setters work, but every rank must use the same features: a
+ * bed on some ranks only is refused by the next step, on every rank. */
 static void physics_agreement(void) {
     const int64_t nx = 40, ny = 30;
     block_t b = block_of(GRID_2D, rank_, size_, nx, ny);
     dpsm_grid *g = NULL;
     OK(NULL, dpsm_create_2d_mpi(MPI_COMM_WORLD, nx, ny, b.i0, b.j0, b.ni, b.nj, 1.0, 1.0, &g));
     if (!g) return;
-    const int saved = dpsm_save(g, "dpsm_mpi_refused.dpsm");
-    require(saved == DPSM_ERR_NOT_APPLICABLE, "dpsm_save on a distributed grid: %s", dpsm_status_string(saved));
     if (size_ > 1) {
         double *zeros_here = calloc((size_t)(b.ni * b.nj), sizeof(double));
         if (rank_ == 0) OK(g, dpsm_set_bedrock(g, zeros_here));
@@ -605,6 +602,188 @@ static void physics_agreement(void) {
         free(zeros_here);
     }
     dpsm_destroy(g);
+}
+
+/* ---- restart files ------------------------------------------------------- */
+
+/* This rank's file of save `name` (the rank count in the name: the runs on 1,
+ * 2 and 4 ranks may share the directory at the same time). */
+static void restart_path(char *out, size_t n, const char *name, int rank) {
+    snprintf(out, n, "dpsm_mpi_%s.%dof%d.dpsm", name, rank, size_);
+}
+
+/* Every rank must fail with a status in `statuses` (or any non-zero status when
+ * that is 0), *out NULL, and a message containing `needle`. */
+static void expect_load_fails(MPI_Comm comm, const char *path, int null_out, int status_wanted, const char *needle,
+                              const char *what) {
+    dpsm_grid *g = (dpsm_grid *)&g; /* not NULL: the call must set it to NULL */
+    const int status = dpsm_load_mpi(comm, path, null_out ? NULL : &g);
+    const char *msg = dpsm_last_error(NULL);
+    require(status != DPSM_OK && (status_wanted == 0 || status == status_wanted),
+            "%s: dpsm_load_mpi returned %s (wanted %s): %s", what, dpsm_status_string(status),
+            status_wanted ? dpsm_status_string(status_wanted) : "a failure", msg);
+    require(strstr(msg, needle) != NULL, "%s: the message \"%s\" does not name the problem (\"%s\")", what, msg, needle);
+    if (!null_out) require(g == NULL, "%s: *out is not NULL after a failure", what);
+    if (rank_ == 0 && status != DPSM_OK) printf("    %s: %s\n", what, msg);
+}
+
+/* Compares two distributed grids: heights bit for bit, every mass figure and
+ * the step information exactly; the cells a step computed (its cost, not the
+ * state) only when `with_cost`: a loaded grid visits every tile once. */
+static void compare_grids(const dpsm_grid *a, const dpsm_grid *b, block_t blk, int with_cost, const char *what) {
+    const size_t cells = (size_t)(blk.ni * blk.nj);
+    double *ha = malloc(cells * sizeof(double)), *hb = malloc(cells * sizeof(double));
+    OK(a, dpsm_get_heights(a, ha));
+    OK(b, dpsm_get_heights(b, hb));
+    size_t differ = 0;
+    for (size_t c = 0; c < cells; ++c) differ += memcmp(&ha[c], &hb[c], sizeof(double)) != 0;
+    require(differ == 0, "%s: %zu of %zu cells differ between the saved grid and the loaded one", what, differ, cells);
+    const int q[] = {DPSM_MASS_TOTAL, DPSM_MASS_SOURCED, DPSM_MASS_EXTERNAL, DPSM_MASS_OUTFLOW, DPSM_MASS_UNMET};
+    for (int k = 0; k < 5; ++k) {
+        double ma = -1, mb = -2;
+        OK(a, dpsm_get_mass(a, q[k], &ma));
+        OK(b, dpsm_get_mass(b, q[k], &mb));
+        require(memcmp(&ma, &mb, sizeof ma) == 0, "%s: mass quantity %d is %.17g saved, %.17g loaded", what, q[k], ma, mb);
+    }
+    const int items[] = {DPSM_INFO_SUBSTEPS, DPSM_INFO_TIME_INTEGRATED, DPSM_INFO_AT_REST, DPSM_INFO_MAX_EXCESS_SLOPE,
+                         DPSM_INFO_CELL_UPDATES};
+    for (int k = 0; k < (with_cost ? 5 : 4); ++k) {
+        double ia = -1, ib = -2;
+        OK(a, dpsm_get_step_info(a, items[k], &ia));
+        OK(b, dpsm_get_step_info(b, items[k], &ib));
+        require(ia == ib, "%s: step info %d is %.17g saved, %.17g loaded", what, items[k], ia, ib);
+    }
+    free(ha);
+    free(hb);
+}
+
+/* dpsm_save on a distributed grid writes one file per rank, dpsm_load_mpi
+ * reads them back, and the loaded grid continues bit for bit: heights, all
+ * five mass figures and the step information, for several steps with the
+ * host's changes, on every decomposition. Then every wrong set of files is
+ * refused on every rank, and a save that fails on one rank fails on all. */
+static void restart_files(void) {
+    scene_t s = physics(); /* bed, erosion, angle field, exponent 1.5, hysteresis, a source */
+    s.bump_before_step = 4;
+    s.bump = (block_t){40, 30, 30, 30};
+    char path[256], other[256];
+    for (int kind = 0; kind < N_DECOMPOSITIONS; ++kind) {
+        char what[160];
+        snprintf(what, sizeof what, "restart, %s", decomposition_names[kind]);
+        block_t b = block_of(kind, rank_, size_, s.nx, s.ny);
+        const long failures_before = failures_;
+        dpsm_grid *g = NULL, *loaded = NULL;
+        OK(NULL, dpsm_create_2d_mpi(MPI_COMM_WORLD, s.nx, s.ny, b.i0, b.j0, b.ni, b.nj, s.dx, s.dy, &g));
+        if (!g) continue;
+        set_scene(g, &s, b);
+        double stable = 0;
+        OK(g, dpsm_stable_dt(g, &stable));
+        const double dt = s.dt_in_stable_steps * stable;
+        for (int step = 0; step < 3; ++step) OK(g, dpsm_step(g, dt));
+        restart_path(path, sizeof path, "restart", rank_);
+        OK(g, dpsm_save(g, path));
+        OK(NULL, dpsm_load_mpi(MPI_COMM_WORLD, path, &loaded));
+        if (!loaded) {
+            dpsm_destroy(g);
+            continue;
+        }
+        compare_grids(g, loaded, b, 1, what);
+        for (int step = 3; step < 7; ++step) {
+            host_changes(g, &s, b, step);
+            host_changes(loaded, &s, b, step);
+            OK(g, dpsm_step(g, dt));
+            OK(loaded, dpsm_step(loaded, dt));
+            char at[200];
+            snprintf(at, sizeof at, "%s, step %d after the load", what, step);
+            compare_grids(g, loaded, b, 0, at);
+        }
+        double substeps = 0;
+        OK(g, dpsm_get_step_info(g, DPSM_INFO_SUBSTEPS, &substeps));
+        require(substeps > 0, "%s: the scene was at rest after the load: it tests nothing", what);
+        long mine = failures_ - failures_before, total = 0;
+        MPI_Allreduce(&mine, &total, 1, MPI_LONG, MPI_SUM, MPI_COMM_WORLD);
+        if (rank_ == 0) printf("  %s: %s\n", what, total == 0 ? "continues bit for bit for 4 steps" : "FAILED");
+        dpsm_destroy(loaded);
+
+        if (kind != GRID_2D) {
+            dpsm_destroy(g);
+            continue;
+        }
+        /* A block file is not a grid of its own. */
+        dpsm_grid *serial = (dpsm_grid *)&serial;
+        int status = dpsm_load(path, &serial);
+        require(status == DPSM_ERR_NOT_APPLICABLE && serial == NULL && strstr(dpsm_last_error(NULL), "dpsm_load_mpi"),
+                "dpsm_load of a block file: %s: %s", dpsm_status_string(status), dpsm_last_error(NULL));
+        if (rank_ == 0) printf("    dpsm_load of a block file: %s\n", dpsm_last_error(NULL));
+        /* Not a block file. */
+        dpsm_grid *own = NULL;
+        restart_path(other, sizeof other, "serial", rank_);
+        OK(NULL, dpsm_create_2d(8, 8, 1.0, 1.0, &own));
+        OK(own, dpsm_save(own, other));
+        dpsm_destroy(own);
+        expect_load_fails(MPI_COMM_WORLD, other, 0, DPSM_ERR_NOT_APPLICABLE, "grid of its own", "a serial file");
+        /* One rank's file missing: that rank says why, the others name it. */
+        restart_path(other, sizeof other, "missing", rank_);
+        if (size_ > 1) {
+            expect_load_fails(MPI_COMM_WORLD, rank_ == 1 ? other : path, 0, DPSM_ERR_IO,
+                              rank_ == 1 ? "cannot open" : "rank 1 could not load", "rank 1's file missing");
+            /* A NULL path or out on one rank. */
+            expect_load_fails(MPI_COMM_WORLD, rank_ == 0 ? NULL : path, 0, DPSM_ERR_NULL_POINTER,
+                              rank_ == 0 ? "path is NULL" : "rank 0 could not load", "a NULL path on rank 0");
+            expect_load_fails(MPI_COMM_WORLD, path, rank_ == size_ - 1, DPSM_ERR_NULL_POINTER,
+                              rank_ == size_ - 1 ? "out is NULL" : "could not load", "a NULL out on the last rank");
+            /* Each rank given the next rank's file. */
+            restart_path(other, sizeof other, "restart", (rank_ + 1) % size_);
+            expect_load_fails(MPI_COMM_WORLD, other, 0, DPSM_ERR_INVALID_VALUE, "holds the block of rank",
+                              "files shifted by one rank");
+            /* One byte changed in rank 1's file. */
+            restart_path(other, sizeof other, "corrupt", rank_);
+            if (rank_ == 1) {
+                FILE *in = fopen(path, "rb"), *out = fopen(other, "wb");
+                int c, at = 0;
+                while (in && out && (c = fgetc(in)) != EOF) fputc(at++ == 500 ? c ^ 0x10 : c, out);
+                if (in) fclose(in);
+                if (out) fclose(out);
+            }
+            expect_load_fails(MPI_COMM_WORLD, rank_ == 1 ? other : path, 0, DPSM_ERR_BAD_FILE,
+                              rank_ == 1 ? "checksum mismatch" : "rank 1 could not load", "a byte changed in rank 1's file");
+            /* Files of two saves mixed: rank 0 keeps the first save's file. */
+            OK(g, dpsm_step(g, dt));
+            restart_path(other, sizeof other, "second", rank_);
+            OK(g, dpsm_save(g, other));
+            expect_load_fails(MPI_COMM_WORLD, rank_ == 0 ? path : other, 0, DPSM_ERR_BAD_FILE, "not the blocks of one save",
+                              "files of two saves");
+            /* Loaded on fewer ranks than saved. */
+            MPI_Comm half;
+            MPI_Comm_split(MPI_COMM_WORLD, rank_ < size_ / 2, rank_, &half);
+            if (rank_ < size_ / 2)
+                expect_load_fails(half, path, 0, DPSM_ERR_INVALID_SIZE, "saved on", "half the ranks");
+            MPI_Comm_free(&half);
+            /* A save that fails on one rank fails on every rank. */
+            restart_path(other, sizeof other, "no_such_directory/x", rank_);
+            const char *target = rank_ == 1 ? other : path;
+            status = dpsm_save(g, target);
+            require(status == DPSM_ERR_IO &&
+                        strstr(dpsm_last_error(g), rank_ == 1 ? "cannot write" : "rank 1 of the distributed grid"),
+                    "a save failing on rank 1: %s: %s", dpsm_status_string(status), dpsm_last_error(g));
+            if (rank_ == 0) printf("    a save failing on rank 1: %s\n", dpsm_last_error(g));
+            status = dpsm_save(g, rank_ == 0 ? NULL : path);
+            require(status == DPSM_ERR_NULL_POINTER && strstr(dpsm_last_error(g), rank_ == 0 ? "path is NULL" : "rank 0"),
+                    "a NULL path on rank 0: %s: %s", dpsm_status_string(status), dpsm_last_error(g));
+            /* The grid still steps after the failed saves (no rank was left behind). */
+            OK(g, dpsm_step(g, dt));
+        }
+        dpsm_destroy(g);
+        restart_path(other, sizeof other, "serial", rank_);
+        remove(other);
+        restart_path(other, sizeof other, "second", rank_);
+        remove(other);
+        restart_path(other, sizeof other, "corrupt", rank_);
+        remove(other);
+    }
+    restart_path(path, sizeof path, "restart", rank_);
+    remove(path);
+    free_scene(&s);
 }
 
 int main(int argc, char **argv) {
@@ -631,6 +810,7 @@ int main(int argc, char **argv) {
     disagreeing_ranks();
     refusing_rank();
     physics_agreement();
+    restart_files();
 
     long total = 0, all_checks = 0;
     MPI_Allreduce(&failures_, &total, 1, MPI_LONG, MPI_SUM, MPI_COMM_WORLD);

@@ -1,7 +1,9 @@
 ! The Fortran binding of the MPI component (module dpsm_mpi), under mpiexec:
 ! each rank owns a strip of columns of a 50 x 40 grid; after every step its
 ! block must equal, bit for bit, the same block of a serial run of the whole
-! scene, and the global mass must match; a decomposition with a gap must fail
+! scene, and the global mass must match; a grid saved with dpsm_save and read
+! back with dpsm_load_mpi must continue bit for bit, and a rank given another
+! rank's file must fail on every rank; a decomposition with a gap must fail
 ! on every rank with a message that says so.
 program test_mpi_fortran
   use, intrinsic :: iso_c_binding, only: c_double, c_int64_t
@@ -10,11 +12,12 @@ program test_mpi_fortran
   use dpsm_mpi
   implicit none
   integer, parameter :: nx = 50, ny = 40
-  type(dpsm_grid) :: g, serial
+  type(dpsm_grid) :: g, serial, loaded
   integer :: ierr, rank, ranks, i, j, step, failures, total, i0, ni
   real(c_double) :: h(nx, ny), dt, mass_g, mass_s
   real(c_double), allocatable :: mine(:, :), ref(:, :)
   character(len=:), allocatable :: message
+  character(len=64) :: path, other
 
   call MPI_Init(ierr)
   call MPI_Comm_rank(MPI_COMM_WORLD, rank, ierr)
@@ -61,8 +64,41 @@ program test_mpi_fortran
       print '(a,i0,a,2es25.17)', 'FAIL: rank ', rank, ' global mass differs: ', mass_g, mass_s
     end if
   end do
-  call dpsm_destroy(g)
   call dpsm_destroy(serial)
+
+  ! Saved, read back, and on for two more steps: bit for bit.
+  write (path, '(a,i0,a,i0,a)') 'dpsm_mpi_fortran.', rank, 'of', ranks, '.dpsm'
+  write (other, '(a,i0,a,i0,a)') 'dpsm_mpi_fortran.', mod(rank + 1, ranks), 'of', ranks, '.dpsm'
+  call dpsm_save(g, path)
+  call dpsm_load_mpi(loaded, MPI_COMM_WORLD, path)
+  do step = 1, 2
+    call dpsm_step(g, dt)
+    call dpsm_step(loaded, dt)
+    call dpsm_get_heights(g, mine)
+    call dpsm_get_heights(loaded, ref)
+    call dpsm_get_mass(g, DPSM_MASS_OUTFLOW, mass_g)
+    call dpsm_get_mass(loaded, DPSM_MASS_OUTFLOW, mass_s)
+    if (any(mine /= ref) .or. mass_g /= mass_s) then
+      failures = failures + 1
+      print '(a,i0,a,i0,a,i0,a,2es25.17)', 'FAIL: rank ', rank, ' step ', step, ' after the load: cells differing: ', &
+        count(mine /= ref), ', outflow ', mass_g, mass_s
+    end if
+  end do
+  call dpsm_destroy(loaded)
+  if (ranks > 1) then
+    call dpsm_load_mpi(loaded, MPI_COMM_WORLD, other, ierr)
+    message = dpsm_last_error()
+    if (ierr == DPSM_OK .or. index(message, 'holds the block of rank') == 0 .or. dpsm_associated(loaded)) then
+      failures = failures + 1
+      print '(a,i0,a,i0,2a)', 'FAIL: rank ', rank, ' another rank''s file gave status ', ierr, ' and message: ', message
+    else if (rank == 0) then
+      print '(2a)', 'refused on every rank: ', message
+    end if
+  end if
+  call MPI_Barrier(MPI_COMM_WORLD, ierr)
+  open (newunit=i, file=trim(path), status='old')
+  close (i, status='delete')
+  call dpsm_destroy(g)
 
   ! A gap: the last rank leaves out its last column.
   if (rank == ranks - 1) ni = ni - 1
