@@ -181,6 +181,23 @@ void save_block(const dpsm::Grid &grid, const dpsm::Decomposition &d, const char
     }
     int failed_rank = -1, failed_status = DPSM_OK;
     d.first_failure(status, failed_rank, failed_status);
+    // Once every rank has written, each file must still hold its own block:
+    // ranks given the same path on a shared file system write over each other.
+    if (failed_rank < 0) {
+        try {
+            const dpsm::RestartBlock back = dpsm::written_block(path, fn);
+            if (!back.present || back.rank != block.rank || back.save_mark != block.save_mark)
+                fail(DPSM_ERR_IO, fn, path, " no longer holds this rank's block once every rank has saved: another "
+                     "rank saved to the same file; give each rank its own path");
+        } catch (const Error &e) {
+            status = e.status();
+            reason = e.what();
+        } catch (const std::bad_alloc &) {
+            status = DPSM_ERR_OUT_OF_MEMORY;
+            reason = std::string(fn) + ": out of memory";
+        }
+        d.first_failure(status, failed_rank, failed_status);
+    }
     if (status != DPSM_OK) throw Error(status, reason);
     if (failed_rank >= 0)
         fail(failed_status, fn, "rank ", failed_rank, " of the distributed grid could not save its block (",

@@ -496,6 +496,26 @@ void save_restart(const Grid &grid, const char *path, const char *function, cons
     tmp.keep = true;  // it is the target now
 }
 
+RestartBlock written_block(const char *path, const char *fn) {
+    struct Closer {
+        std::FILE *file;
+        ~Closer() {
+            if (file) std::fclose(file);
+        }
+    } in{std::fopen(path, "rb")};
+    const std::string source(path);
+    if (!in.file) fail(DPSM_ERR_IO, fn, "cannot read back ", source, ": ", system_reason(errno));
+    std::vector<std::uint8_t> bytes;
+    RestartBlock block;
+    if (!read_more(in.file, bytes, kHeaderBytes + kBlockBytes, source, fn)) return block;
+    Header header;
+    GridState ignored;
+    Reader r(bytes, 0, source, fn);
+    read_header(r, header, ignored);
+    read_block(r, header, block);
+    return block;
+}
+
 void load_restart(const char *path, Geometry &geometry, GridState &state, RestartBlock &block, const char *fn) {
     const std::string source(path);
     errno = 0;

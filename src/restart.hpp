@@ -31,6 +31,12 @@ struct RestartBlock {
 // Error (DPSM_ERR_IO) naming the path and the reason.
 void save_restart(const Grid &grid, const char *path, const char *function, const RestartBlock &block = {});
 
+// The block record of a file that dpsm_save has just written (present =
+// false when the file is shorter or holds no block): a distributed save reads
+// it back to see that no other rank wrote over the file. Throws Error
+// (DPSM_ERR_IO) when the file cannot be read.
+RestartBlock written_block(const char *path, const char *function);
+
 // Reads and checks a whole file: on return `geometry` and `state` hold values
 // the setters would accept, and `block` says whether the file holds a block
 // of a distributed grid and where (checked against its geometry only). Throws

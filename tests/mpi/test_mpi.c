@@ -767,6 +767,20 @@ static void restart_files(void) {
                         strstr(dpsm_last_error(g), rank_ == 1 ? "cannot write" : "rank 1 of the distributed grid"),
                     "a save failing on rank 1: %s: %s", dpsm_status_string(status), dpsm_last_error(g));
             if (rank_ == 0) printf("    a save failing on rank 1: %s\n", dpsm_last_error(g));
+            /* Every rank given the same path: they write over each other. */
+            restart_path(other, sizeof other, "shared", 0);
+            status = dpsm_save(g, other);
+            require(status == DPSM_ERR_IO, "one path for every rank: %s: %s", dpsm_status_string(status),
+                    dpsm_last_error(g));
+            /* Which rank finds it depends on the order of the writes: the one
+             * whose file another rank replaced, or whose rename found the
+             * temporary file gone; the others name that rank. */
+            const char *msg = dpsm_last_error(g);
+            require(strstr(msg, "same file") || strstr(msg, "cannot") || strstr(msg, "of the distributed grid could not"),
+                    "one path for every rank: the message names neither the problem nor a rank: %s", msg);
+            if (rank_ == 0) printf("    one path for every rank: %s\n", msg);
+            MPI_Barrier(MPI_COMM_WORLD);
+            if (rank_ == 0) remove(other);
             status = dpsm_save(g, rank_ == 0 ? NULL : path);
             require(status == DPSM_ERR_NULL_POINTER && strstr(dpsm_last_error(g), rank_ == 0 ? "path is NULL" : "rank 0"),
                     "a NULL path on rank 0: %s: %s", dpsm_status_string(status), dpsm_last_error(g));
