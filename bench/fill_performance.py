@@ -55,12 +55,16 @@ def speed_table(data):
 
 
 def steps_table(data):
-    out = ["| scene | method | tolerance | sweeps | seconds | top | top error | deposit error (L1) | at rest |",
-           "| --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
+    out = ["| scene | method | tolerance | sweeps | seconds | top | top error | deposit error (L1) | "
+           "from explicit (L1) | at rest |",
+           "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
     for r in rows(data, "steps"):
+        exact = float(r["deposit_error_percent"])  # nan where no exact deposit is known
+        top_error = f"{float(r['top_error_percent']):+.2f} %" if exact == exact else "(no exact top)"
+        deposit = f"{exact:.2f} %" if exact == exact else ""
         out.append(f"| {r['scene']} | {r['method']} | {r['tolerance']} | {r['sweeps']} | {float(r['seconds']):.3f} | "
-                   f"{float(r['top']):.4f} | {float(r['top_error_percent']):+.2f} % | "
-                   f"{float(r['deposit_error_percent']):.2f} % | {'yes' if r['at_rest'] == '1' else 'no'} |")
+                   f"{float(r['top']):.4f} | {top_error} | {deposit} | "
+                   f"{float(r['difference_from_explicit_percent']):.3f} % | {'yes' if r['at_rest'] == '1' else 'no'} |")
     return out
 
 

@@ -169,26 +169,10 @@ void save_block(const dpsm::Grid &grid, const dpsm::Decomposition &d, const char
     block.ranks = d.ranks();
     int status = DPSM_OK;
     std::string reason;
-    try {
-        require_pointer(path, fn, "path");
-        dpsm::save_restart(grid, path, fn, block);
-    } catch (const Error &e) {
-        status = e.status();
-        reason = e.what();
-    } catch (const std::bad_alloc &) {
-        status = DPSM_ERR_OUT_OF_MEMORY;
-        reason = std::string(fn) + ": out of memory";
-    }
-    int failed_rank = -1, failed_status = DPSM_OK;
-    d.first_failure(status, failed_rank, failed_status);
-    // Once every rank has written, each file must still hold its own block:
-    // ranks given the same path on a shared file system write over each other.
-    if (failed_rank < 0) {
+    // This rank's part, its failure kept for after the ranks have agreed.
+    const auto attempt = [&](auto &&body) {
         try {
-            const dpsm::RestartBlock back = dpsm::written_block(path, fn);
-            if (!back.present || back.rank != block.rank || back.save_mark != block.save_mark)
-                fail(DPSM_ERR_IO, fn, path, " no longer holds this rank's block once every rank has saved: another "
-                     "rank saved to the same file; give each rank its own path");
+            body();
         } catch (const Error &e) {
             status = e.status();
             reason = e.what();
@@ -196,6 +180,22 @@ void save_block(const dpsm::Grid &grid, const dpsm::Decomposition &d, const char
             status = DPSM_ERR_OUT_OF_MEMORY;
             reason = std::string(fn) + ": out of memory";
         }
+    };
+    attempt([&] {
+        require_pointer(path, fn, "path");
+        dpsm::save_restart(grid, path, fn, block);
+    });
+    int failed_rank = -1, failed_status = DPSM_OK;
+    d.first_failure(status, failed_rank, failed_status);
+    // Once every rank has written, each file must still hold its own block:
+    // ranks given the same path on a shared file system write over each other.
+    if (failed_rank < 0) {
+        attempt([&] {
+            const dpsm::RestartBlock back = dpsm::written_block(path, fn);
+            if (!back.present || back.rank != block.rank || back.save_mark != block.save_mark)
+                fail(DPSM_ERR_IO, fn, path, " no longer holds this rank's block once every rank has saved: another "
+                     "rank saved to the same file; give each rank its own path");
+        });
         d.first_failure(status, failed_rank, failed_status);
     }
     if (status != DPSM_OK) throw Error(status, reason);
