@@ -523,6 +523,22 @@ static void test_block_files_need_dpsm_load_mpi(void **state) {
             dpsm_status_string(status), message);
     REQUIRE(strstr(message, "rank 1 of a grid distributed over 2 ranks") && strstr(message, "dpsm_load_mpi"),
             "a block file: the message does not say what it is and what reads it: %s", message);
+    /* Every changed byte of a block file, its block record included, is a bad file. */
+    unsigned char *changed = malloc(n);
+    const unsigned char masks[2] = {0xff, 0x01};
+    for (int m = 0; m < 2; ++m)
+        for (size_t at = 0; at < n; ++at) {
+            memcpy(changed, b, n);
+            changed[at] ^= masks[m];
+            write_file(bad, changed, n);
+            char what[96];
+            snprintf(what, sizeof what, "block file, byte %zu ^ 0x%02x", at, masks[m]);
+            require_refused(bad, at < 8 ? "not a dpsm restart file" : at < 12 ? NULL
+                                 : at < kHeaderBytes ? "checksum mismatch in its header" : "checksum mismatch",
+                            what);
+        }
+    print_message("%zu changed block files of %zu bytes, all refused\n", 2 * n, n);
+    free(changed);
     free(b);
 
     struct {
