@@ -125,6 +125,7 @@ void Grid::restore(GridState &&s) {
     max_substeps_ = s.max_substeps;
     threads_ = s.threads;
     scheme_ = s.scheme;
+    relax_to_rest_ = s.relax_to_rest;
     side_open_ = s.side_open;
     heights_ = std::move(s.heights);
     residuals_ = std::move(s.residuals);
