@@ -85,6 +85,25 @@ void Grid::write_heights(const Block &block, const double *values, bool add) {
     }
 }
 
+void Grid::set_heights_between_sweeps(const std::vector<double> &y) {
+    const std::int64_t nx = geometry_.nx, ny = geometry_.ny, side = ActiveSet::kTile;
+    for (std::int64_t tj = 0; tj < ny; tj += side)
+        for (std::int64_t ti = 0; ti < nx; ti += side) {
+            CellBox box;  // per tile, so that a pile in one corner wakes only its own cells
+            for (std::int64_t j = tj; j < std::min(tj + side, ny); ++j)
+                for (std::int64_t i = ti; i < std::min(ti + side, nx); ++i) {
+                    const std::size_t c = static_cast<std::size_t>(i + nx * j);
+                    if (heights_[c] == y[c] && residuals_[c] == 0.0f) continue;
+                    heights_[c] = y[c];
+                    residuals_[c] = 0.0f;
+                    box.add(i, i + 1, j, j + 1);
+                }
+            if (box.empty()) continue;
+            if (active_) active_->mark_block(box.i0, box.j0, box.i1 - box.i0, box.j1 - box.j0);
+            if (tiled_ && active_) tiled_workspace_changed(*tiled_, *active_, box);
+        }
+}
+
 void Grid::read_heights(const Block &block, double *values) const {
     for (std::int64_t j = 0; j < block.nj; ++j)
         for (std::int64_t i = 0; i < block.ni; ++i)

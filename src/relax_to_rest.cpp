@@ -71,11 +71,9 @@ public:
     Evaluator(Grid &grid, double dt) : grid_(grid), dt_(dt), cells_(grid.heights().size()) {}
 
     LevelSummary change(const std::vector<double> &y, std::vector<double> &change) {
-        std::vector<double> &h = grid_.heights_for_stepping();
-        h = y;
-        std::fill(grid_.residuals_for_stepping().begin(), grid_.residuals_for_stepping().end(), 0.0f);
-        grid_.active_set().mark_all();
-        grid_.tiled_workspace().all_stale = true;
+        // The active set then computes only the cells that y moved or that
+        // touch a moving face, as in any sub-step.
+        grid_.set_heights_between_sweeps(y);
         tiled_sweep(grid_, 1, dt_, levels_);
         const std::vector<double> &next = grid_.heights();
         change.resize(cells_);
@@ -198,11 +196,8 @@ void relax_to_rest(Grid &grid) {
         }
     }
 
-    // The state reached becomes the grid's; every tile is looked at again.
-    grid.heights_for_stepping() = x;
-    std::fill(grid.residuals_for_stepping().begin(), grid.residuals_for_stepping().end(), 0.0f);
-    grid.active_set().mark_all();
-    grid.tiled_workspace().all_stale = true;
+    // The state reached becomes the grid's (at rest, it already is).
+    grid.set_heights_between_sweeps(x);
     grid.ledger().outflow.add(mass_before - grid.total_mass());
     info.substeps = rates.evaluations();
     info.at_rest = rested;
