@@ -125,7 +125,8 @@ void relax_to_rest(Grid &grid) {
     StepInfo info;
 
     // The flow's path by RKC steps, while much sand moves.
-    std::vector<double> y0 = grid.heights(), f0, yjm1(cells), yjm2(cells), fj, yj(cells);
+    // All the memory first: an allocation that fails leaves the grid as it was.
+    std::vector<double> y0 = grid.heights(), f0(cells), yjm1(cells), yjm2(cells), fj(cells), yj(cells);
     bool rested = false, switched = false;
     double last_excess = 0.0;
     for (int k = 0; rates.evaluations() < budget; ++k) {
