@@ -266,6 +266,17 @@ int dpsm_set_mobility(dpsm_grid *g, double nu) {
     });
 }
 
+int dpsm_set_relaxation(dpsm_grid *g, int relaxation) {
+    const char *fn = "dpsm_set_relaxation";
+    return guarded(g, fn, [&] {
+        require_grid(g, fn);
+        if (relaxation != DPSM_RELAX_TIME_ACCURATE && relaxation != DPSM_RELAX_TO_REST)
+            fail(DPSM_ERR_UNKNOWN_ENUM, fn, "relaxation = ", relaxation,
+                 " is not DPSM_RELAX_TIME_ACCURATE or DPSM_RELAX_TO_REST");
+        g->core.set_relax_to_rest(relaxation == DPSM_RELAX_TO_REST);
+    });
+}
+
 int dpsm_set_scheme(dpsm_grid *g, int scheme) {
     const char *fn = "dpsm_set_scheme";
     return guarded(g, fn, [&] {

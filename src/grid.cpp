@@ -85,6 +85,38 @@ void Grid::write_heights(const Block &block, const double *values, bool add) {
     }
 }
 
+void Grid::set_heights_between_sweeps(const std::vector<double> &y) {
+    const std::int64_t nx = geometry_.nx, ny = geometry_.ny, side = ActiveSet::kTile;
+    for (std::int64_t tj = 0; tj < ny; tj += side)
+        for (std::int64_t ti = 0; ti < nx; ti += side) {
+            // Per tile, so that a pile in one corner wakes only its own cells.
+            std::int64_t i0 = nx, i1 = -1, j0 = ny, j1 = -1;
+            const std::int64_t i_end = std::min(ti + side, nx), j_end = std::min(tj + side, ny);
+            for (std::int64_t j = tj; j < j_end; ++j) {
+                const std::size_t row = static_cast<std::size_t>(nx * j);
+                std::int64_t first = -1, last = -1;
+                for (std::int64_t i = ti; i < i_end; ++i) {
+                    const std::size_t c = row + static_cast<std::size_t>(i);
+                    if (heights_[c] == y[c] && residuals_[c] == 0.0f) continue;
+                    heights_[c] = y[c];
+                    residuals_[c] = 0.0f;
+                    if (first < 0) first = i;
+                    last = i;
+                }
+                if (first < 0) continue;
+                i0 = std::min(i0, first);
+                i1 = std::max(i1, last);
+                j0 = std::min(j0, j);
+                j1 = j;
+            }
+            if (i1 < 0) continue;
+            CellBox box;
+            box.add(i0, i1 + 1, j0, j1 + 1);
+            if (active_) active_->mark_block(box.i0, box.j0, box.i1 - box.i0, box.j1 - box.j0);
+            if (tiled_ && active_) tiled_workspace_changed(*tiled_, *active_, box);
+        }
+}
+
 void Grid::read_heights(const Block &block, double *values) const {
     for (std::int64_t j = 0; j < block.nj; ++j)
         for (std::int64_t i = 0; i < block.ni; ++i)
@@ -125,6 +157,7 @@ void Grid::restore(GridState &&s) {
     max_substeps_ = s.max_substeps;
     threads_ = s.threads;
     scheme_ = s.scheme;
+    relax_to_rest_ = s.relax_to_rest;
     side_open_ = s.side_open;
     heights_ = std::move(s.heights);
     residuals_ = std::move(s.residuals);

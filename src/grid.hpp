@@ -66,6 +66,7 @@ struct GridState {
     double flux_exponent = 1.0;
     double static_angle = 0.0;          // 0: no hysteresis
     std::vector<std::uint8_t> moving;   // empty unless static_angle > 0
+    bool relax_to_rest = false;         // dpsm_set_relaxation(DPSM_RELAX_TO_REST)
     MassLedger ledger;
     StepInfo last_step;
 };
@@ -139,6 +140,11 @@ public:
         return !bed_.empty() || !tan_field_.empty() || flux_exponent_ != 1.0 || hysteresis();
     }
 
+    // How dpsm_step moves the surface: time-accurate sub-steps (false) or the
+    // fast relaxation to rest (relax_to_rest.hpp).
+    bool relax_to_rest() const { return relax_to_rest_; }
+    void set_relax_to_rest(bool on) { relax_to_rest_ = on; }
+
     bool side_open(int side) const { return side_open_[side]; }
     void set_side_open(int side, bool open) {
         side_open_[side] = open;
@@ -182,6 +188,10 @@ public:
     // new grid of the same geometry. Unlike the setters it books nothing in
     // the ledger (the state carries its ledger); it recomputes what is derived.
     void restore(GridState &&state);
+    // The relaxation to rest (relax_to_rest.cpp) between its sweeps: every
+    // height becomes y's and every residual 0. Only the cells that change are
+    // looked at again, as after a host's edit, but nothing is booked.
+    void set_heights_between_sweeps(const std::vector<double> &y);
     void set_source(const double *q);                 // NULL: none
 
     // Mass on sand cells now, a compensated sum.
@@ -241,6 +251,7 @@ private:
     std::unique_ptr<ActiveSet> active_;
     std::unique_ptr<TiledWorkspace> tiled_;
     Scheme scheme_;
+    bool relax_to_rest_ = false;
     int threads_ = 0;
     std::int64_t wall_cells_ = 0;
     std::int64_t open_cells_ = 0;

@@ -45,7 +45,11 @@ constexpr std::uint32_t kHasAngleField = 1u << 2;
 constexpr std::uint32_t kHasMoving = 1u << 3;
 // Version 2: a block record follows the header (one rank's block of a distributed grid).
 constexpr std::uint32_t kIsBlock = 1u << 4;
-constexpr std::uint32_t kKnownFlags = kHasSource | kHasBed | kHasAngleField | kHasMoving | kIsBlock;
+// Version 2: dpsm_step relaxes to rest (dpsm_set_relaxation); no data of its own.
+constexpr std::uint32_t kRelaxToRest = 1u << 5;
+constexpr std::uint32_t kKnownFlags = kHasSource | kHasBed | kHasAngleField | kHasMoving | kIsBlock | kRelaxToRest;
+// The flags a file of version 1 cannot hold.
+constexpr std::uint32_t kVersion2Flags = kIsBlock | kRelaxToRest;
 
 
 // ---- CRC-32 (ISO-HDLC, as zlib, PNG and gzip: reflected 0xEDB88320) -------
@@ -139,13 +143,15 @@ std::uint32_t flags_of(const Grid &g) {
     if (!g.bed().empty()) flags |= kHasBed;
     if (!g.angle_field().empty()) flags |= kHasAngleField;
     if (!g.moving().empty()) flags |= kHasMoving;
+    if (g.relax_to_rest()) flags |= kRelaxToRest;
     return flags;
 }
 
 void write_header(Writer &w, const Grid &g, const RestartBlock &block) {
     const Geometry &geo = g.geometry();
     for (const std::uint8_t b : kMagic) w.u8(b);
-    w.u32(block.present ? 2u : 1u);
+    // The oldest version that holds the grid, so that older libraries read what they can.
+    w.u32(((flags_of(g) | (block.present ? kIsBlock : 0u)) & kVersion2Flags) ? 2u : 1u);
     w.u32(static_cast<std::uint32_t>(geo.dim));
     w.u32(geo.axisymmetric ? 1u : 0u);
     w.i64(geo.nx);
@@ -366,8 +372,10 @@ void check_layout(const Header &h, const std::string &path, const char *fn) {
     if (h.nx > kMaxCells / h.ny)
         bad("nx * ny = ", h.nx, " * ", h.ny, " cells is more than this library can address (", kMaxCells, ")");
     if (h.flags & ~kKnownFlags) bad("unknown array flags ", hex32(h.flags & ~kKnownFlags));
-    if ((h.flags & kIsBlock) && h.version < 2)
-        bad("the block flag ", hex32(kIsBlock), " is set in a file of version ", h.version, " (it needs version 2)");
+    if ((h.flags & kVersion2Flags) && h.version < 2)
+        bad("the flags ", hex32(h.flags & kVersion2Flags), " are set in a file of version ", h.version,
+            " (they need version 2)");
+    if ((h.flags & kRelaxToRest) && h.dim != 2) bad("a grid of dim = ", h.dim, " cannot relax to rest");
     if ((h.flags & kIsBlock) && h.dim != 2) bad("a block of a distributed grid must have dim = 2, not ", h.dim);
     const std::uint64_t cells = static_cast<std::uint64_t>(h.nx) * static_cast<std::uint64_t>(h.ny);
     if (cells > (std::numeric_limits<std::size_t>::max() - kHeaderBytes - kBlockBytes - kChecksumBytes) /
@@ -591,6 +599,7 @@ void load_restart(const char *path, Geometry &geometry, GridState &state, Restar
     check_values(header, state, n, source, fn);
     check_block(header, block, source, fn);
     state.scheme = header.scheme == kIsotropic ? kIsotropic : kPairwise;
+    state.relax_to_rest = (header.flags & kRelaxToRest) != 0;
     state.last_step.at_rest = header.at_rest != 0;
     for (int side = 0; side < 4; ++side) state.side_open[side] = header.side_open[side] != 0;
     geometry = Geometry{static_cast<int>(header.dim), header.axisymmetric != 0, header.nx, header.ny, header.dx, header.dy};

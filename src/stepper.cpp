@@ -9,6 +9,7 @@
 #include "dpsm/dpsm.h"
 #include "error.hpp"
 #include "kernels.hpp"
+#include "relax_to_rest.hpp"
 #include "tiled_sweep.hpp"
 
 namespace dpsm {
@@ -60,6 +61,19 @@ StepAgreement agree_before_step(Grid &grid, double dt) {
 }  // namespace
 
 void step(Grid &grid, double dt) {
+    if (grid.relax_to_rest()) {
+        // Not on a distributed grid (relax_to_rest refuses it): its peers may
+        // be waiting in the step's first agreement, so take part, refusing.
+        if (Decomposition *decomposition = grid.decomposition()) {
+            try {
+                decomposition->agree_before_step(grid, 0.0, true);
+            } catch (const Error &) {
+                // every rank throws; this one reports its own reason below
+            }
+        }
+        relax_to_rest(grid);  // no time scale: dt only says that time passed
+        return;
+    }
     const StepAgreement state = agree_before_step(grid, dt);  // first: it may set the smallest angle
     const double dt_max = stable_dt(grid);
     const double needed = std::ceil(dt / dt_max);

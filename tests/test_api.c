@@ -1746,6 +1746,8 @@ static void test_null_grid_every_function(void **state) {
     EXPECT_NULL_GRID(dpsm_set_mobility(NULL, 1.0), "dpsm_set_mobility");
     EXPECT_NULL_GRID(dpsm_set_scheme(NULL, DPSM_SCHEME_PAIRWISE), "dpsm_set_scheme");
     EXPECT_NULL_GRID(dpsm_set_scheme(NULL, 99), "dpsm_set_scheme");
+    EXPECT_NULL_GRID(dpsm_set_relaxation(NULL, DPSM_RELAX_TO_REST), "dpsm_set_relaxation");
+    EXPECT_NULL_GRID(dpsm_set_relaxation(NULL, 99), "dpsm_set_relaxation");
     EXPECT_NULL_GRID(dpsm_set_heights_region(NULL, 0, 0, 1, 1, h), "dpsm_set_heights_region");
     EXPECT_NULL_GRID(dpsm_set_heights_region(NULL, -1, -1, 0, 0, NULL), "dpsm_set_heights_region");
     EXPECT_NULL_GRID(dpsm_add_heights_region(NULL, 0, 0, 1, 1, h), "dpsm_add_heights_region");
@@ -1881,6 +1883,13 @@ static void test_bad_scheme(void **state) {
     const int bad[] = {-1, 2, 3, 255, INT_MAX, INT_MIN};
     for (size_t k = 0; k < sizeof bad / sizeof *bad; ++k)
         EXPECT_FAIL(fx, dpsm_set_scheme(fx->g, bad[k]), DPSM_ERR_UNKNOWN_ENUM, "dpsm_set_scheme", "scheme");
+}
+
+static void test_bad_relaxation(void **state) {
+    fixture_t *fx = *state;
+    const int bad[] = {-1, 2, 3, 255, INT_MAX, INT_MIN};
+    for (size_t k = 0; k < sizeof bad / sizeof *bad; ++k)
+        EXPECT_FAIL(fx, dpsm_set_relaxation(fx->g, bad[k]), DPSM_ERR_UNKNOWN_ENUM, "dpsm_set_relaxation", "relaxation");
 }
 
 /* Blocks that do not lie on the grid, NULL arrays and non-finite values, for
@@ -2128,6 +2137,7 @@ int main(int argc, char **argv) {
 #define BAD_INPUT_TESTS                                                                                       \
     cmocka_unit_test(test_null_grid_every_function), cmocka_unit_test(test_bad_repose_angle),                 \
         cmocka_unit_test(test_bad_mobility), cmocka_unit_test(test_bad_scheme),                               \
+        cmocka_unit_test(test_bad_relaxation),                                                                \
         cmocka_unit_test(test_bad_boundary), cmocka_unit_test(test_bad_heights_region),                       \
         cmocka_unit_test(test_bad_cell_kinds), cmocka_unit_test(test_bad_heights),                            \
         cmocka_unit_test(test_bad_get_heights), cmocka_unit_test(test_bad_source),                            \

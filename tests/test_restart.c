@@ -547,7 +547,7 @@ static void test_block_files_need_dpsm_load_mpi(void **state) {
         int32_t rank, ranks;
         const char *phrase;
     } wrong[] = {
-        {1, 10, 8, 5, 4, 1, 2, "needs version 2"},
+        {1, 10, 8, 5, 4, 1, 2, "need version 2"},
         {2, 10, 8, 5, 4, 2, 2, "rank 2 is not one of its 2 ranks"},
         {2, 10, 8, 5, 4, 0, 0, "says 0 ranks"},
         {2, 10, 8, 6, 4, 1, 2, "does not lie in its global grid"},

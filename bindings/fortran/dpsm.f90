@@ -56,6 +56,9 @@ module dpsm
   ! Schemes.
   integer(c_int), parameter, public :: DPSM_SCHEME_PAIRWISE = 0
   integer(c_int), parameter, public :: DPSM_SCHEME_ISOTROPIC = 1
+  ! Relaxations (dpsm_set_relaxation).
+  integer(c_int), parameter, public :: DPSM_RELAX_TIME_ACCURATE = 0
+  integer(c_int), parameter, public :: DPSM_RELAX_TO_REST = 1
   ! Cell kinds (the values of an integer(c_int8_t) kinds array).
   integer(c_int8_t), parameter, public :: DPSM_CELL_SAND = 0_c_int8_t
   integer(c_int8_t), parameter, public :: DPSM_CELL_WALL = 1_c_int8_t
@@ -102,7 +105,7 @@ module dpsm
 
   ! ---- the public procedures: one per C function ---------------------------
   public :: dpsm_create_1d, dpsm_create_2d, dpsm_create_axisymmetric, dpsm_destroy
-  public :: dpsm_set_repose_angle, dpsm_set_mobility, dpsm_set_scheme, dpsm_set_boundary
+  public :: dpsm_set_repose_angle, dpsm_set_mobility, dpsm_set_scheme, dpsm_set_relaxation, dpsm_set_boundary
   public :: dpsm_set_cell_kinds, dpsm_set_heights, dpsm_get_heights
   public :: dpsm_set_heights_region, dpsm_add_heights_region, dpsm_get_heights_region
   public :: dpsm_set_source, dpsm_stable_dt, dpsm_step, dpsm_get_mass, dpsm_get_step_info
@@ -207,6 +210,12 @@ module dpsm
       type(c_ptr), value :: g
       integer(c_int), value :: scheme
     end function c_dpsm_set_scheme
+
+    integer(c_int) function c_dpsm_set_relaxation(g, relaxation) bind(C, name='dpsm_set_relaxation')
+      import :: c_int, c_ptr
+      type(c_ptr), value :: g
+      integer(c_int), value :: relaxation
+    end function c_dpsm_set_relaxation
 
     integer(c_int) function c_dpsm_set_boundary(g, side, kind) bind(C, name='dpsm_set_boundary')
       import :: c_int, c_ptr
@@ -633,6 +642,16 @@ contains
     call clear_message(g)
     call finish(c_dpsm_set_scheme(g%ptr, scheme), ierr, 'dpsm_set_scheme', g)
   end subroutine dpsm_set_scheme
+
+  !> dpsm_set_relaxation(g, relaxation[, ierr]): DPSM_RELAX_TIME_ACCURATE (the
+  !> default) or DPSM_RELAX_TO_REST (each dpsm_step relaxes to rest, fast).
+  subroutine dpsm_set_relaxation(g, relaxation, ierr)
+    type(dpsm_grid), intent(in) :: g
+    integer(c_int), intent(in) :: relaxation
+    integer, intent(out), optional :: ierr
+    call clear_message(g)
+    call finish(c_dpsm_set_relaxation(g%ptr, relaxation), ierr, 'dpsm_set_relaxation', g)
+  end subroutine dpsm_set_relaxation
 
   !> dpsm_set_boundary(g, side, kind[, ierr]): side DPSM_XMIN..DPSM_YMAX, kind DPSM_OPEN or DPSM_WALL.
   subroutine dpsm_set_boundary(g, side, kind, ierr)

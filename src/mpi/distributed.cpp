@@ -164,8 +164,9 @@ public:
                   "MPI_Allreduce before dpsm_step");
         if (v[7] != 0.0)
             throw Error(DPSM_ERR_INVALID_VALUE,
-                        "dpsm_step: another rank of the distributed grid refused its dt (not finite, or not "
-                        "positive), so no rank stepped; every rank must step the same dt");
+                        "dpsm_step: another rank of the distributed grid refused the step (its dt is not finite "
+                        "or not positive, or it was set to DPSM_RELAX_TO_REST), so no rank stepped; every rank "
+                        "must step the same dt");
         static const char *const names[] = {"dt",         "the repose angle (dpsm_set_repose_angle)",
                                             "the mobility (dpsm_set_mobility)",
                                             "the rest tolerance (dpsm_set_rest_tolerance)",

@@ -1009,7 +1009,7 @@ static void op_null_grid(reader_t *r) {
     int64_t a, c;
     int st;
     const char *fn;
-    switch (b % 24) {
+    switch (b % 25) {
         case 0: st = dpsm_set_repose_angle(NULL, 0.5), fn = "dpsm_set_repose_angle"; break;
         case 1: st = dpsm_set_mobility(NULL, 1.0), fn = "dpsm_set_mobility"; break;
         case 2: st = dpsm_set_scheme(NULL, 0), fn = "dpsm_set_scheme"; break;
@@ -1033,6 +1033,7 @@ static void op_null_grid(reader_t *r) {
         case 20: st = dpsm_set_repose_angle_field(NULL, NULL), fn = "dpsm_set_repose_angle_field"; break;
         case 21: st = dpsm_set_flux_exponent(NULL, 1.0), fn = "dpsm_set_flux_exponent"; break;
         case 22: st = dpsm_set_static_angle(NULL, 0.6), fn = "dpsm_set_static_angle"; break;
+        case 23: st = dpsm_set_relaxation(NULL, DPSM_RELAX_TO_REST), fn = "dpsm_set_relaxation"; break;
         default: {
             dpsm_destroy(NULL);
             const int code = (int)(int8_t)u8(r);

@@ -119,6 +119,9 @@ class Test2D(LedgerMixin, unittest.TestCase):
         self.assertFails(dpsm.ERR_UNKNOWN_ENUM, g.set_scheme, 2**40)  # not wrapped into a valid int
         g.set_scheme(dpsm.SCHEME_PAIRWISE)
         g.set_scheme(dpsm.DPSM_SCHEME_ISOTROPIC)
+        self.assertFails(dpsm.ERR_UNKNOWN_ENUM, g.set_relaxation, 7)
+        g.set_relaxation(dpsm.RELAX_TO_REST)
+        g.set_relaxation(dpsm.DPSM_RELAX_TIME_ACCURATE)
         self.assertFails(dpsm.ERR_UNKNOWN_ENUM, g.set_boundary, 9, dpsm.OPEN)
         self.assertFails(dpsm.ERR_UNKNOWN_ENUM, g.set_boundary, dpsm.XMIN, 5)
         for side in (dpsm.XMIN, dpsm.XMAX, dpsm.YMIN, dpsm.YMAX):
@@ -200,6 +203,30 @@ class Test2D(LedgerMixin, unittest.TestCase):
         self.assertFails(dpsm.ERR_UNKNOWN_ENUM, g.set_cell_kinds, kinds)
         kinds[0, 0] = dpsm.CELL_WALL
         g.set_cell_kinds(kinds)
+
+    def test_relax_to_rest(self):
+        """DPSM_RELAX_TO_REST: at rest in one step, in fewer evaluations than sub-steps, mass kept."""
+        g, accurate = self.g, dpsm.Grid.create_2d(self.nx, self.ny, self.dx, self.dy)
+        try:
+            for grid in (g, accurate):
+                grid.set_repose_angle(0.6)
+                grid.set_heights(self.cone)
+            g.set_relaxation(dpsm.RELAX_TO_REST)
+            total = g.get_mass(dpsm.MASS_TOTAL)
+            g.step(1.0)
+            accurate.step(1e6)
+            self.assertEqual(g.get_step_info(dpsm.INFO_AT_REST), 1.0)
+            self.assertEqual(g.get_step_info(dpsm.INFO_TIME_INTEGRATED), 0.0)
+            self.assertLess(g.get_step_info(dpsm.INFO_SUBSTEPS), accurate.get_step_info(dpsm.INFO_SUBSTEPS))
+            self.assertAlmostEqual(g.get_mass(dpsm.MASS_TOTAL), total, delta=1e-12 * total)
+            self.assertLedger(g)
+            fast, slow = flat(g.get_heights()), flat(accurate.get_heights())
+            self.assertLess(sum(abs(a - b) for a, b in zip(fast, slow)), 0.01 * sum(slow))
+            g.set_relaxation(dpsm.RELAX_TIME_ACCURATE)
+            g.step(10.0)
+            self.assertEqual(g.get_step_info(dpsm.INFO_SUBSTEPS), 0.0)  # truly at rest
+        finally:
+            accurate.close()
 
     def test_step_to_rest(self):
         g = self.g

@@ -285,6 +285,12 @@ class Grid:
         f = "dpsm_set_scheme"
         self._call(f, _c_int(scheme, "scheme", f, C.DPSM_ERR_UNKNOWN_ENUM))
 
+    def set_relaxation(self, relaxation):
+        """``dpsm_set_relaxation``: ``RELAX_TIME_ACCURATE`` (the default) or ``RELAX_TO_REST`` (each ``step``
+        brings the surface to rest in few flux evaluations, without a time scale)."""
+        f = "dpsm_set_relaxation"
+        self._call(f, _c_int(relaxation, "relaxation", f, C.DPSM_ERR_UNKNOWN_ENUM))
+
     def set_boundary(self, side, kind):
         """``dpsm_set_boundary``: side ``XMIN``, ``XMAX``, ``YMIN`` or ``YMAX``; kind ``OPEN`` or ``WALL``."""
         f = "dpsm_set_boundary"

@@ -40,6 +40,7 @@ SIGNATURES = {
     "dpsm_set_repose_angle": (_int, [GridPtr, _dbl]),
     "dpsm_set_mobility": (_int, [GridPtr, _dbl]),
     "dpsm_set_scheme": (_int, [GridPtr, _int]),
+    "dpsm_set_relaxation": (_int, [GridPtr, _int]),
     "dpsm_set_boundary": (_int, [GridPtr, _int, _int]),
     "dpsm_set_cell_kinds": (_int, [GridPtr, _P(ctypes.c_uint8)]),
     "dpsm_set_heights": (_int, [GridPtr, _P(_dbl)]),

@@ -1,0 +1,211 @@
+// The fast relaxation to rest. The rule and the figures that chose it are in
+// docs/performance.md ("Larger steps: what was tried", rkc-then-momentum):
+//
+//  - Runge-Kutta-Chebyshev steps (second order, damping 2/13) whose stage
+//    count ramps up, s_k = min(20, 2 + k), each 0.9 of its stable length.
+//    They follow the flow's path while much sand moves; the deposit depends
+//    on that path.
+//  - Once the largest excess slope of the faces that carry sand is below 3 %
+//    of tan(theta), Nesterov's momentum (beta = k / (k + 3)) on explicit
+//    sub-steps, restarted when a step works against the rates or when more
+//    than 90 % of its motion lies in cells no face acts on (sand coasting past
+//    the angle of repose, which nothing would bring back).
+//  - At rest when a sub-step taken without momentum moves nothing.
+//
+// Every flux evaluation is one explicit sub-step of the grid's own 2D sweep
+// from the state at hand (its change S(y) - y is dt times the rates), so the
+// flux law, the masks and the sides stay in one place. Each stage is a
+// combination of states of one mass; what leaves through open sides and cells
+// is booked as outflow, as the difference of the mass before and after.
+#include "relax_to_rest.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <vector>
+
+#include "active_set.hpp"
+#include "dpsm/dpsm.h"
+#include "error.hpp"
+#include "stepper.hpp"
+#include "tiled_sweep.hpp"
+
+namespace dpsm {
+namespace {
+
+constexpr int kMaxStages = 20;
+constexpr double kStageSafety = 0.9;
+constexpr double kSwitchExcessShare = 0.03;  // of tan(theta): where momentum takes over
+constexpr double kCoastingShare = 0.9;
+
+// The coefficients of a second-order RKC step of s stages (Sommeijer,
+// Shampine and Verwer 1997).
+struct RkcStep {
+    int s = 2;
+    double w0 = 0.0, w1 = 0.0, beta = 0.0;  // beta: the stable length in units of 1 / lambda_max
+    double T[kMaxStages + 1] = {}, b[kMaxStages + 1] = {};
+
+    explicit RkcStep(int stages) : s(stages) {
+        double dT[kMaxStages + 1] = {}, ddT[kMaxStages + 1] = {};
+        w0 = 1.0 + (2.0 / 13.0) / (static_cast<double>(s) * s);
+        T[0] = 1.0;
+        T[1] = w0;
+        dT[1] = 1.0;
+        for (int j = 2; j <= s; ++j) {
+            T[j] = 2.0 * w0 * T[j - 1] - T[j - 2];
+            dT[j] = 2.0 * T[j - 1] + 2.0 * w0 * dT[j - 1] - dT[j - 2];
+            ddT[j] = 4.0 * dT[j - 1] + 2.0 * w0 * ddT[j - 1] - ddT[j - 2];
+        }
+        w1 = dT[s] / ddT[s];
+        for (int j = 2; j <= s; ++j) b[j] = ddT[j] / (dT[j] * dT[j]);
+        b[0] = b[1] = b[2];
+        beta = (w0 + 1.0) * ddT[s] / dT[s];
+    }
+};
+
+// Evaluates the slide fluxes at heights y by one explicit sub-step of dt
+// from y: change = S(y) - y. Returns the sub-step's summary (moved, largest
+// excess slope). Leaves the grid's heights at S(y).
+class Evaluator {
+public:
+    Evaluator(Grid &grid, double dt) : grid_(grid), dt_(dt), cells_(grid.heights().size()) {}
+
+    LevelSummary change(const std::vector<double> &y, std::vector<double> &change) {
+        // The active set then computes only the cells that y moved or that
+        // touch a moving face, as in any sub-step.
+        grid_.set_heights_between_sweeps(y);
+        tiled_sweep(grid_, 1, dt_, levels_);
+        const std::vector<double> &next = grid_.heights();
+        change.resize(cells_);
+        for (std::size_t c = 0; c < cells_; ++c) change[c] = next[c] - y[c];
+        ++evaluations_;
+        return levels_.front();
+    }
+    std::int64_t evaluations() const { return evaluations_; }
+    double dt() const { return dt_; }
+
+private:
+    Grid &grid_;
+    double dt_;
+    std::size_t cells_;
+    std::vector<LevelSummary> levels_;
+    std::int64_t evaluations_ = 0;
+};
+
+void require_supported(const Grid &grid) {
+    const char *fn = "dpsm_step";
+    const auto refuse = [&](const char *what) {
+        fail(DPSM_ERR_NOT_APPLICABLE, fn, "the relaxation DPSM_RELAX_TO_REST does not support ", what,
+             " in this version; use DPSM_RELAX_TIME_ACCURATE (dpsm_set_relaxation)");
+    };
+    if (grid.geometry().dim != 2) refuse("1D or axisymmetric grids");
+    if (grid.decomposition()) refuse("distributed grids");
+    if (grid.scheme() != kIsotropic) refuse("the pairwise scheme (dpsm_set_scheme)");
+    if (!grid.bed().empty()) refuse("a bed (dpsm_set_bedrock)");
+    // Both were seen to need far more evaluations, or never to rest, in a
+    // relaxation tuned on the plain law; they stay with the time-accurate steps.
+    if (!grid.angle_field().empty()) refuse("an angle field (dpsm_set_repose_angle_field)");
+    if (grid.flux_exponent() != 1.0) refuse("a flux exponent other than 1 (dpsm_set_flux_exponent)");
+    if (grid.hysteresis()) refuse("a static angle (dpsm_set_static_angle)");
+    if (grid.source_active()) refuse("an active source (dpsm_set_source); add the deposit with dpsm_add_heights_region");
+    if (grid.has_open_cells() && grid.open_level_min() != grid.open_level_max())
+        refuse("open cells held at different levels (sand would flow for ever)");
+}
+
+}  // namespace
+
+void relax_to_rest(Grid &grid) {
+    require_supported(grid);
+    prepare_tiled_sweep(grid, grid.threads());  // allocates before anything changes
+    const std::size_t cells = grid.heights().size();
+    const double mass_before = grid.total_mass();
+    Evaluator rates(grid, stable_dt(grid));
+    const double switch_excess = kSwitchExcessShare * std::tan(grid.min_repose_angle());
+    const std::int64_t budget = grid.max_substeps();
+    StepInfo info;
+
+    // The flow's path by RKC steps, while much sand moves.
+    // All the memory first: an allocation that fails leaves the grid as it was.
+    std::vector<double> y0 = grid.heights(), f0(cells), yjm1(cells), yjm2(cells), fj(cells), yj(cells);
+    bool rested = false, switched = false;
+    double last_excess = 0.0;
+    for (int k = 0; rates.evaluations() < budget; ++k) {
+        const LevelSummary start = rates.change(y0, f0);  // f0: dt times the rates at y0
+        last_excess = start.max_excess;
+        if (!start.moved) {
+            rested = true;
+            break;
+        }
+        if (start.max_excess < switch_excess) {
+            switched = true;
+            break;
+        }
+        // Its stages after the first evaluation must fit in what is left of the limit.
+        const std::int64_t left = budget - rates.evaluations();
+        if (left < 1) break;
+        const RkcStep rkc(static_cast<int>(std::min<std::int64_t>(std::min(kMaxStages, 2 + k), left + 1)));
+        const double tau = kStageSafety * rkc.beta / 2.0;  // the step in units of the explicit sub-step
+        // Each stage as y0 plus a combination of changes, so that a cell no
+        // face acts on keeps its height to the last bit.
+        for (std::size_t c = 0; c < cells; ++c) {
+            yjm2[c] = y0[c];
+            yjm1[c] = y0[c] + rkc.b[1] * rkc.w1 * tau * f0[c];
+        }
+        for (int j = 2; j <= rkc.s; ++j) {
+            rates.change(yjm1, fj);
+            const double mu = 2.0 * rkc.b[j] * rkc.w0 / rkc.b[j - 1], nu = -rkc.b[j] / rkc.b[j - 2];
+            const double mut = 2.0 * rkc.b[j] * rkc.w1 / rkc.b[j - 1];
+            const double gamt = -(1.0 - rkc.b[j - 1] * rkc.T[j - 1]) * mut;
+            for (std::size_t c = 0; c < cells; ++c)
+                yj[c] = y0[c] + (mu * (yjm1[c] - y0[c]) + nu * (yjm2[c] - y0[c]) + mut * tau * fj[c] +
+                                 gamt * tau * f0[c]);
+            yjm2.swap(yjm1);
+            yjm1.swap(yj);
+        }
+        y0.swap(yjm1);
+    }
+
+    // Momentum for the tail, where little sand is left to move.
+    std::vector<double> &x = y0, &x_prev = yjm1, &y = yjm2, &change = fj;
+    x_prev = x;
+    for (std::int64_t k = 0; switched && !rested && rates.evaluations() < budget;) {
+        const double beta = static_cast<double>(k) / static_cast<double>(k + 3);
+        for (std::size_t c = 0; c < cells; ++c) y[c] = x[c] + beta * (x[c] - x_prev[c]);  // x where x = x_prev
+        const LevelSummary at = rates.change(y, change);
+        last_excess = at.max_excess;
+        if (!at.moved) {
+            x = y;
+            x_prev = y;
+            rested = k == 0;
+            k = 0;
+            continue;
+        }
+        double along = 0.0, motion = 0.0, coasting = 0.0;
+        for (std::size_t c = 0; c < cells; ++c) {
+            const double next = y[c] + change[c], moved = std::fabs(next - x[c]);
+            along += change[c] * (next - x[c]);
+            motion += moved;
+            if (change[c] == 0.0) coasting += moved;
+            x_prev[c] = x[c];
+            x[c] = next;
+        }
+        if (along < 0.0 || coasting > kCoastingShare * motion) {
+            x_prev = x;
+            k = 0;
+        } else {
+            ++k;
+        }
+    }
+
+    // The state reached becomes the grid's (at rest, it already is).
+    grid.set_heights_between_sweeps(x);
+    grid.ledger().outflow.add(mass_before - grid.total_mass());
+    info.substeps = rates.evaluations();
+    info.at_rest = rested;
+    info.time_integrated = 0.0;
+    info.max_excess_slope = rested ? 0.0 : last_excess;
+    info.cell_updates = static_cast<double>(rates.evaluations()) * static_cast<double>(cells);
+    grid.last_step() = info;
+}
+
+}  // namespace dpsm

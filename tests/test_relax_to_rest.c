@@ -1,0 +1,324 @@
+/* The fast relaxation to rest (dpsm_set_relaxation(g, DPSM_RELAX_TO_REST)):
+ * it reaches the rest that the time-accurate sub-steps reach, to a fraction
+ * of a per cent, in far fewer flux evaluations; the state is truly at rest
+ * (a time-accurate step after it does nothing); mass is kept and booked;
+ * results do not depend on the threads; a restart file keeps the setting;
+ * what it does not support is refused before anything changes. */
+#include <math.h>
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <cmocka.h>
+
+#include "test_support.h"
+
+static const double kPi = 3.14159265358979323846;
+
+/* The cone of the performance page: 40 high, slope 1.5, on 101^2 cells of
+ * width 1, relaxed at 33 degrees with open sides. */
+enum { N = 101 };
+static void cone(double *h) {
+    for (int j = 0; j < N; ++j)
+        for (int i = 0; i < N; ++i) h[i + N * j] = fmax(0.0, 40.0 - 1.5 * hypot(i - N / 2, j - N / 2));
+}
+
+/* Twelve cones that meet, a wall across part of them, one open side: piles
+ * whose deposit depends on the path, with masks and outflow. */
+static void cones_and_wall(double *h, uint8_t *kinds) {
+    unsigned seed = 7u;
+    memset(h, 0, sizeof(double) * N * N);
+    for (int p = 0; p < 12; ++p) {
+        double v[4];
+        for (int k = 0; k < 4; ++k) {
+            seed = seed * 1664525u + 1013904223u;
+            v[k] = (double)(seed >> 8) / (double)(1u << 24);
+        }
+        for (int j = 0; j < N; ++j)
+            for (int i = 0; i < N; ++i)
+                h[i + N * j] = fmax(h[i + N * j], 5.0 + 20.0 * v[2] - (1.0 + v[3]) * hypot(i - 15.0 - 70.0 * v[0],
+                                                                                          j - 15.0 - 70.0 * v[1]));
+    }
+    for (int c = 0; c < N * N; ++c) kinds[c] = DPSM_CELL_SAND;
+    for (int j = 20; j < 75; ++j) kinds[40 + N * j] = DPSM_CELL_WALL;
+}
+
+static dpsm_grid *grid_of(const double *h, const uint8_t *kinds, int open_sides, int threads) {
+    dpsm_grid *g = NULL;
+    CHECK_OK(NULL, dpsm_create_2d(N, N, 1.0, 1.0, &g));
+    CHECK_OK(g, dpsm_set_repose_angle(g, 33.0 * kPi / 180.0));
+    CHECK_OK(g, dpsm_set_threads(g, threads));
+    for (int side = DPSM_XMIN; side <= DPSM_YMAX; ++side)
+        CHECK_OK(g, dpsm_set_boundary(g, side, side < open_sides ? DPSM_OPEN : DPSM_WALL));
+    if (kinds) CHECK_OK(g, dpsm_set_cell_kinds(g, kinds));
+    CHECK_OK(g, dpsm_set_heights(g, h));
+    return g;
+}
+
+static double info(const dpsm_grid *g, int item) {
+    double v = -1.0;
+    CHECK_OK(g, dpsm_get_step_info(g, item, &v));
+    return v;
+}
+
+static double mass(const dpsm_grid *g, int quantity) {
+    double v = 0.0;
+    CHECK_OK(g, dpsm_get_mass(g, quantity, &v));
+    return v;
+}
+
+/* L1 difference of a and b over the volume of b. */
+static double l1_share(const double *a, const double *b) {
+    double d = 0.0, v = 0.0;
+    for (int c = 0; c < N * N; ++c) {
+        d += fabs(a[c] - b[c]);
+        v += fabs(b[c]);
+    }
+    return d / v;
+}
+
+/* Relaxes the same scene both ways; checks the fast rest against the
+ * time-accurate one and that it is a rest of the model's own. */
+static void compare_with_time_accurate(const double *h0, const uint8_t *kinds, int open_sides, double tolerance,
+                                       double max_l1, const char *name) {
+    dpsm_grid *accurate = grid_of(h0, kinds, open_sides, 0), *fast = grid_of(h0, kinds, open_sides, 0);
+    CHECK_OK(accurate, dpsm_set_rest_tolerance(accurate, tolerance));
+    CHECK_OK(fast, dpsm_set_rest_tolerance(fast, tolerance));
+    CHECK_OK(fast, dpsm_set_relaxation(fast, DPSM_RELAX_TO_REST));
+    CHECK_OK(accurate, dpsm_step(accurate, 1e6));
+    CHECK_OK(fast, dpsm_step(fast, 1e6));
+    REQUIRE(info(accurate, DPSM_INFO_AT_REST) == 1.0, "%s: the time-accurate run did not rest", name);
+    REQUIRE(info(fast, DPSM_INFO_AT_REST) == 1.0, "%s: the fast relaxation did not rest", name);
+    const double evaluations = info(fast, DPSM_INFO_SUBSTEPS), substeps = info(accurate, DPSM_INFO_SUBSTEPS);
+    REQUIRE(evaluations * 4.0 < substeps, "%s: %g evaluations against %g sub-steps: not fast", name, evaluations,
+            substeps);
+    REQUIRE(info(fast, DPSM_INFO_TIME_INTEGRATED) == 0.0 && info(fast, DPSM_INFO_MAX_EXCESS_SLOPE) == 0.0,
+            "%s: time integrated %g, largest excess %g", name, info(fast, DPSM_INFO_TIME_INTEGRATED),
+            info(fast, DPSM_INFO_MAX_EXCESS_SLOPE));
+    double *a = malloc(sizeof(double) * N * N), *b = malloc(sizeof(double) * N * N);
+    CHECK_OK(accurate, dpsm_get_heights(accurate, a));
+    CHECK_OK(fast, dpsm_get_heights(fast, b));
+    const double l1 = l1_share(b, a);
+    print_message("%s, tolerance %g: %g evaluations (time accurate: %g sub-steps), deposit %.3f %% from the "
+                  "time-accurate one (L1), top %.4f against %.4f\n",
+                  name, tolerance, evaluations, substeps, 100.0 * l1, max_of(b, N * N), max_of(a, N * N));
+    REQUIRE(l1 <= max_l1, "%s: the deposit is %.3f %% from the time-accurate one, more than %.2f %%", name, 100.0 * l1,
+            100.0 * max_l1);
+    for (int c = 0; c < N * N; ++c) REQUIRE(isfinite(b[c]), "%s: h[%d] = %g", name, c, b[c]);
+    if (kinds)
+        for (int c = 0; c < N * N; ++c)
+            if (kinds[c] == DPSM_CELL_WALL) REQUIRE(b[c] == h0[c], "%s: wall cell %d moved", name, c);
+    /* Mass: the ledger closes, and what left is what the time-accurate run lost, to round-off. */
+    const double total = mass(fast, DPSM_MASS_TOTAL);
+    REQUIRE(ledger_residual(fast) <= 1e-13, "%s: ledger residual %g", name, ledger_residual(fast));
+    REQUIRE(fabs(mass(fast, DPSM_MASS_OUTFLOW) - mass(accurate, DPSM_MASS_OUTFLOW)) <= 5e-3 * total + 1e-12 * total,
+            "%s: outflow %.17g, time accurate %.17g", name, mass(fast, DPSM_MASS_OUTFLOW),
+            mass(accurate, DPSM_MASS_OUTFLOW));
+    if (open_sides == 0)
+        REQUIRE(fabs(mass(fast, DPSM_MASS_OUTFLOW)) <= 1e-13 * total, "%s: %g left a closed domain", name,
+                mass(fast, DPSM_MASS_OUTFLOW));
+    /* At rest by the model's own criterion: a time-accurate step does nothing. */
+    CHECK_OK(fast, dpsm_set_relaxation(fast, DPSM_RELAX_TIME_ACCURATE));
+    CHECK_OK(fast, dpsm_step(fast, 1e3));
+    REQUIRE(info(fast, DPSM_INFO_SUBSTEPS) == 0.0 && info(fast, DPSM_INFO_AT_REST) == 1.0,
+            "%s: a time-accurate step after the fast rest took %g sub-steps", name, info(fast, DPSM_INFO_SUBSTEPS));
+    free(a);
+    free(b);
+    dpsm_destroy(accurate);
+    dpsm_destroy(fast);
+}
+
+static void test_cone_rests_fast_and_right(void **state) {
+    (void)state;
+    double *h = malloc(sizeof(double) * N * N);
+    cone(h);
+    compare_with_time_accurate(h, NULL, 4, 1e-6, 0.002, "cone");
+    compare_with_time_accurate(h, NULL, 4, 1e-3, 0.002, "cone");
+    /* The top against the exact cone at the angle of repose. */
+    dpsm_grid *g = grid_of(h, NULL, 4, 0);
+    CHECK_OK(g, dpsm_set_relaxation(g, DPSM_RELAX_TO_REST));
+    CHECK_OK(g, dpsm_step(g, 1.0));
+    CHECK_OK(g, dpsm_get_heights(g, h));
+    const double top = max_of(h, N * N);
+    print_message("cone: top %.4f, exact 22.89 (%+.2f %%)\n", top, 100.0 * (top - 22.89) / 22.89);
+    REQUIRE(fabs(top - 22.89) <= 0.005 * 22.89, "cone: top %.4f, more than 0.5 %% from 22.89", top);
+    dpsm_destroy(g);
+    free(h);
+}
+
+static void test_meeting_cones_walls_and_outflow(void **state) {
+    (void)state;
+    double *h = malloc(sizeof(double) * N * N);
+    uint8_t *kinds = malloc(N * N);
+    cones_and_wall(h, kinds);
+    compare_with_time_accurate(h, kinds, 1, 1e-6, 0.003, "meeting cones, a wall, one open side");
+    compare_with_time_accurate(h, kinds, 0, 1e-6, 0.003, "meeting cones, a wall, closed");
+    free(h);
+    free(kinds);
+}
+
+/* The same heights bit for bit on 1, 2 and 3 threads. */
+static void test_independent_of_threads(void **state) {
+    (void)state;
+    double *h = malloc(sizeof(double) * N * N), *out[3];
+    uint8_t *kinds = malloc(N * N);
+    cones_and_wall(h, kinds);
+    for (int t = 0; t < 3; ++t) {
+        dpsm_grid *g = grid_of(h, kinds, 1, t + 1);
+        CHECK_OK(g, dpsm_set_relaxation(g, DPSM_RELAX_TO_REST));
+        CHECK_OK(g, dpsm_step(g, 1.0));
+        REQUIRE(info(g, DPSM_INFO_AT_REST) == 1.0, "threads %d: not at rest", t + 1);
+        out[t] = malloc(sizeof(double) * N * N);
+        CHECK_OK(g, dpsm_get_heights(g, out[t]));
+        dpsm_destroy(g);
+    }
+    for (int t = 1; t < 3; ++t)
+        REQUIRE(memcmp(out[0], out[t], sizeof(double) * N * N) == 0, "1 and %d threads differ", t + 1);
+    for (int t = 0; t < 3; ++t) free(out[t]);
+    free(h);
+    free(kinds);
+}
+
+/* Out of flux evaluations: the step succeeds, says it is not at rest, and
+ * the ledger closes; a time-accurate grid set back afterwards steps as one
+ * that never relaxed to rest. */
+static void test_limit_and_switching_back(void **state) {
+    (void)state;
+    double *h = malloc(sizeof(double) * N * N), *a = malloc(sizeof(double) * N * N), *b = malloc(sizeof(double) * N * N);
+    cone(h);
+    dpsm_grid *g = grid_of(h, NULL, 4, 0), *never = grid_of(h, NULL, 4, 0);
+    CHECK_OK(g, dpsm_set_relaxation(g, DPSM_RELAX_TO_REST));
+    CHECK_OK(g, dpsm_set_max_substeps(g, 10));
+    CHECK_OK(g, dpsm_step(g, 1.0));
+    REQUIRE(info(g, DPSM_INFO_AT_REST) == 0.0 && info(g, DPSM_INFO_SUBSTEPS) == 10.0,
+            "with a limit of 10: at rest %g after %g evaluations", info(g, DPSM_INFO_AT_REST),
+            info(g, DPSM_INFO_SUBSTEPS));
+    REQUIRE(info(g, DPSM_INFO_MAX_EXCESS_SLOPE) > 0.0, "not at rest, but no excess slope");
+    REQUIRE(ledger_residual(g) <= 1e-13, "ledger residual %g", ledger_residual(g));
+    CHECK_OK(g, dpsm_set_relaxation(g, DPSM_RELAX_TIME_ACCURATE));
+    CHECK_OK(g, dpsm_set_max_substeps(g, 100000000));
+    CHECK_OK(g, dpsm_get_heights(g, a));
+    CHECK_OK(never, dpsm_set_heights(never, a));
+    CHECK_OK(g, dpsm_step(g, 5.0));
+    CHECK_OK(never, dpsm_step(never, 5.0));
+    CHECK_OK(g, dpsm_get_heights(g, a));
+    CHECK_OK(never, dpsm_get_heights(never, b));
+    REQUIRE(memcmp(a, b, sizeof(double) * N * N) == 0, "set back to DPSM_RELAX_TIME_ACCURATE, it steps differently");
+    dpsm_destroy(g);
+    dpsm_destroy(never);
+    free(h);
+    free(a);
+    free(b);
+}
+
+/* A restart file keeps the setting, and the loaded grid continues bit for bit. */
+static void test_restart_keeps_it(void **state) {
+    (void)state;
+    double *h = malloc(sizeof(double) * N * N), *a = malloc(sizeof(double) * N * N), *b = malloc(sizeof(double) * N * N);
+    cone(h);
+    dpsm_grid *g = grid_of(h, NULL, 4, 0), *loaded = NULL;
+    CHECK_OK(g, dpsm_set_relaxation(g, DPSM_RELAX_TO_REST));
+    CHECK_OK(g, dpsm_set_max_substeps(g, 40));
+    CHECK_OK(g, dpsm_step(g, 1.0));
+    const char *path = "test_relax_to_rest.dpsm";
+    CHECK_OK(g, dpsm_save(g, path));
+    CHECK_OK(NULL, dpsm_load(path, &loaded));
+    remove(path);
+    CHECK_OK(g, dpsm_set_max_substeps(g, 100000000));
+    CHECK_OK(loaded, dpsm_set_max_substeps(loaded, 100000000));
+    CHECK_OK(g, dpsm_step(g, 1.0));
+    CHECK_OK(loaded, dpsm_step(loaded, 1.0));
+    REQUIRE(info(loaded, DPSM_INFO_TIME_INTEGRATED) == 0.0, "the loaded grid stepped in time: it lost the setting");
+    CHECK_OK(g, dpsm_get_heights(g, a));
+    CHECK_OK(loaded, dpsm_get_heights(loaded, b));
+    REQUIRE(memcmp(a, b, sizeof(double) * N * N) == 0, "the loaded grid relaxed differently");
+    REQUIRE(info(g, DPSM_INFO_SUBSTEPS) == info(loaded, DPSM_INFO_SUBSTEPS), "evaluations %g and %g",
+            info(g, DPSM_INFO_SUBSTEPS), info(loaded, DPSM_INFO_SUBSTEPS));
+    dpsm_destroy(g);
+    dpsm_destroy(loaded);
+    free(h);
+    free(a);
+    free(b);
+}
+
+/* What it does not support is refused by dpsm_step with
+ * DPSM_ERR_NOT_APPLICABLE, naming it, before anything changes. */
+static void require_refused(dpsm_grid *g, int64_t cells, const char *phrase) {
+    CHECK_OK(g, dpsm_set_relaxation(g, DPSM_RELAX_TO_REST));
+    double *before = malloc(sizeof(double) * (size_t)cells), *after = malloc(sizeof(double) * (size_t)cells);
+    CHECK_OK(g, dpsm_get_heights(g, before));
+    const double outflow = mass(g, DPSM_MASS_OUTFLOW);
+    const int status = dpsm_step(g, 1.0);
+    const char *message = dpsm_last_error(g);
+    REQUIRE(status == DPSM_ERR_NOT_APPLICABLE, "%s: dpsm_step returned %s (%s)", phrase, dpsm_status_string(status),
+            message);
+    REQUIRE(strstr(message, phrase) != NULL && strstr(message, "DPSM_RELAX_TO_REST") != NULL,
+            "the message does not name '%s': %s", phrase, message);
+    CHECK_OK(g, dpsm_get_heights(g, after));
+    REQUIRE(memcmp(before, after, sizeof(double) * (size_t)cells) == 0 && mass(g, DPSM_MASS_OUTFLOW) == outflow,
+            "%s: the refused step changed the grid", phrase);
+    free(before);
+    free(after);
+}
+
+static void test_unsupported_scenes_refused(void **state) {
+    (void)state;
+    enum { M = 12 };
+    double h[M * M], q[M * M], zb[M * M];
+    uint8_t kinds[M * M];
+    for (int c = 0; c < M * M; ++c) {
+        h[c] = (double)(c % 7);
+        q[c] = 0.01;
+        zb[c] = -1.0;
+        kinds[c] = DPSM_CELL_SAND;
+    }
+    dpsm_grid *g = NULL;
+    CHECK_OK(NULL, dpsm_create_1d(M, 1.0, &g));
+    CHECK_OK(g, dpsm_set_heights(g, h));
+    require_refused(g, M, "1D or axisymmetric");
+    dpsm_destroy(g);
+    CHECK_OK(NULL, dpsm_create_axisymmetric(M, 1.0, &g));
+    CHECK_OK(g, dpsm_set_heights(g, h));
+    require_refused(g, M, "1D or axisymmetric");
+    dpsm_destroy(g);
+    double theta[M * M];
+    for (int c = 0; c < M * M; ++c) theta[c] = 0.5 + 0.01 * (c % 3);
+    for (int feature = 0; feature < 7; ++feature) {
+        CHECK_OK(NULL, dpsm_create_2d(M, M, 1.0, 1.0, &g));
+        CHECK_OK(g, dpsm_set_heights(g, h));
+        const char *phrase = NULL;
+        switch (feature) {
+            case 0: CHECK_OK(g, dpsm_set_bedrock(g, zb)); phrase = "a bed"; break;
+            case 1: CHECK_OK(g, dpsm_set_static_angle(g, 0.7)); phrase = "a static angle"; break;
+            case 2: CHECK_OK(g, dpsm_set_source(g, q)); phrase = "an active source"; break;
+            case 3: CHECK_OK(g, dpsm_set_repose_angle_field(g, theta)); phrase = "an angle field"; break;
+            case 4: CHECK_OK(g, dpsm_set_flux_exponent(g, 1.5)); phrase = "a flux exponent other than 1"; break;
+            case 5: CHECK_OK(g, dpsm_set_scheme(g, DPSM_SCHEME_PAIRWISE)); phrase = "the pairwise scheme"; break;
+            default:
+                kinds[0] = kinds[M * M - 1] = DPSM_CELL_OPEN;
+                CHECK_OK(g, dpsm_set_cell_kinds(g, kinds));
+                double low = 0.0, high = 3.0;
+                CHECK_OK(g, dpsm_set_heights_region(g, 0, 0, 1, 1, &low));
+                CHECK_OK(g, dpsm_set_heights_region(g, M - 1, M - 1, 1, 1, &high));
+                phrase = "open cells held at different levels";
+        }
+        require_refused(g, M * M, phrase);
+        dpsm_destroy(g);
+    }
+}
+
+int main(void) {
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_cone_rests_fast_and_right),
+        cmocka_unit_test(test_meeting_cones_walls_and_outflow),
+        cmocka_unit_test(test_independent_of_threads),
+        cmocka_unit_test(test_limit_and_switching_back),
+        cmocka_unit_test(test_restart_keeps_it),
+        cmocka_unit_test(test_unsupported_scenes_refused),
+    };
+    return cmocka_run_group_tests_name("relax to rest", tests, NULL, NULL);
+}
