@@ -17,17 +17,7 @@
 
 static const double kDeg = 3.14159265358979323846 / 180.0;
 
-static double unmet_of(const dpsm_grid *g) {
-    double v = -1.0;
-    CHECK_OK(g, dpsm_get_mass(g, DPSM_MASS_UNMET, &v));
-    return v;
-}
-
-static double step_info(const dpsm_grid *g, int item) {
-    double v = 0.0;
-    CHECK_OK(g, dpsm_get_step_info(g, item, &v));
-    return v;
-}
+static double unmet_of(const dpsm_grid *g) { return mass_of(g, DPSM_MASS_UNMET); }
 
 /* ------------------------------------------------------------------------ */
 /* Bed                                                                       */
@@ -82,7 +72,7 @@ static void check_bed_scene(dpsm_grid *g, int64_t nx, int64_t ny, double dx, dou
     CHECK_OK(g, dpsm_set_source(g, NULL));
     CHECK_OK(g, dpsm_step(g, to_rest ? 1e7 : 100.0));
     if (to_rest)
-        REQUIRE(step_info(g, DPSM_INFO_AT_REST) == 1.0, "a bed steeper than the angle of repose must come to rest");
+        REQUIRE(step_info_of(g, DPSM_INFO_AT_REST) == 1.0, "a bed steeper than the angle of repose must come to rest");
     CHECK_OK(g, dpsm_get_heights(g, h));
     for (int64_t c = 0; c < n; ++c) REQUIRE(h[c] >= zb[c], "cell %lld below its bed at rest", (long long)c);
     REQUIRE(ledger_residual(g) < 1e-12, "ledger residual %.3g at rest", ledger_residual(g));
@@ -170,7 +160,7 @@ static void test_bare_rock_is_at_rest(void **state) {
     CHECK_OK(g, dpsm_set_heights(g, zb));
     CHECK_OK(g, dpsm_set_bedrock(g, zb));
     CHECK_OK(g, dpsm_step(g, 100.0));
-    REQUIRE(step_info(g, DPSM_INFO_AT_REST) == 1.0 && step_info(g, DPSM_INFO_SUBSTEPS) == 0.0,
+    REQUIRE(step_info_of(g, DPSM_INFO_AT_REST) == 1.0 && step_info_of(g, DPSM_INFO_SUBSTEPS) == 0.0,
             "bare rock must be at rest at once");
     CHECK_OK(g, dpsm_get_heights(g, h));
     REQUIRE(memcmp(h, zb, sizeof h) == 0, "bare rock moved");
@@ -192,7 +182,7 @@ static void test_bed_axisymmetric(void **state) {
     CHECK_OK(g, dpsm_step(g, 1e6));
     CHECK_OK(g, dpsm_get_heights(g, h));
     for (int i = 0; i < n; ++i) REQUIRE(h[i] >= zb[i], "ring %d below its bed", i);
-    REQUIRE(step_info(g, DPSM_INFO_AT_REST) == 1.0, "the sand on the rocky cone comes to rest");
+    REQUIRE(step_info_of(g, DPSM_INFO_AT_REST) == 1.0, "the sand on the rocky cone comes to rest");
     REQUIRE(ledger_residual(g) < 1e-12, "ledger residual %.3g", ledger_residual(g));
     dpsm_destroy(g);
 }
@@ -267,8 +257,8 @@ static void test_angle_field_comes_to_rest_isotropic(void **state) {
         double dt = 0.0;
         CHECK_OK(g, dpsm_stable_dt(g, &dt));
         CHECK_OK(g, dpsm_step(g, 1e6 * dt));
-        const double substeps = step_info(g, DPSM_INFO_SUBSTEPS);
-        REQUIRE(step_info(g, DPSM_INFO_AT_REST) == 1.0, "seed %d: not at rest after 1e6 sub-steps", seed);
+        const double substeps = step_info_of(g, DPSM_INFO_SUBSTEPS);
+        REQUIRE(step_info_of(g, DPSM_INFO_AT_REST) == 1.0, "seed %d: not at rest after 1e6 sub-steps", seed);
         printf("angle field 0.5 .. 89.5 deg, seed %d: at rest after %.0f sub-steps, ledger residual %.2e\n", seed,
                substeps, ledger_residual(g));
         REQUIRE(ledger_residual(g) < 1e-12, "ledger residual %.3g", ledger_residual(g));
@@ -300,7 +290,7 @@ static void test_angle_field_gives_a_pile_per_patch(void **state) {
     REQUIRE(fabs(dt_field - 1.0 / (4.0 * cos(angles[0]))) < 1e-15, "the stable step follows the smallest angle: %.17g",
             dt_field);
     CHECK_OK(g, dpsm_step(g, 1e6));
-    REQUIRE(step_info(g, DPSM_INFO_AT_REST) == 1.0, "the piles come to rest");
+    REQUIRE(step_info_of(g, DPSM_INFO_AT_REST) == 1.0, "the piles come to rest");
     CHECK_OK(g, dpsm_get_heights(g, h));
     for (int patch = 0; patch < 2; ++patch) {
         double top = 0.0, edge = 0.0;
@@ -405,14 +395,14 @@ static void test_flux_exponent_same_rest_state(void **state) {
         CHECK_OK(g, dpsm_set_heights(g, h));
         double dt = 0.0, total = 0.0;
         CHECK_OK(g, dpsm_stable_dt(g, &dt));
-        for (int n = 0; n < 100000 && !step_info(g, DPSM_INFO_AT_REST); ++n) {
+        for (int n = 0; n < 100000 && !step_info_of(g, DPSM_INFO_AT_REST); ++n) {
             CHECK_OK(g, dpsm_step(g, 50.0 * dt));
-            total += step_info(g, DPSM_INFO_SUBSTEPS);
+            total += step_info_of(g, DPSM_INFO_SUBSTEPS);
             CHECK_OK(g, dpsm_get_heights(g, h));
             REQUIRE(max_of(h, N) <= h0 && min_of(h, N) >= 0.0, "p = %g: new extremum %.17g / %.17g", p, max_of(h, N),
                     min_of(h, N));
         }
-        REQUIRE(step_info(g, DPSM_INFO_AT_REST) == 1.0, "p = %g: not at rest after %.0f sub-steps", p, total);
+        REQUIRE(step_info_of(g, DPSM_INFO_AT_REST) == 1.0, "p = %g: not at rest after %.0f sub-steps", p, total);
         substeps[k] = total;
         /* The exact trapezoid: top of half-width half - h0/(2 alpha), flanks at alpha. */
         const double top = half - h0 / (2.0 * alpha);
@@ -462,7 +452,7 @@ static void test_hysteresis_holds_and_releases(void **state) {
         CHECK_OK(g, dpsm_step(g, 1e4));
         CHECK_OK(g, dpsm_get_heights(g, h));
         REQUIRE(memcmp(h, before, sizeof(double) * cells) == 0, "%dD: a 33-degree slope must hold", dim);
-        REQUIRE(step_info(g, DPSM_INFO_AT_REST) == 1.0, "%dD: at rest", dim);
+        REQUIRE(step_info_of(g, DPSM_INFO_AT_REST) == 1.0, "%dD: at rest", dim);
         /* The same slope without hysteresis flows: the static angle is what held it. */
         dpsm_grid *paper = NULL;
         if (dim == 1)
@@ -480,7 +470,7 @@ static void test_hysteresis_holds_and_releases(void **state) {
         /* 38 degrees: released, and it relaxes to the angle of repose, not to the static angle. */
         g = ramp(dim, 38.0, before, N);
         CHECK_OK(g, dpsm_step(g, 1e6));
-        REQUIRE(step_info(g, DPSM_INFO_AT_REST) == 1.0, "%dD: the released slope comes to rest", dim);
+        REQUIRE(step_info_of(g, DPSM_INFO_AT_REST) == 1.0, "%dD: the released slope comes to rest", dim);
         CHECK_OK(g, dpsm_get_heights(g, h));
         double steepest = 0.0;
         for (int j = 0; j < (dim == 1 ? 1 : 20); ++j)
@@ -517,7 +507,7 @@ static void test_hysteresis_intermittent_avalanches(void **state) {
         CHECK_OK(g, dpsm_step(g, 1.0));
         CHECK_OK(g, dpsm_set_source(g, NULL));
         CHECK_OK(g, dpsm_step(g, 1e6)); /* let any avalanche finish */
-        const int moving = step_info(g, DPSM_INFO_SUBSTEPS) > 0;
+        const int moving = step_info_of(g, DPSM_INFO_SUBSTEPS) > 0;
         avalanches += moving && !was_moving;
         was_moving = moving;
         CHECK_OK(g, dpsm_get_heights(g, h));

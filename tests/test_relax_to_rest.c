@@ -59,18 +59,6 @@ static dpsm_grid *grid_of(const double *h, const uint8_t *kinds, int open_sides,
     return g;
 }
 
-static double info(const dpsm_grid *g, int item) {
-    double v = -1.0;
-    CHECK_OK(g, dpsm_get_step_info(g, item, &v));
-    return v;
-}
-
-static double mass(const dpsm_grid *g, int quantity) {
-    double v = 0.0;
-    CHECK_OK(g, dpsm_get_mass(g, quantity, &v));
-    return v;
-}
-
 /* L1 difference of a and b over the volume of b. */
 static double l1_share(const double *a, const double *b) {
     double d = 0.0, v = 0.0;
@@ -91,14 +79,14 @@ static void compare_with_time_accurate(const double *h0, const uint8_t *kinds, i
     CHECK_OK(fast, dpsm_set_relaxation(fast, DPSM_RELAX_TO_REST));
     CHECK_OK(accurate, dpsm_step(accurate, 1e6));
     CHECK_OK(fast, dpsm_step(fast, 1e6));
-    REQUIRE(info(accurate, DPSM_INFO_AT_REST) == 1.0, "%s: the time-accurate run did not rest", name);
-    REQUIRE(info(fast, DPSM_INFO_AT_REST) == 1.0, "%s: the fast relaxation did not rest", name);
-    const double evaluations = info(fast, DPSM_INFO_SUBSTEPS), substeps = info(accurate, DPSM_INFO_SUBSTEPS);
+    REQUIRE(step_info_of(accurate, DPSM_INFO_AT_REST) == 1.0, "%s: the time-accurate run did not rest", name);
+    REQUIRE(step_info_of(fast, DPSM_INFO_AT_REST) == 1.0, "%s: the fast relaxation did not rest", name);
+    const double evaluations = step_info_of(fast, DPSM_INFO_SUBSTEPS), substeps = step_info_of(accurate, DPSM_INFO_SUBSTEPS);
     REQUIRE(evaluations * 4.0 < substeps, "%s: %g evaluations against %g sub-steps: not fast", name, evaluations,
             substeps);
-    REQUIRE(info(fast, DPSM_INFO_TIME_INTEGRATED) == 0.0 && info(fast, DPSM_INFO_MAX_EXCESS_SLOPE) == 0.0,
-            "%s: time integrated %g, largest excess %g", name, info(fast, DPSM_INFO_TIME_INTEGRATED),
-            info(fast, DPSM_INFO_MAX_EXCESS_SLOPE));
+    REQUIRE(step_info_of(fast, DPSM_INFO_TIME_INTEGRATED) == 0.0 && step_info_of(fast, DPSM_INFO_MAX_EXCESS_SLOPE) == 0.0,
+            "%s: time integrated %g, largest excess %g", name, step_info_of(fast, DPSM_INFO_TIME_INTEGRATED),
+            step_info_of(fast, DPSM_INFO_MAX_EXCESS_SLOPE));
     double *a = malloc(sizeof(double) * N * N), *b = malloc(sizeof(double) * N * N);
     CHECK_OK(accurate, dpsm_get_heights(accurate, a));
     CHECK_OK(fast, dpsm_get_heights(fast, b));
@@ -113,19 +101,19 @@ static void compare_with_time_accurate(const double *h0, const uint8_t *kinds, i
         for (int c = 0; c < N * N; ++c)
             if (kinds[c] == DPSM_CELL_WALL) REQUIRE(b[c] == h0[c], "%s: wall cell %d moved", name, c);
     /* Mass: the ledger closes, and what left is what the time-accurate run lost, to round-off. */
-    const double total = mass(fast, DPSM_MASS_TOTAL);
+    const double total = mass_of(fast, DPSM_MASS_TOTAL);
     REQUIRE(ledger_residual(fast) <= 1e-13, "%s: ledger residual %g", name, ledger_residual(fast));
-    REQUIRE(fabs(mass(fast, DPSM_MASS_OUTFLOW) - mass(accurate, DPSM_MASS_OUTFLOW)) <= 5e-3 * total + 1e-12 * total,
-            "%s: outflow %.17g, time accurate %.17g", name, mass(fast, DPSM_MASS_OUTFLOW),
-            mass(accurate, DPSM_MASS_OUTFLOW));
+    REQUIRE(fabs(mass_of(fast, DPSM_MASS_OUTFLOW) - mass_of(accurate, DPSM_MASS_OUTFLOW)) <= 5e-3 * total + 1e-12 * total,
+            "%s: outflow %.17g, time accurate %.17g", name, mass_of(fast, DPSM_MASS_OUTFLOW),
+            mass_of(accurate, DPSM_MASS_OUTFLOW));
     if (open_sides == 0)
-        REQUIRE(fabs(mass(fast, DPSM_MASS_OUTFLOW)) <= 1e-13 * total, "%s: %g left a closed domain", name,
-                mass(fast, DPSM_MASS_OUTFLOW));
+        REQUIRE(fabs(mass_of(fast, DPSM_MASS_OUTFLOW)) <= 1e-13 * total, "%s: %g left a closed domain", name,
+                mass_of(fast, DPSM_MASS_OUTFLOW));
     /* At rest by the model's own criterion: a time-accurate step does nothing. */
     CHECK_OK(fast, dpsm_set_relaxation(fast, DPSM_RELAX_TIME_ACCURATE));
     CHECK_OK(fast, dpsm_step(fast, 1e3));
-    REQUIRE(info(fast, DPSM_INFO_SUBSTEPS) == 0.0 && info(fast, DPSM_INFO_AT_REST) == 1.0,
-            "%s: a time-accurate step after the fast rest took %g sub-steps", name, info(fast, DPSM_INFO_SUBSTEPS));
+    REQUIRE(step_info_of(fast, DPSM_INFO_SUBSTEPS) == 0.0 && step_info_of(fast, DPSM_INFO_AT_REST) == 1.0,
+            "%s: a time-accurate step after the fast rest took %g sub-steps", name, step_info_of(fast, DPSM_INFO_SUBSTEPS));
     free(a);
     free(b);
     dpsm_destroy(accurate);
@@ -171,7 +159,7 @@ static void test_independent_of_threads(void **state) {
         dpsm_grid *g = grid_of(h, kinds, 1, t + 1);
         CHECK_OK(g, dpsm_set_relaxation(g, DPSM_RELAX_TO_REST));
         CHECK_OK(g, dpsm_step(g, 1.0));
-        REQUIRE(info(g, DPSM_INFO_AT_REST) == 1.0, "threads %d: not at rest", t + 1);
+        REQUIRE(step_info_of(g, DPSM_INFO_AT_REST) == 1.0, "threads %d: not at rest", t + 1);
         out[t] = malloc(sizeof(double) * N * N);
         CHECK_OK(g, dpsm_get_heights(g, out[t]));
         dpsm_destroy(g);
@@ -194,10 +182,10 @@ static void test_limit_and_switching_back(void **state) {
     CHECK_OK(g, dpsm_set_relaxation(g, DPSM_RELAX_TO_REST));
     CHECK_OK(g, dpsm_set_max_substeps(g, 10));
     CHECK_OK(g, dpsm_step(g, 1.0));
-    REQUIRE(info(g, DPSM_INFO_AT_REST) == 0.0 && info(g, DPSM_INFO_SUBSTEPS) == 10.0,
-            "with a limit of 10: at rest %g after %g evaluations", info(g, DPSM_INFO_AT_REST),
-            info(g, DPSM_INFO_SUBSTEPS));
-    REQUIRE(info(g, DPSM_INFO_MAX_EXCESS_SLOPE) > 0.0, "not at rest, but no excess slope");
+    REQUIRE(step_info_of(g, DPSM_INFO_AT_REST) == 0.0 && step_info_of(g, DPSM_INFO_SUBSTEPS) == 10.0,
+            "with a limit of 10: at rest %g after %g evaluations", step_info_of(g, DPSM_INFO_AT_REST),
+            step_info_of(g, DPSM_INFO_SUBSTEPS));
+    REQUIRE(step_info_of(g, DPSM_INFO_MAX_EXCESS_SLOPE) > 0.0, "not at rest, but no excess slope");
     REQUIRE(ledger_residual(g) <= 1e-13, "ledger residual %g", ledger_residual(g));
     CHECK_OK(g, dpsm_set_relaxation(g, DPSM_RELAX_TIME_ACCURATE));
     CHECK_OK(g, dpsm_set_max_substeps(g, 100000000));
@@ -232,12 +220,12 @@ static void test_restart_keeps_it(void **state) {
     CHECK_OK(loaded, dpsm_set_max_substeps(loaded, 100000000));
     CHECK_OK(g, dpsm_step(g, 1.0));
     CHECK_OK(loaded, dpsm_step(loaded, 1.0));
-    REQUIRE(info(loaded, DPSM_INFO_TIME_INTEGRATED) == 0.0, "the loaded grid stepped in time: it lost the setting");
+    REQUIRE(step_info_of(loaded, DPSM_INFO_TIME_INTEGRATED) == 0.0, "the loaded grid stepped in time: it lost the setting");
     CHECK_OK(g, dpsm_get_heights(g, a));
     CHECK_OK(loaded, dpsm_get_heights(loaded, b));
     REQUIRE(memcmp(a, b, sizeof(double) * N * N) == 0, "the loaded grid relaxed differently");
-    REQUIRE(info(g, DPSM_INFO_SUBSTEPS) == info(loaded, DPSM_INFO_SUBSTEPS), "evaluations %g and %g",
-            info(g, DPSM_INFO_SUBSTEPS), info(loaded, DPSM_INFO_SUBSTEPS));
+    REQUIRE(step_info_of(g, DPSM_INFO_SUBSTEPS) == step_info_of(loaded, DPSM_INFO_SUBSTEPS), "evaluations %g and %g",
+            step_info_of(g, DPSM_INFO_SUBSTEPS), step_info_of(loaded, DPSM_INFO_SUBSTEPS));
     dpsm_destroy(g);
     dpsm_destroy(loaded);
     free(h);
@@ -251,7 +239,7 @@ static void require_refused(dpsm_grid *g, int64_t cells, const char *phrase) {
     CHECK_OK(g, dpsm_set_relaxation(g, DPSM_RELAX_TO_REST));
     double *before = malloc(sizeof(double) * (size_t)cells), *after = malloc(sizeof(double) * (size_t)cells);
     CHECK_OK(g, dpsm_get_heights(g, before));
-    const double outflow = mass(g, DPSM_MASS_OUTFLOW);
+    const double outflow = mass_of(g, DPSM_MASS_OUTFLOW);
     const int status = dpsm_step(g, 1.0);
     const char *message = dpsm_last_error(g);
     REQUIRE(status == DPSM_ERR_NOT_APPLICABLE, "%s: dpsm_step returned %s (%s)", phrase, dpsm_status_string(status),
@@ -259,7 +247,7 @@ static void require_refused(dpsm_grid *g, int64_t cells, const char *phrase) {
     REQUIRE(strstr(message, phrase) != NULL && strstr(message, "DPSM_RELAX_TO_REST") != NULL,
             "the message does not name '%s': %s", phrase, message);
     CHECK_OK(g, dpsm_get_heights(g, after));
-    REQUIRE(memcmp(before, after, sizeof(double) * (size_t)cells) == 0 && mass(g, DPSM_MASS_OUTFLOW) == outflow,
+    REQUIRE(memcmp(before, after, sizeof(double) * (size_t)cells) == 0 && mass_of(g, DPSM_MASS_OUTFLOW) == outflow,
             "%s: the refused step changed the grid", phrase);
     free(before);
     free(after);

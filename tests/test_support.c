@@ -24,6 +24,18 @@ void require_at(int cond, const char *file, int line, const char *fmt, ...) {
     _fail(file, line);
 }
 
+double step_info_of(const dpsm_grid *g, int item) {
+    double v = -1.0;
+    CHECK_OK(g, dpsm_get_step_info(g, item, &v));
+    return v;
+}
+
+double mass_of(const dpsm_grid *g, int quantity) {
+    double v = 0.0;
+    CHECK_OK(g, dpsm_get_mass(g, quantity, &v));
+    return v;
+}
+
 ledger_t read_ledger(const dpsm_grid *g) {
     ledger_t l;
     CHECK_OK(g, dpsm_get_mass(g, DPSM_MASS_TOTAL, &l.total));

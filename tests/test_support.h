@@ -33,6 +33,10 @@ double min_of(const double *v, size_t n);
  * cells only when kinds is not NULL). */
 double max_face_slope(const double *h, const uint8_t *kinds, int64_t nx, int64_t ny, double dx, double dy);
 
+/* One figure of dpsm_get_step_info / dpsm_get_mass, failing the test when the call fails. */
+double step_info_of(const dpsm_grid *g, int item);
+double mass_of(const dpsm_grid *g, int quantity);
+
 /* Sets every side of a 2D grid (or both of a 1D grid) to kind. */
 void set_all_sides(dpsm_grid *g, int kind, int dim);
 
