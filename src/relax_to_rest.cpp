@@ -24,7 +24,6 @@
 #include <cstdint>
 #include <vector>
 
-#include "active_set.hpp"
 #include "dpsm/dpsm.h"
 #include "error.hpp"
 #include "stepper.hpp"
@@ -82,7 +81,6 @@ public:
         return levels_.front();
     }
     std::int64_t evaluations() const { return evaluations_; }
-    double dt() const { return dt_; }
 
 private:
     Grid &grid_;
