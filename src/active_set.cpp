@@ -60,11 +60,8 @@ void ActiveSet::mark_block(std::int64_t i0, std::int64_t j0, std::int64_t ni, st
 
 void ActiveSet::refresh_masks(const Grid &grid) {
     const std::vector<std::uint8_t> &kind = grid.kinds();
-    for (std::int64_t t = 0; t < tiles(); ++t) {
-        const CellBox c = tile_cells(t);
-        // Ghost cells beyond the domain's edge are sinks or walls.
-        masked_[t] = c.i0 - kReach < 0 || c.j0 - kReach < 0 || c.i1 + kReach > nx_ || c.j1 + kReach > ny_;
-    }
+    // The domain's edge is not here: the sweep masks what reads beyond it.
+    std::fill(masked_.begin(), masked_.end(), 0);
     for (std::int64_t j = 0; j < ny_; ++j)
         for (std::int64_t i = 0; i < nx_; ++i) {
             if (kind[i + nx_ * j] != kSand) for_tiles_reaching(i, j, [&](std::int64_t t) { masked_[t] = 1; });

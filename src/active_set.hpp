@@ -97,7 +97,7 @@ private:
     std::int64_t nx_, ny_, tiles_x_, tiles_y_;
     std::vector<CellBox> hot_;
     std::vector<CellBox> source_;          // cells with a source, per tile
-    std::vector<std::uint8_t> masked_;     // walls, sinks or the edge within a tile's reach
+    std::vector<std::uint8_t> masked_;     // walls or sinks within a tile's reach (the sweep adds the edge)
     std::vector<std::uint8_t> has_source_; // a source within a tile's reach
     std::vector<CellBox> remote_;             // per tile: remote boxes that may reach it (empty: serial)
     std::vector<std::uint8_t> remote_source_; // per tile: a remote source within reach (empty: serial)

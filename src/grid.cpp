@@ -85,25 +85,33 @@ void Grid::write_heights(const Block &block, const double *values, bool add) {
     }
 }
 
-void Grid::set_heights_between_sweeps(const std::vector<double> &y) {
+void Grid::set_heights_between_sweeps(const std::vector<double> &y, const CellBox &within) {
     const std::int64_t nx = geometry_.nx, ny = geometry_.ny, side = ActiveSet::kTile;
-    for (std::int64_t tj = 0; tj < ny; tj += side)
-        for (std::int64_t ti = 0; ti < nx; ti += side) {
+    const std::int64_t wi0 = std::max<std::int64_t>(within.i0, 0), wi1 = std::min(within.i1, nx);
+    const std::int64_t wj0 = std::max<std::int64_t>(within.j0, 0), wj1 = std::min(within.j1, ny);
+    if (wi0 >= wi1 || wj0 >= wj1) return;
+    for (std::int64_t tj = wj0 - wj0 % side; tj < wj1; tj += side)
+        for (std::int64_t ti = wi0 - wi0 % side; ti < wi1; ti += side) {
             // Per tile, so that a pile in one corner wakes only its own cells.
+            const std::int64_t i_begin = std::max(ti, wi0), i_end = std::min(ti + side, wi1);
+            const std::int64_t j_begin = std::max(tj, wj0), j_end = std::min(tj + side, wj1);
             std::int64_t i0 = nx, i1 = -1, j0 = ny, j1 = -1;
-            const std::int64_t i_end = std::min(ti + side, nx), j_end = std::min(tj + side, ny);
-            for (std::int64_t j = tj; j < j_end; ++j) {
-                const std::size_t row = static_cast<std::size_t>(nx * j);
-                std::int64_t first = -1, last = -1;
-                for (std::int64_t i = ti; i < i_end; ++i) {
-                    const std::size_t c = row + static_cast<std::size_t>(i);
-                    if (heights_[c] == y[c] && residuals_[c] == 0.0f) continue;
-                    heights_[c] = y[c];
-                    residuals_[c] = 0.0f;
-                    if (first < 0) first = i;
-                    last = i;
+            for (std::int64_t j = j_begin; j < j_end; ++j) {
+                const double *row_y = y.data() + nx * j;
+                double *row_h = heights_.data() + nx * j;
+                float *row_r = residuals_.data() + nx * j;
+                auto differs = [&](std::int64_t i) { return row_h[i] != row_y[i] || row_r[i] != 0.0f; };
+                // The first and the last cell that differ; those between are
+                // simply overwritten (where they agree, with the same values).
+                std::int64_t first = i_begin;
+                while (first < i_end && !differs(first)) ++first;
+                if (first == i_end) continue;
+                std::int64_t last = i_end - 1;
+                while (!differs(last)) --last;
+                for (std::int64_t i = first; i <= last; ++i) {
+                    row_h[i] = row_y[i];
+                    row_r[i] = 0.0f;
                 }
-                if (first < 0) continue;
                 i0 = std::min(i0, first);
                 i1 = std::max(i1, last);
                 j0 = std::min(j0, j);

@@ -189,9 +189,10 @@ public:
     // the ledger (the state carries its ledger); it recomputes what is derived.
     void restore(GridState &&state);
     // The relaxation to rest (relax_to_rest.cpp) between its sweeps: every
-    // height becomes y's and every residual 0. Only the cells that change are
-    // looked at again, as after a host's edit, but nothing is booked.
-    void set_heights_between_sweeps(const std::vector<double> &y);
+    // height becomes y's and every residual 0, where y may differ from the
+    // heights only within the box. Only the cells that change are looked at
+    // again, as after a host's edit, but nothing is booked.
+    void set_heights_between_sweeps(const std::vector<double> &y, const CellBox &within);
     void set_source(const double *q);                 // NULL: none
 
     // Mass on sand cells now, a compensated sum.

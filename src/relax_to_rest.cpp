@@ -63,29 +63,75 @@ struct RkcStep {
 };
 
 // Evaluates the slide fluxes at heights y by one explicit sub-step of dt
-// from y: change = S(y) - y. Returns the sub-step's summary (moved, largest
-// excess slope). Leaves the grid's heights at S(y).
+// from y: afterwards next() holds S(y), and S(y) - y is dt times the rates.
+// Returns the sub-step's summary (moved, largest excess slope).
+//
+// It keeps the box of cells that any sweep so far has changed: outside it
+// the grid holds the heights the relaxation started from, with no residuals,
+// and so must every state the caller makes (and its changes must be 0), which
+// lets every loop run over the box alone.
 class Evaluator {
 public:
-    Evaluator(Grid &grid, double dt) : grid_(grid), dt_(dt), cells_(grid.heights().size()) {}
+    Evaluator(Grid &grid, double dt) : grid_(grid), dt_(dt), nx_(grid.geometry().nx) {
+        // Residuals become 0 everywhere once, so that they hold outside the box.
+        CellBox all;
+        all.add(0, grid.geometry().nx, 0, grid.geometry().ny);
+        grid.set_heights_between_sweeps(grid.heights(), all);
+    }
 
-    LevelSummary change(const std::vector<double> &y, std::vector<double> &change) {
+    LevelSummary evaluate(const std::vector<double> &y) {
         // The active set then computes only the cells that y moved or that
         // touch a moving face, as in any sub-step.
-        grid_.set_heights_between_sweeps(y);
+        grid_.set_heights_between_sweeps(y, live_);
         tiled_sweep(grid_, 1, dt_, levels_);
-        const std::vector<double> &next = grid_.heights();
-        change.resize(cells_);
-        for (std::size_t c = 0; c < cells_; ++c) change[c] = next[c] - y[c];
+        // The cells the sweep changed join the box (it writes whole tiles
+        // where little or nothing moves); those already in it need no look.
+        const double *next = grid_.heights().data(), *from = y.data();
+        const float *residual = grid_.residuals().data();
+        const CellBox &written = grid_.tiled_workspace().last_written;
+        const CellBox before = live_;
+        for (std::int64_t j = written.j0; j < written.j1; ++j) {
+            const double *next_row = next + nx_ * j, *from_row = from + nx_ * j;
+            const float *residual_row = residual + nx_ * j;
+            auto changed = [&](std::int64_t i) { return next_row[i] != from_row[i] || residual_row[i] != 0.0f; };
+            // Where the row crosses the box, the cells left to look at lie on its two sides.
+            const bool crosses = j >= before.j0 && j < before.j1;
+            const std::int64_t left_end = crosses ? std::max(written.i0, before.i0) : written.i1;
+            const std::int64_t right_begin = crosses ? std::min(written.i1, before.i1) : written.i0;
+            std::int64_t first = written.i0;
+            while (first < left_end && !changed(first)) ++first;
+            std::int64_t last = written.i1 - 1;
+            while (last >= right_begin && !changed(last)) --last;
+            if (first < left_end) live_.add(first, first + 1, j, j + 1);
+            if (last >= right_begin) live_.add(last, last + 1, j, j + 1);
+        }
         ++evaluations_;
         return levels_.front();
     }
+    // S(y) of the last evaluation, until the next one.
+    const double *next() const { return grid_.heights().data(); }
+
+    // Calls f(first, end) for the cells of each row of the box.
+    template <class F>
+    void for_rows(F &&f) const {
+        for_rows(live_, f);
+    }
+    // The grid's heights become y's.
+    void finish(const std::vector<double> &y) { grid_.set_heights_between_sweeps(y, live_); }
     std::int64_t evaluations() const { return evaluations_; }
 
 private:
+    template <class F>
+    void for_rows(const CellBox &box, F &&f) const {
+        if (box.empty()) return;
+        for (std::int64_t j = box.j0; j < box.j1; ++j)
+            f(static_cast<std::size_t>(box.i0 + nx_ * j), static_cast<std::size_t>(box.i1 + nx_ * j));
+    }
+
     Grid &grid_;
     double dt_;
-    std::size_t cells_;
+    std::int64_t nx_;
+    CellBox live_;
     std::vector<LevelSummary> levels_;
     std::int64_t evaluations_ = 0;
 };
@@ -116,6 +162,9 @@ void relax_to_rest(Grid &grid) {
     require_supported(grid);
     prepare_tiled_sweep(grid, grid.threads());  // allocates before anything changes
     const std::size_t cells = grid.heights().size();
+    // All the memory first: an allocation that fails leaves the grid as it was.
+    // Outside the evaluator's box, states hold the start and changes are 0.
+    std::vector<double> y0 = grid.heights(), yjm1 = y0, yjm2 = y0, yj = y0, f0(cells);
     const double mass_before = grid.total_mass();
     Evaluator rates(grid, stable_dt(grid));
     const double switch_excess = kSwitchExcessShare * std::tan(grid.min_repose_angle());
@@ -123,12 +172,10 @@ void relax_to_rest(Grid &grid) {
     StepInfo info;
 
     // The flow's path by RKC steps, while much sand moves.
-    // All the memory first: an allocation that fails leaves the grid as it was.
-    std::vector<double> y0 = grid.heights(), f0(cells), yjm1(cells), yjm2(cells), fj(cells), yj(cells);
     bool rested = false, switched = false;
     double last_excess = 0.0;
     for (int k = 0; rates.evaluations() < budget; ++k) {
-        const LevelSummary start = rates.change(y0, f0);  // f0: dt times the rates at y0
+        const LevelSummary start = rates.evaluate(y0);
         last_excess = start.max_excess;
         if (!start.moved) {
             rested = true;
@@ -145,18 +192,26 @@ void relax_to_rest(Grid &grid) {
         const double tau = kStageSafety * rkc.beta / 2.0;  // the step in units of the explicit sub-step
         // Each stage as y0 plus a combination of changes, so that a cell no
         // face acts on keeps its height to the last bit.
-        for (std::size_t c = 0; c < cells; ++c) {
-            yjm2[c] = y0[c];
-            yjm1[c] = y0[c] + rkc.b[1] * rkc.w1 * tau * f0[c];
-        }
+        const double first = rkc.b[1] * rkc.w1 * tau;
+        const double *start_next = rates.next();
+        rates.for_rows([&](std::size_t c0, std::size_t c1) {
+            for (std::size_t c = c0; c < c1; ++c) {
+                f0[c] = start_next[c] - y0[c];  // dt times the rates at y0
+                yjm2[c] = y0[c];
+                yjm1[c] = y0[c] + first * f0[c];
+            }
+        });
         for (int j = 2; j <= rkc.s; ++j) {
-            rates.change(yjm1, fj);
+            rates.evaluate(yjm1);
+            const double *next = rates.next();
             const double mu = 2.0 * rkc.b[j] * rkc.w0 / rkc.b[j - 1], nu = -rkc.b[j] / rkc.b[j - 2];
             const double mut = 2.0 * rkc.b[j] * rkc.w1 / rkc.b[j - 1];
             const double gamt = -(1.0 - rkc.b[j - 1] * rkc.T[j - 1]) * mut;
-            for (std::size_t c = 0; c < cells; ++c)
-                yj[c] = y0[c] + (mu * (yjm1[c] - y0[c]) + nu * (yjm2[c] - y0[c]) + mut * tau * fj[c] +
-                                 gamt * tau * f0[c]);
+            rates.for_rows([&](std::size_t c0, std::size_t c1) {
+                for (std::size_t c = c0; c < c1; ++c)
+                    yj[c] = y0[c] + (mu * (yjm1[c] - y0[c]) + nu * (yjm2[c] - y0[c]) +
+                                     mut * tau * (next[c] - yjm1[c]) + gamt * tau * f0[c]);
+            });
             yjm2.swap(yjm1);
             yjm1.swap(yj);
         }
@@ -164,31 +219,45 @@ void relax_to_rest(Grid &grid) {
     }
 
     // Momentum for the tail, where little sand is left to move.
-    std::vector<double> &x = y0, &x_prev = yjm1, &y = yjm2, &change = fj;
-    x_prev = x;
+    std::vector<double> &x = y0, &x_prev = yjm1, &y = yjm2;
+    const auto copy = [&](std::vector<double> &to, const std::vector<double> &from) {
+        rates.for_rows([&](std::size_t c0, std::size_t c1) { std::copy(&from[c0], &from[c0] + (c1 - c0), &to[c0]); });
+    };
+    copy(x_prev, x);
     for (std::int64_t k = 0; switched && !rested && rates.evaluations() < budget;) {
         const double beta = static_cast<double>(k) / static_cast<double>(k + 3);
-        for (std::size_t c = 0; c < cells; ++c) y[c] = x[c] + beta * (x[c] - x_prev[c]);  // x where x = x_prev
-        const LevelSummary at = rates.change(y, change);
+        rates.for_rows([&](std::size_t c0, std::size_t c1) {
+            for (std::size_t c = c0; c < c1; ++c) y[c] = x[c] + beta * (x[c] - x_prev[c]);  // x where x = x_prev
+        });
+        const LevelSummary at = rates.evaluate(y);
+        const double *next = rates.next();
         last_excess = at.max_excess;
         if (!at.moved) {
-            x = y;
-            x_prev = y;
+            copy(x, y);
+            copy(x_prev, y);
             rested = k == 0;
             k = 0;
             continue;
         }
-        double along = 0.0, motion = 0.0, coasting = 0.0;
-        for (std::size_t c = 0; c < cells; ++c) {
-            const double next = y[c] + change[c], moved = std::fabs(next - x[c]);
-            along += change[c] * (next - x[c]);
-            motion += moved;
-            if (change[c] == 0.0) coasting += moved;
+        // Four partial sums, so that the additions do not wait on each other.
+        double along[4] = {}, motion[4] = {}, coasting[4] = {};
+        const auto advance = [&](std::size_t c, int part) {
+            const double change = next[c] - y[c], to = y[c] + change, moved = std::fabs(to - x[c]);
+            along[part] += change * (to - x[c]);
+            motion[part] += moved;
+            coasting[part] += change == 0.0 ? moved : 0.0;
             x_prev[c] = x[c];
-            x[c] = next;
-        }
-        if (along < 0.0 || coasting > kCoastingShare * motion) {
-            x_prev = x;
+            x[c] = to;
+        };
+        rates.for_rows([&](std::size_t c0, std::size_t c1) {
+            std::size_t c = c0;
+            for (; c + 4 <= c1; c += 4)
+                for (int part = 0; part < 4; ++part) advance(c + part, part);
+            for (; c < c1; ++c) advance(c, 0);
+        });
+        const auto total = [](const double *parts) { return (parts[0] + parts[1]) + (parts[2] + parts[3]); };
+        if (total(along) < 0.0 || total(coasting) > kCoastingShare * total(motion)) {
+            copy(x_prev, x);
             k = 0;
         } else {
             ++k;
@@ -196,7 +265,7 @@ void relax_to_rest(Grid &grid) {
     }
 
     // The state reached becomes the grid's (at rest, it already is).
-    grid.set_heights_between_sweeps(x);
+    rates.finish(x);
     grid.ledger().outflow.add(mass_before - grid.total_mass());
     info.substeps = rates.evaluations();
     info.at_rest = rested;

@@ -305,7 +305,7 @@ std::int64_t tiled_sweep(Grid &grid, int levels, double dt, std::vector<LevelSum
     auto visit_tile = [&](std::int64_t k, TileBuffers &b) {
         const std::int64_t t = ws.visit[k];
         const CellBox &cells = ws.boxes[k];
-        const bool masked = active.masked(t), source = active.has_source(t);
+        const bool source = active.has_source(t);
         // Level s must be right on the cells that later levels read (within
         // levels - s of the box) but can change only those within s - 1 of the
         // seeds: it computes where both hold. What the levels read, one cell
@@ -321,10 +321,14 @@ std::int64_t tiled_sweep(Grid &grid, int levels, double dt, std::vector<LevelSum
         const std::int64_t gi0 = read.i0, gj0 = read.j0;
         b.width = static_cast<int>(read.i1 - read.i0);
         b.height = static_cast<int>(read.j1 - read.j0);
+        // Ghost cells beyond the edge are sinks or walls: only a box that reads
+        // them needs the kernel that looks at cell kinds, not its whole tile.
+        // (Both kernels round alike: src/CMakeLists.txt.)
+        const bool inside = gi0 >= 0 && gj0 >= 0 && gi0 + b.width <= geo.nx && gj0 + b.height <= geo.ny;
+        const bool masked = active.masked(t) || !inside;
         // The physics kernel reads cell kinds on every tile.
         gather(grid, b, gi0, gj0, masked || physics, source);
-        if (halo_store && !(gi0 >= 0 && gj0 >= 0 && gi0 + b.width <= geo.nx && gj0 + b.height <= geo.ny))
-            gather_halo(grid, *halo_store, b, gi0, gj0, masked || physics, source);
+        if (halo_store && !inside) gather_halo(grid, *halo_store, b, gi0, gj0, masked || physics, source);
         if (physics) gather_physics(grid, halo_store, b, gi0, gj0);
         if (!every_cell) {
             // A cell a level leaves alone keeps its gathered value, which the
@@ -399,11 +403,13 @@ std::int64_t tiled_sweep(Grid &grid, int levels, double dt, std::vector<LevelSum
     // The old grid, now the scratch, differs from the new one where this sweep wrote.
     for (const std::int64_t t : ws.stale_tiles) ws.stale[static_cast<std::size_t>(t)] = CellBox{};
     ws.stale_tiles.clear();
+    ws.last_written = CellBox{};
     for (std::int64_t k = 0; k < visits; ++k) {
         const std::size_t t = static_cast<std::size_t>(ws.visit[k]);
         ws.written[t] = CellBox{};
         if (ws.boxes[k].empty()) continue;
         ws.stale[t] = ws.boxes[k];
+        ws.last_written.add(ws.boxes[k]);
         ws.stale_tiles.push_back(ws.visit[k]);
     }
 

@@ -38,6 +38,7 @@ struct TiledWorkspace {
     std::vector<CellBox> stale;        // per tile: where the scratch may differ from the grid
     std::vector<std::int64_t> stale_tiles;  // the tiles whose stale box is not empty
     std::vector<CellBox> written;      // per tile, during a sweep: the cells it writes
+    CellBox last_written;              // after a sweep: every cell it wrote (where the grid may have changed)
     std::vector<TileBuffers> buffers;  // one per thread
     std::vector<std::int64_t> visit;
     std::vector<CellBox> boxes;         // per visited tile: the cells that can change
