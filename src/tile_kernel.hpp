@@ -24,6 +24,9 @@ struct TileLevelParams {
     double inv_dx, inv_dy, half_inv_dx, half_inv_dy;
     double dt;
     double x_face_length, y_face_length;  // dy and dx: flux per unit length to mass per unit time
+    // Carry what rounding drops from each height in its residual (a TwoSum).
+    // Without, residuals are neither read nor written: they must be 0.
+    bool residuals = true;
     // Read by the physics kernel only (tile_kernel_physics.cpp).
     double rest_factor = 1.0;  // 1 + tol: a face's threshold is tan(theta) times this
     double flux_exponent = 1.0;

@@ -141,7 +141,7 @@ void advance_tile_level(TileBuffers &b, int in, const TileRect &reg, const TileR
         const bool row_in_tile = r >= tile.r0 && r < tile.r1;
         for (int k = 0; k < n; k += w) {
             const int m = std::min(w, n - k), col = reg.c0 + k, c = row + col;
-            const V hc = load(h + c, m), rc = load(res + c, m);
+            const V hc = load(h + c, m), rc = p.residuals ? load(res + c, m) : zero;
             const V f_west = load(fx + k, m), f_east = load(fx + k + 1, m);
             const V f_south = load(fy_below + k, m), f_north = load(fy_above + k, m);
             V increment = ((f_west - f_east) * inv_dx + (f_south - f_north) * inv_dy) * dt;
@@ -149,17 +149,18 @@ void advance_tile_level(TileBuffers &b, int in, const TileRect &reg, const TileR
             // h + increment as a TwoSum, carrying what rounding drops.
             const V b_ = increment + rc;
             V sum = hc + b_;
-            const V b_virtual = sum - hc;
-            V err = (hc - (sum - b_virtual)) + (b_ - b_virtual);
             // Cells that do not move keep height and residual bit for bit, as
             // they would in a tile that is not visited.
             M sand = all;
             if constexpr (Masked) sand = V::kind_is(kind + c, kSand);
             const M changes = V::both(sand, increment != zero);
+            if (p.residuals) {
+                const V b_virtual = sum - hc;
+                const V err = (hc - (sum - b_virtual)) + (b_ - b_virtual);
+                store(res_out + c, select(changes, err, rc), m);
+            }
             sum = select(changes, sum, hc);
-            err = select(changes, err, rc);
             store(h_out + c, sum, m);
-            store(res_out + c, err, m);
 
             // Motion is sand carried by a face, even where an increment is too
             // small to change a height (a tiny dt): such a cell stays hot.

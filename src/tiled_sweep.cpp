@@ -75,7 +75,8 @@ std::uint8_t ghost_kind(const Grid &grid, std::int64_t i, std::int64_t j) {
 }
 
 // Copies a tile and its halo into the buffers, ghosts beyond the edge.
-void gather(const Grid &grid, TileBuffers &b, std::int64_t gi0, std::int64_t gj0, bool masked, bool source) {
+void gather(const Grid &grid, TileBuffers &b, std::int64_t gi0, std::int64_t gj0, bool masked, bool source,
+            bool residuals) {
     const Geometry &geo = grid.geometry();
     const double *h = grid.heights().data();
     const float *res = grid.residuals().data();
@@ -106,7 +107,7 @@ void gather(const Grid &grid, TileBuffers &b, std::int64_t gi0, std::int64_t gj0
             const std::size_t at = static_cast<std::size_t>(j * geo.nx + gi0 + c_in0);
             const int count = c_in1 - c_in0;
             std::memcpy(hb + c_in0, h + at, sizeof(double) * count);
-            widen(res + at, rb + c_in0, count);
+            if (residuals) widen(res + at, rb + c_in0, count);
             if (masked) std::memcpy(kb + c_in0, kind + at, count);
             if (source)
                 for (int c = 0; c < count; ++c) qb[c_in0 + c] = kind[at + c] == kSand ? q[at + c] : 0.0;
@@ -266,7 +267,7 @@ void prepare_tiled_sweep(Grid &grid, int threads) {
     ws.origin.reserve(2 * tiles);
 }
 
-std::int64_t tiled_sweep(Grid &grid, int levels, double dt, std::vector<LevelSummary> &summaries) {
+std::int64_t tiled_sweep(Grid &grid, int levels, double dt, std::vector<LevelSummary> &summaries, bool residuals) {
     const Geometry &geo = grid.geometry();
     ActiveSet &active = grid.active_set();
     TiledWorkspace &ws = grid.tiled_workspace();
@@ -284,6 +285,8 @@ std::int64_t tiled_sweep(Grid &grid, int levels, double dt, std::vector<LevelSum
                            1.0 / geo.dy,    0.5 / geo.dx,    0.5 / geo.dy,          dt,
                            geo.dy,          geo.dx};
     const bool physics = grid.uses_physics(), hysteresis = grid.hysteresis();
+    residuals = residuals || physics;  // the physics kernel always carries them
+    params.residuals = residuals;
     if (physics) {
         params.rest_factor = 1.0 + grid.rest_tolerance();
         params.flux_exponent = grid.flux_exponent();
@@ -327,7 +330,7 @@ std::int64_t tiled_sweep(Grid &grid, int levels, double dt, std::vector<LevelSum
         const bool inside = gi0 >= 0 && gj0 >= 0 && gi0 + b.width <= geo.nx && gj0 + b.height <= geo.ny;
         const bool masked = active.masked(t) || !inside;
         // The physics kernel reads cell kinds on every tile.
-        gather(grid, b, gi0, gj0, masked || physics, source);
+        gather(grid, b, gi0, gj0, masked || physics, source, residuals);
         if (halo_store && !inside) gather_halo(grid, *halo_store, b, gi0, gj0, masked || physics, source);
         if (physics) gather_physics(grid, halo_store, b, gi0, gj0);
         if (!every_cell) {
@@ -335,7 +338,7 @@ std::int64_t tiled_sweep(Grid &grid, int levels, double dt, std::vector<LevelSum
             // next level then reads from the other slot.
             const std::size_t count = static_cast<std::size_t>(b.width) * b.height;
             std::memcpy(b.h[1].data(), b.h[0].data(), sizeof(double) * count);
-            std::memcpy(b.residual[1].data(), b.residual[0].data(), sizeof(double) * count);
+            if (residuals) std::memcpy(b.residual[1].data(), b.residual[0].data(), sizeof(double) * count);
             if (hysteresis) std::memcpy(b.moving[1].data(), b.moving[0].data(), count);
         }
         auto in_buffer = [&](const CellBox &box) {
@@ -356,7 +359,10 @@ std::int64_t tiled_sweep(Grid &grid, int levels, double dt, std::vector<LevelSum
             const std::size_t to = static_cast<std::size_t>((gj0 + r) * geo.nx + gi0 + tile.c0);
             const int count = tile.c1 - tile.c0;
             std::memcpy(ws.heights.data() + to, b.h[in].data() + from, sizeof(double) * count);
-            narrow(b.residual[in].data() + from, ws.residuals.data() + to, count);
+            if (residuals)
+                narrow(b.residual[in].data() + from, ws.residuals.data() + to, count);
+            else
+                std::fill_n(ws.residuals.data() + to, count, 0.0f);
             if (hysteresis) std::memcpy(ws.moving.data() + to, b.moving[in].data() + from, count);
         }
         ws.origin[2 * k] = gi0;

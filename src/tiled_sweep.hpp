@@ -57,6 +57,10 @@ void tiled_workspace_changed(TiledWorkspace &ws, const ActiveSet &active, const 
 
 // Advances a 2D grid `levels` (1 .. ActiveSet::kMaxLevels) sub-steps of dt and
 // fills one summary per level; returns the number of cells it visited.
-std::int64_t tiled_sweep(Grid &grid, int levels, double dt, std::vector<LevelSummary> &summaries);
+// Without residuals (the relaxation to rest, which has no use for them) every
+// residual must be 0 and stays 0, and the heights are those the sweep with
+// them would give; the physics kernel always carries them.
+std::int64_t tiled_sweep(Grid &grid, int levels, double dt, std::vector<LevelSummary> &summaries,
+                         bool residuals = true);
 
 }  // namespace dpsm

@@ -203,6 +203,54 @@ static void test_limit_and_switching_back(void **state) {
     free(b);
 }
 
+/* A host's time-accurate steps leave residuals wherever sand moved; then a
+ * new pile far from there is relaxed to rest. Afterwards the grid steps as one
+ * that only has its heights (no residual is left anywhere, not only where the
+ * relaxation acted), and the ledger closes. */
+static void test_after_time_accurate_steps(void **state) {
+    (void)state;
+    double *h = malloc(sizeof(double) * N * N), *a = malloc(sizeof(double) * N * N), *b = malloc(sizeof(double) * N * N);
+    for (int j = 0; j < N; ++j)
+        for (int i = 0; i < N; ++i) h[i + N * j] = fmax(0.0, 8.0 - 1.5 * hypot(i - 20.0, j - 20.0));
+    dpsm_grid *g = grid_of(h, NULL, 4, 0);
+    CHECK_OK(g, dpsm_step(g, 1e6));
+    REQUIRE(step_info_of(g, DPSM_INFO_AT_REST) == 1.0, "the first pile did not rest");
+    CHECK_OK(g, dpsm_step(g, 1.0)); /* at rest: the active set forgets the pile */
+    REQUIRE(step_info_of(g, DPSM_INFO_SUBSTEPS) == 0.0, "the first pile moved again");
+    enum { M = 21 };
+    double column[M * M];
+    for (int j = 0; j < M; ++j)
+        for (int i = 0; i < M; ++i) column[i + M * j] = fmax(0.0, 15.0 - 2.0 * hypot(i - M / 2, j - M / 2));
+    CHECK_OK(g, dpsm_add_heights_region(g, 65, 65, M, M, column));
+    CHECK_OK(g, dpsm_set_relaxation(g, DPSM_RELAX_TO_REST));
+    CHECK_OK(g, dpsm_step(g, 1.0));
+    REQUIRE(step_info_of(g, DPSM_INFO_AT_REST) == 1.0, "the new pile did not rest");
+    REQUIRE(ledger_residual(g) <= 1e-13, "ledger residual %g", ledger_residual(g));
+    CHECK_OK(g, dpsm_get_heights(g, a));
+    REQUIRE(a[20 + N * 20] < 8.0 && a[75 + N * 75] < 15.0 && a[75 + N * 75] > 5.0, "tops %g and %g", a[20 + N * 20],
+            a[75 + N * 75]);
+    /* Knocked out of rest on both piles (dpsm_add_heights_region clears the
+     * residuals of its block only), both grids must step alike. */
+    dpsm_grid *fresh = grid_of(a, NULL, 4, 0);
+    double knock[5 * 5];
+    for (int c = 0; c < 5 * 5; ++c) knock[c] = 6.0;
+    for (int pile = 0; pile < 2; ++pile) {
+        CHECK_OK(g, dpsm_add_heights_region(g, 18 + 55 * pile, 18 + 55 * pile, 5, 5, knock));
+        CHECK_OK(fresh, dpsm_add_heights_region(fresh, 18 + 55 * pile, 18 + 55 * pile, 5, 5, knock));
+    }
+    CHECK_OK(g, dpsm_set_relaxation(g, DPSM_RELAX_TIME_ACCURATE));
+    CHECK_OK(g, dpsm_step(g, 5.0));
+    CHECK_OK(fresh, dpsm_step(fresh, 5.0));
+    CHECK_OK(g, dpsm_get_heights(g, a));
+    CHECK_OK(fresh, dpsm_get_heights(fresh, b));
+    REQUIRE(memcmp(a, b, sizeof(double) * N * N) == 0, "after the relaxation, the grid steps unlike a fresh one");
+    dpsm_destroy(g);
+    dpsm_destroy(fresh);
+    free(h);
+    free(a);
+    free(b);
+}
+
 /* A restart file keeps the setting, and the loaded grid continues bit for bit. */
 static void test_restart_keeps_it(void **state) {
     (void)state;
@@ -305,6 +353,7 @@ int main(void) {
         cmocka_unit_test(test_meeting_cones_walls_and_outflow),
         cmocka_unit_test(test_independent_of_threads),
         cmocka_unit_test(test_limit_and_switching_back),
+        cmocka_unit_test(test_after_time_accurate_steps),
         cmocka_unit_test(test_restart_keeps_it),
         cmocka_unit_test(test_unsupported_scenes_refused),
     };
