@@ -27,6 +27,7 @@
 #include "dpsm/dpsm.h"
 #include "error.hpp"
 #include "stepper.hpp"
+#include "tile_kernel.hpp"
 #include "tiled_sweep.hpp"
 
 namespace dpsm {
@@ -61,6 +62,88 @@ struct RkcStep {
         beta = (w0 + 1.0) * ddT[s] / dT[s];
     }
 };
+
+// The arithmetic on the cells of one row, [c0, c1), after every evaluation.
+// Where the kernels run in AVX-512 so do these, 8 cells at a time instead of
+// 2 (copies built for it; chosen by a test of the CPU, as in tiled_sweep.cpp).
+// Neither copy has fused multiply-adds, so both round alike.
+struct StageWeights {
+    double mu, nu, mut_tau, gamt_tau;
+};
+// Four partial sums, so that the additions do not wait on each other.
+struct MomentumStep {
+    double along[4] = {}, motion[4] = {}, coasting[4] = {};
+};
+
+// A stage of an RKC step: y0 plus a combination of changes.
+inline void rkc_stage_cells(std::size_t c0, std::size_t c1, const double *y0, const double *yjm1, const double *yjm2,
+                            const double *next, const double *f0, StageWeights w, double *__restrict yj) {
+    for (std::size_t c = c0; c < c1; ++c)
+        yj[c] = y0[c] + (w.mu * (yjm1[c] - y0[c]) + w.nu * (yjm2[c] - y0[c]) + w.mut_tau * (next[c] - yjm1[c]) +
+                         w.gamt_tau * f0[c]);
+}
+// Momentum's look-ahead: x where x = x_prev.
+inline void extrapolate_cells(std::size_t c0, std::size_t c1, const double *x, const double *x_prev, double beta,
+                              double *__restrict y) {
+    for (std::size_t c = c0; c < c1; ++c) y[c] = x[c] + beta * (x[c] - x_prev[c]);
+}
+// Momentum's step to next = S(y), and how its motion went.
+inline void momentum_cells(std::size_t c0, std::size_t c1, const double *next, const double *y, double *__restrict x,
+                           double *__restrict x_prev, MomentumStep &m) {
+    const auto advance = [&](std::size_t c, int part) {
+        const double change = next[c] - y[c], to = y[c] + change, moved = std::fabs(to - x[c]);
+        m.along[part] += change * (to - x[c]);
+        m.motion[part] += moved;
+        m.coasting[part] += change == 0.0 ? moved : 0.0;
+        x_prev[c] = x[c];
+        x[c] = to;
+    };
+    std::size_t c = c0;
+    for (; c + 4 <= c1; c += 4)
+        for (int part = 0; part < 4; ++part) advance(c + part, part);
+    for (; c < c1; ++c) advance(c, 0);
+}
+
+struct CellLoops {
+    void (*rkc_stage)(std::size_t, std::size_t, const double *, const double *, const double *, const double *,
+                      const double *, StageWeights, double *);
+    void (*extrapolate)(std::size_t, std::size_t, const double *, const double *, double, double *);
+    void (*momentum)(std::size_t, std::size_t, const double *, const double *, double *, double *, MomentumStep &);
+};
+void rkc_stage_plain(std::size_t c0, std::size_t c1, const double *y0, const double *yjm1, const double *yjm2,
+                     const double *next, const double *f0, StageWeights w, double *yj) {
+    rkc_stage_cells(c0, c1, y0, yjm1, yjm2, next, f0, w, yj);
+}
+void extrapolate_plain(std::size_t c0, std::size_t c1, const double *x, const double *x_prev, double beta, double *y) {
+    extrapolate_cells(c0, c1, x, x_prev, beta, y);
+}
+void momentum_plain(std::size_t c0, std::size_t c1, const double *next, const double *y, double *x, double *x_prev,
+                    MomentumStep &m) {
+    momentum_cells(c0, c1, next, y, x, x_prev, m);
+}
+#if defined(DPSM_HAVE_AVX512_KERNEL)
+__attribute__((target("avx512f"))) void rkc_stage_avx512(std::size_t c0, std::size_t c1, const double *y0,
+                                                          const double *yjm1, const double *yjm2, const double *next,
+                                                          const double *f0, StageWeights w, double *yj) {
+    rkc_stage_cells(c0, c1, y0, yjm1, yjm2, next, f0, w, yj);
+}
+__attribute__((target("avx512f"))) void extrapolate_avx512(std::size_t c0, std::size_t c1, const double *x,
+                                                            const double *x_prev, double beta, double *y) {
+    extrapolate_cells(c0, c1, x, x_prev, beta, y);
+}
+__attribute__((target("avx512f"))) void momentum_avx512(std::size_t c0, std::size_t c1, const double *next,
+                                                         const double *y, double *x, double *x_prev, MomentumStep &m) {
+    momentum_cells(c0, c1, next, y, x, x_prev, m);
+}
+#endif
+const CellLoops &cell_loops() {
+    static const CellLoops plain{rkc_stage_plain, extrapolate_plain, momentum_plain};
+#if defined(DPSM_HAVE_AVX512_KERNEL)
+    static const CellLoops avx512{rkc_stage_avx512, extrapolate_avx512, momentum_avx512};
+    if (tile_kernels_use_avx512()) return avx512;
+#endif
+    return plain;
+}
 
 // Evaluates the slide fluxes at heights y by one explicit sub-step of dt
 // from y: afterwards next() holds S(y), and S(y) - y is dt times the rates.
@@ -170,6 +253,7 @@ void relax_to_rest(Grid &grid) {
     const double switch_excess = kSwitchExcessShare * std::tan(grid.min_repose_angle());
     const std::int64_t budget = grid.max_substeps();
     StepInfo info;
+    const CellLoops &loops = cell_loops();
 
     // The flow's path by RKC steps, while much sand moves.
     bool rested = false, switched = false;
@@ -207,10 +291,9 @@ void relax_to_rest(Grid &grid) {
             const double mu = 2.0 * rkc.b[j] * rkc.w0 / rkc.b[j - 1], nu = -rkc.b[j] / rkc.b[j - 2];
             const double mut = 2.0 * rkc.b[j] * rkc.w1 / rkc.b[j - 1];
             const double gamt = -(1.0 - rkc.b[j - 1] * rkc.T[j - 1]) * mut;
+            const StageWeights weights{mu, nu, mut * tau, gamt * tau};
             rates.for_rows([&](std::size_t c0, std::size_t c1) {
-                for (std::size_t c = c0; c < c1; ++c)
-                    yj[c] = y0[c] + (mu * (yjm1[c] - y0[c]) + nu * (yjm2[c] - y0[c]) +
-                                     mut * tau * (next[c] - yjm1[c]) + gamt * tau * f0[c]);
+                loops.rkc_stage(c0, c1, y0.data(), yjm1.data(), yjm2.data(), next, f0.data(), weights, yj.data());
             });
             yjm2.swap(yjm1);
             yjm1.swap(yj);
@@ -227,7 +310,7 @@ void relax_to_rest(Grid &grid) {
     for (std::int64_t k = 0; switched && !rested && rates.evaluations() < budget;) {
         const double beta = static_cast<double>(k) / static_cast<double>(k + 3);
         rates.for_rows([&](std::size_t c0, std::size_t c1) {
-            for (std::size_t c = c0; c < c1; ++c) y[c] = x[c] + beta * (x[c] - x_prev[c]);  // x where x = x_prev
+            loops.extrapolate(c0, c1, x.data(), x_prev.data(), beta, y.data());
         });
         const LevelSummary at = rates.evaluate(y);
         const double *next = rates.next();
@@ -239,24 +322,12 @@ void relax_to_rest(Grid &grid) {
             k = 0;
             continue;
         }
-        // Four partial sums, so that the additions do not wait on each other.
-        double along[4] = {}, motion[4] = {}, coasting[4] = {};
-        const auto advance = [&](std::size_t c, int part) {
-            const double change = next[c] - y[c], to = y[c] + change, moved = std::fabs(to - x[c]);
-            along[part] += change * (to - x[c]);
-            motion[part] += moved;
-            coasting[part] += change == 0.0 ? moved : 0.0;
-            x_prev[c] = x[c];
-            x[c] = to;
-        };
+        MomentumStep step;
         rates.for_rows([&](std::size_t c0, std::size_t c1) {
-            std::size_t c = c0;
-            for (; c + 4 <= c1; c += 4)
-                for (int part = 0; part < 4; ++part) advance(c + part, part);
-            for (; c < c1; ++c) advance(c, 0);
+            loops.momentum(c0, c1, next, y.data(), x.data(), x_prev.data(), step);
         });
         const auto total = [](const double *parts) { return (parts[0] + parts[1]) + (parts[2] + parts[3]); };
-        if (total(along) < 0.0 || total(coasting) > kCoastingShare * total(motion)) {
+        if (total(step.along) < 0.0 || total(step.coasting) > kCoastingShare * total(step.motion)) {
             copy(x_prev, x);
             k = 0;
         } else {

@@ -69,6 +69,8 @@ using TileLevelFunction = void (*)(TileBuffers &buffers, int in, const TileRect 
 // The kernel for a tile: masked (walls, sinks or ghosts in reach), isotropic
 // or pairwise, with or without a source. The widest lanes this CPU has.
 TileLevelFunction select_tile_kernel(bool masked, bool isotropic, bool source);
+// Whether the kernels chosen run in AVX-512 (this CPU has it, DPSM_NO_AVX512 is not set).
+bool tile_kernels_use_avx512();
 
 // The kernel of a grid that uses a bed, an angle field, a flux exponent or
 // hysteresis (tile_kernel_physics.cpp): plain scalar code, used for every tile

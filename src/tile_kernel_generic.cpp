@@ -36,8 +36,13 @@ static bool use_avx512() {
 #endif
 }
 
-TileLevelFunction select_tile_kernel(bool masked, bool isotropic, bool source) {
+bool tile_kernels_use_avx512() {
     static const bool avx512 = use_avx512();
+    return avx512;
+}
+
+TileLevelFunction select_tile_kernel(bool masked, bool isotropic, bool source) {
+    const bool avx512 = tile_kernels_use_avx512();
 #if defined(DPSM_HAVE_AVX512_KERNEL)
     if (avx512) return tile_kernel_avx512(masked, isotropic, source);
 #endif
