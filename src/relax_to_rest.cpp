@@ -90,11 +90,18 @@ inline void extrapolate_cells(std::size_t c0, std::size_t c1, const double *x, c
 // Momentum's step to next = S(y), and how its motion went.
 inline void momentum_cells(std::size_t c0, std::size_t c1, const double *next, const double *y, double *__restrict x,
                            double *__restrict x_prev, MomentumStep &m) {
+    // Sums in locals, which the stores to the cells cannot alias.
+    double along[4], motion[4], coasting[4];
+    for (int part = 0; part < 4; ++part) {
+        along[part] = m.along[part];
+        motion[part] = m.motion[part];
+        coasting[part] = m.coasting[part];
+    }
     const auto advance = [&](std::size_t c, int part) {
         const double change = next[c] - y[c], to = y[c] + change, moved = std::fabs(to - x[c]);
-        m.along[part] += change * (to - x[c]);
-        m.motion[part] += moved;
-        m.coasting[part] += change == 0.0 ? moved : 0.0;
+        along[part] += change * (to - x[c]);
+        motion[part] += moved;
+        coasting[part] += change == 0.0 ? moved : 0.0;
         x_prev[c] = x[c];
         x[c] = to;
     };
@@ -102,6 +109,11 @@ inline void momentum_cells(std::size_t c0, std::size_t c1, const double *next, c
     for (; c + 4 <= c1; c += 4)
         for (int part = 0; part < 4; ++part) advance(c + part, part);
     for (; c < c1; ++c) advance(c, 0);
+    for (int part = 0; part < 4; ++part) {
+        m.along[part] = along[part];
+        m.motion[part] = motion[part];
+        m.coasting[part] = coasting[part];
+    }
 }
 
 struct CellLoops {
