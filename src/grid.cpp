@@ -125,6 +125,23 @@ void Grid::set_heights_between_sweeps(const std::vector<double> &y, const CellBo
         }
 }
 
+void Grid::copy_heights_between_sweeps(const std::vector<double> &y, const CellBox &within) {
+    const std::int64_t nx = geometry_.nx, ny = geometry_.ny, side = ActiveSet::kTile;
+    const std::int64_t wi0 = std::max<std::int64_t>(within.i0, 0), wi1 = std::min(within.i1, nx);
+    const std::int64_t wj0 = std::max<std::int64_t>(within.j0, 0), wj1 = std::min(within.j1, ny);
+    if (wi0 >= wi1 || wj0 >= wj1) return;
+    for (std::int64_t j = wj0; j < wj1; ++j)
+        std::copy(y.data() + nx * j + wi0, y.data() + nx * j + wi1, heights_.data() + nx * j + wi0);
+    // Per tile, as the host's edits are.
+    for (std::int64_t tj = wj0 - wj0 % side; tj < wj1; tj += side)
+        for (std::int64_t ti = wi0 - wi0 % side; ti < wi1; ti += side) {
+            CellBox box;
+            box.add(std::max(ti, wi0), std::min(ti + side, wi1), std::max(tj, wj0), std::min(tj + side, wj1));
+            if (active_) active_->mark_block(box.i0, box.j0, box.i1 - box.i0, box.j1 - box.j0);
+            if (tiled_ && active_) tiled_workspace_changed(*tiled_, *active_, box);
+        }
+}
+
 void Grid::read_heights(const Block &block, double *values) const {
     for (std::int64_t j = 0; j < block.nj; ++j)
         for (std::int64_t i = 0; i < block.ni; ++i)

@@ -177,7 +177,7 @@ public:
     LevelSummary evaluate(const std::vector<double> &y) {
         // The active set then computes only the cells that y moved or that
         // touch a moving face, as in any sub-step.
-        grid_.set_heights_between_sweeps(y, live_);
+        grid_.copy_heights_between_sweeps(y, live_);  // no residuals here
         tiled_sweep(grid_, 1, dt_, levels_, /*residuals=*/false);  // all 0 here
         // The cells the sweep changed join the box (it writes whole tiles
         // where little or nothing moves); those already in it need no look.
