@@ -87,9 +87,10 @@ inline void extrapolate_cells(std::size_t c0, std::size_t c1, const double *x, c
                               double *__restrict y) {
     for (std::size_t c = c0; c < c1; ++c) y[c] = x[c] + beta * (x[c] - x_prev[c]);
 }
-// Momentum's step to next = S(y), and how its motion went.
-inline void momentum_cells(std::size_t c0, std::size_t c1, const double *next, const double *y, double *__restrict x,
-                           double *__restrict x_prev, MomentumStep &m) {
+// Momentum's step to next = S(y), and how its motion went. The new x goes
+// over x_prev (the caller then swaps the two), which saves a copy per cell.
+inline void momentum_cells(std::size_t c0, std::size_t c1, const double *next, const double *y, const double *x,
+                           double *__restrict x_next, MomentumStep &m) {
     // Sums in locals, which the stores to the cells cannot alias.
     double along[4], motion[4], coasting[4];
     for (int part = 0; part < 4; ++part) {
@@ -102,8 +103,7 @@ inline void momentum_cells(std::size_t c0, std::size_t c1, const double *next, c
         along[part] += change * (to - x[c]);
         motion[part] += moved;
         coasting[part] += change == 0.0 ? moved : 0.0;
-        x_prev[c] = x[c];
-        x[c] = to;
+        x_next[c] = to;
     };
     std::size_t c = c0;
     for (; c + 4 <= c1; c += 4)
@@ -120,7 +120,8 @@ struct CellLoops {
     void (*rkc_stage)(std::size_t, std::size_t, const double *, const double *, const double *, const double *,
                       const double *, StageWeights, double *);
     void (*extrapolate)(std::size_t, std::size_t, const double *, const double *, double, double *);
-    void (*momentum)(std::size_t, std::size_t, const double *, const double *, double *, double *, MomentumStep &);
+    void (*momentum)(std::size_t, std::size_t, const double *, const double *, const double *, double *,
+                     MomentumStep &);
 };
 void rkc_stage_plain(std::size_t c0, std::size_t c1, const double *y0, const double *yjm1, const double *yjm2,
                      const double *next, const double *f0, StageWeights w, double *yj) {
@@ -129,9 +130,9 @@ void rkc_stage_plain(std::size_t c0, std::size_t c1, const double *y0, const dou
 void extrapolate_plain(std::size_t c0, std::size_t c1, const double *x, const double *x_prev, double beta, double *y) {
     extrapolate_cells(c0, c1, x, x_prev, beta, y);
 }
-void momentum_plain(std::size_t c0, std::size_t c1, const double *next, const double *y, double *x, double *x_prev,
-                    MomentumStep &m) {
-    momentum_cells(c0, c1, next, y, x, x_prev, m);
+void momentum_plain(std::size_t c0, std::size_t c1, const double *next, const double *y, const double *x,
+                    double *x_next, MomentumStep &m) {
+    momentum_cells(c0, c1, next, y, x, x_next, m);
 }
 #if defined(DPSM_HAVE_AVX512_KERNEL)
 __attribute__((target("avx512f"))) void rkc_stage_avx512(std::size_t c0, std::size_t c1, const double *y0,
@@ -144,8 +145,9 @@ __attribute__((target("avx512f"))) void extrapolate_avx512(std::size_t c0, std::
     extrapolate_cells(c0, c1, x, x_prev, beta, y);
 }
 __attribute__((target("avx512f"))) void momentum_avx512(std::size_t c0, std::size_t c1, const double *next,
-                                                         const double *y, double *x, double *x_prev, MomentumStep &m) {
-    momentum_cells(c0, c1, next, y, x, x_prev, m);
+                                                         const double *y, const double *x, double *x_next,
+                                                         MomentumStep &m) {
+    momentum_cells(c0, c1, next, y, x, x_next, m);
 }
 #endif
 const CellLoops &cell_loops() {
@@ -338,6 +340,7 @@ void relax_to_rest(Grid &grid) {
         rates.for_rows([&](std::size_t c0, std::size_t c1) {
             loops.momentum(c0, c1, next, y.data(), x.data(), x_prev.data(), step);
         });
+        x.swap(x_prev);  // x_prev: the x before this step
         const auto total = [](const double *parts) { return (parts[0] + parts[1]) + (parts[2] + parts[3]); };
         if (total(step.along) < 0.0 || total(step.coasting) > kCoastingShare * total(step.motion)) {
             copy(x_prev, x);
