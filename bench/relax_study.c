@@ -847,8 +847,9 @@ int cmd_steps(int argc, char **argv) {
                 report(&sc, method, tol, now_seconds() - t0, (double)evaluations, h, explicit_h, v0, at_rest);
             }
             /* The flow's path by RKC, momentum for the tail: switched at an
-             * excess slope of 0.02, and when the flowing region stops growing. */
-            const double switches[] = {0.02, 0.0};
+             * excess slope of 5 % of tan(theta) (as dpsm's DPSM_RELAX_TO_REST),
+             * and when the flowing region stops growing. */
+            const double switches[] = {0.05 * tan(sc.theta), 0.0};
             for (size_t m = 0; m < sizeof switches / sizeof *switches; ++m) {
                 memcpy(h, h0, sizeof(double) * (size_t)cells);
                 t0 = now_seconds();

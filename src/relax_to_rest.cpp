@@ -5,7 +5,7 @@
 //    count ramps up, s_k = min(20, 2 + k), each 0.9 of its stable length.
 //    They follow the flow's path while much sand moves; the deposit depends
 //    on that path.
-//  - Once the largest excess slope of the faces that carry sand is below 3 %
+//  - Once the largest excess slope of the faces that carry sand is below 5 %
 //    of tan(theta), Nesterov's momentum (beta = k / (k + 3)) on explicit
 //    sub-steps, restarted when a step works against the rates or when more
 //    than 90 % of its motion lies in cells no face acts on (sand coasting past
@@ -35,7 +35,7 @@ namespace {
 
 constexpr int kMaxStages = 20;
 constexpr double kStageSafety = 0.9;
-constexpr double kSwitchExcessShare = 0.03;  // of tan(theta): where momentum takes over
+constexpr double kSwitchExcessShare = 0.05;  // of tan(theta): where momentum takes over
 constexpr double kCoastingShare = 0.9;
 
 // The coefficients of a second-order RKC step of s stages (Sommeijer,
