@@ -166,6 +166,8 @@ typedef struct {
     double *bed;    /* NULL: none */
     double *tan_field; /* tan of each cell's angle of repose; NULL: uniform */
     double tan_static; /* hysteresis; 0: none */
+    int scheme;        /* DPSM_SCHEME_* */
+    double exponent;   /* the flux exponent */
     double mass_scale;
 } slot_t;
 
@@ -457,6 +459,8 @@ static void op_create(reader_t *r) {
     s->theta = DPSM_DEFAULT_REPOSE_ANGLE;
     s->tol = DPSM_DEFAULT_REST_TOLERANCE;
     s->max_substeps = DPSM_DEFAULT_MAX_SUBSTEPS;
+    s->scheme = DPSM_SCHEME_ISOTROPIC;
+    s->exponent = 1.0;
     s->kinds = calloc((size_t)s->n, 1);
     if (!s->kinds) die("out of memory");
     int64_t sx, sy;
@@ -487,6 +491,7 @@ static void op_parameter(reader_t *r, unsigned which) {
             static const int schemes[] = {0, 1, 0, 1, 2, -1, 1000, INT32_MIN};
             const int v = schemes[u8(r) % COUNT(schemes)];
             ON_BOTH(s, v == 0 || v == 1 ? DPSM_OK : DPSM_ERR_UNKNOWN_ENUM, g_op, dpsm_set_scheme(g_, v));
+            if (v == 0 || v == 1) s->scheme = v;
             break;
         }
         case 3: {
@@ -855,6 +860,90 @@ static void op_step(reader_t *r) {
     unsnap(&before);
 }
 
+/* One step relaxed to rest (dpsm_set_relaxation(g, DPSM_RELAX_TO_REST)) on
+ * the grid and its twin, with at most as many flux evaluations as the work
+ * budget allows, then back to time-accurate steps. Where dpsm.h says the
+ * relaxation does not apply it is refused with DPSM_ERR_NOT_APPLICABLE and
+ * the grid is unchanged. Otherwise it succeeds whatever dt is, integrates no
+ * time, takes at least one and at most the allowed evaluations, keeps held
+ * cells, and at rest (and not driven) leaves no face steeper than
+ * tan(theta) (1 + tol); the state invariants and the twin are checked after
+ * every operation. */
+static void op_relax(reader_t *r) {
+    g_op = "dpsm_step";
+    slot_t *s = pick_slot(r);
+    if (!s) return;
+    const unsigned b = u8(r);
+    const double dt = (b & 0xe0) == 0xe0 ? kDtBad[b % COUNT(kDtBad)] : 1.0;
+    const double left = kWorkBudget - g_work;
+    const int64_t cap = (int64_t)fmin(fmin(1000.0, (double)s->max_substeps), floor(left / (double)s->n));
+    if (cap < 1 && !extreme_mode()) return;
+    const int64_t limit = cap < 1 ? 1 : cap;
+    for (int k = 0; k < 2; ++k) {
+        dpsm_grid *g = k == 0 ? s->g : s->twin;
+        if (dpsm_set_relaxation(g, DPSM_RELAX_TO_REST) != DPSM_OK || dpsm_set_max_substeps(g, limit) != DPSM_OK)
+            die("setting up the relaxation failed: %s", dpsm_last_error(g));
+    }
+    snap_t before;
+    snap(s->g, s, &before);
+    int open_cells = 0, levels_differ = 0;
+    double level = 0.0;
+    for (int64_t c = 0; c < s->n; ++c) {
+        if (s->kinds[c] != DPSM_CELL_OPEN) continue;
+        if (open_cells && before.h[c] != level) levels_differ = 1;
+        level = before.h[c];
+        open_cells = 1;
+    }
+    int want = DPSM_OK;
+    if (!valid_positive(dt))
+        want = DPSM_ERR_INVALID_VALUE;
+    else if (s->geom != GEOM_2D || s->scheme != DPSM_SCHEME_ISOTROPIC || s->bed || s->tan_field ||
+             s->exponent != 1.0 || s->tan_static > 0.0 || source_active(s) || levels_differ)
+        want = DPSM_ERR_NOT_APPLICABLE;
+    const int st = dpsm_step(s->g, dt);
+    trace("dpsm_step(%g) relaxed to rest, at most %lld evaluations, on %lld x %lld", dt, (long long)limit,
+          (long long)s->nx, (long long)s->ny);
+    expect_status(st, want, g_op, s->g);
+    if (st != DPSM_OK) {
+        check_failed(s, s->g, &before, st, g_op);
+    } else {
+        g_work += (double)limit * (double)s->n;
+        if (*dpsm_last_error(s->g)) die("dpsm_step succeeded but left the message \"%s\"", dpsm_last_error(s->g));
+        if (dpsm_step(s->twin, dt) != DPSM_OK) die("the twin's step failed: %s", dpsm_last_error(s->twin));
+        snap_t after;
+        snap(s->g, s, &after);
+        check_state(s, &after);
+        for (int64_t c = 0; c < s->n; ++c)
+            if (s->kinds[c] != DPSM_CELL_SAND && memcmp(&after.h[c], &before.h[c], sizeof(double)) != 0)
+                die("the held height of cell %lld changed from %.17g to %.17g", (long long)c, before.h[c],
+                    after.h[c]);
+        const double evaluations = after.info[DPSM_INFO_SUBSTEPS], at_rest = after.info[DPSM_INFO_AT_REST];
+        if (!(evaluations >= 1.0 && evaluations <= (double)limit))
+            die("SUBSTEPS = %g relaxed to rest, with at most %lld allowed", evaluations, (long long)limit);
+        if (after.info[DPSM_INFO_TIME_INTEGRATED] != 0.0)
+            die("TIME_INTEGRATED = %g relaxed to rest", after.info[DPSM_INFO_TIME_INTEGRATED]);
+        if (at_rest != 0.0 && at_rest != 1.0) die("AT_REST = %g", at_rest);
+        if (at_rest == 1.0 && after.info[DPSM_INFO_MAX_EXCESS_SLOPE] != 0.0)
+            die("MAX_EXCESS_SLOPE = %.17g at rest", after.info[DPSM_INFO_MAX_EXCESS_SLOPE]);
+        if (at_rest == 0.0 && (evaluations != (double)limit || !(after.info[DPSM_INFO_MAX_EXCESS_SLOPE] >= 0.0)))
+            die("not at rest after %g of %lld evaluations, largest excess %g", evaluations, (long long)limit,
+                after.info[DPSM_INFO_MAX_EXCESS_SLOPE]);
+        if (at_rest == 1.0 && !driven(s, after.h)) {
+            const double excess = rest_excess(s, after.h);
+            if (excess > 1e-12) die("relaxed to rest with a face steeper than tan(theta)(1+tol) by %.3g", excess);
+        }
+        compare_twin(s, &after);
+        unsnap(&after);
+    }
+    unsnap(&before);
+    for (int k = 0; k < 2; ++k) {
+        dpsm_grid *g = k == 0 ? s->g : s->twin;
+        if (dpsm_set_relaxation(g, DPSM_RELAX_TIME_ACCURATE) != DPSM_OK ||
+            dpsm_set_max_substeps(g, s->max_substeps) != DPSM_OK)
+            die("restoring the time-accurate steps failed: %s", dpsm_last_error(g));
+    }
+}
+
 /* The physics of real scenes: a bed under the sand, an angle of repose per
  * cell, the flux exponent, the static angle. */
 static void op_physics(reader_t *r) {
@@ -927,6 +1016,7 @@ static void op_physics(reader_t *r) {
             const double p = pick(r, kExponents, COUNT(kExponents), kExponentsBad, COUNT(kExponentsBad));
             const int ok = p >= 1.0 && p <= DPSM_MAX_FLUX_EXPONENT;
             ON_BOTH(s, ok ? DPSM_OK : DPSM_ERR_INVALID_VALUE, g_op, dpsm_set_flux_exponent(g_, p));
+            if (ok) s->exponent = p;
             break;
         }
         default: {
@@ -1062,7 +1152,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
     memset(g_slots, 0, sizeof g_slots);
     while (more(&r) && g_opcount < 400) {
         ++g_opcount;
-        const unsigned op = u8(&r) % 24;
+        const unsigned op = u8(&r) % 25;
         if (op < 2)
             op_create(&r);
         else if (op < 9)
@@ -1083,8 +1173,10 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
             op_null_grid(&r);
         else if (op == 22)
             op_destroy(&r);
-        else
+        else if (op == 23)
             op_physics(&r);
+        else
+            op_relax(&r);
         /* Every live grid: the state invariants and the twin. */
         for (int k = 0; k < NSLOTS; ++k) {
             slot_t *s = &g_slots[k];

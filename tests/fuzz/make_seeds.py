@@ -11,10 +11,11 @@ import random
 HERE = os.path.dirname(os.path.abspath(__file__))
 OUT = os.path.join(HERE, "corpus")
 
-# Opcodes (first byte of an operation, taken modulo 24 by the harness).
+# Opcodes (first byte of an operation, taken modulo 25 by the harness).
 CREATE, ANGLE, MOBILITY, SCHEME, BOUNDARY, TOLERANCE, MAX_SUBSTEPS, THREADS = 0, 2, 3, 4, 5, 6, 7, 8
 KINDS, HEIGHTS, SET_REGION, ADD_REGION, GET_REGION, SOURCE, STEP = 9, 10, 12, 13, 14, 15, 16
-GETTERS, NULL_GRID, DESTROY, PHYSICS = 20, 21, 22, 23
+GETTERS, NULL_GRID, DESTROY, PHYSICS, RELAX = 20, 21, 22, 23, 24
+# RELAX, slot, dt byte (0xe0 + 0..6: a bad dt; else 1): one step relaxed to rest
 # PHYSICS, slot, which (0 bed, 1 angle field, 2 flux exponent, 3 static angle), then:
 #   bed: mode (0 removes; else a fill pattern of depths below the surface follows;
 #        mode 0x40 + a u16 cell plants one cell above its height)
@@ -195,6 +196,20 @@ seed("physics_bad_2d", create(0, "2d", 6, 6), heights(0, 0, 3.0, 0.0),
      [PHYSICS, 0, 0, 0x41] + fill(0, H[0.5], H[0.0]) + [5, 0], [PHYSICS, 0, 0, 1] + fill(0, H[1.0], H[0.0], plant=7),
      [PHYSICS, 0, 1, 0x41, 0, 0, 3, 0, 3], [PHYSICS, 0, 2, 0x83], [PHYSICS, 0, 2, 0x80], [PHYSICS, 0, 3, 0x85],
      [NULL_GRID, 19], [NULL_GRID, 20], [NULL_GRID, 21], [NULL_GRID, 22], step(0, 10.0))
+
+# The relaxation to rest: a pile open and closed, with masks and a bad dt;
+# refused with a source, the pairwise scheme, an exponent, and on 1D grids.
+def relax(slot, dt_byte=0):
+    return [RELAX, slot, dt_byte]
+
+
+seed("relax_2d", create(0, "2d", 9, 9), heights(0, 2, 30.0, 0.0), relax(0), relax(0, 0xE3),
+     all_open(0, "2d"), heights(0, 2, 100.0, 1.0), relax(0), step(0, 10.0),
+     create(1, "2d", 9, 9, 0.5, 2.0), heights(1, 4, 3.0, 0.0, per_cell=([4, 1, 5, 0, 14, 16, 2, 13, 4] * 9)),
+     kinds(1, 3), relax(1), kinds(1, 5), relax(1), [MAX_SUBSTEPS, 1, 1], heights(1, 2, 1e3, 0.0), relax(1))
+seed("relax_refused", create(0, "2d", 6, 6), heights(0, 2, 10.0, 0.0), source(0, 1, 0.1, 0.0), relax(0),
+     source(0, 0, 0, 0, none=True), [SCHEME, 0, 0], relax(0), [SCHEME, 0, 1], [PHYSICS, 0, 2, 1], relax(0),
+     [PHYSICS, 0, 2, 0], relax(0), create(1, "1d", 9), heights(1, 2, 10.0, 0.0), relax(1))
 
 rng = random.Random(20240611)
 for k in range(8):
