@@ -755,6 +755,18 @@ static void check_restart_continues(slot_t *s, dpsm_grid *copy, double dt, const
     unsnap(&stepped);
 }
 
+/* After a step that succeeded on the slot's grid: the same step on its twin,
+ * the state invariants, and held cells as they were. Snaps the grid. */
+static void after_step(slot_t *s, double dt, const snap_t *before, snap_t *after) {
+    if (*dpsm_last_error(s->g)) die("dpsm_step succeeded but left the message \"%s\"", dpsm_last_error(s->g));
+    if (dpsm_step(s->twin, dt) != DPSM_OK) die("the twin's step failed: %s", dpsm_last_error(s->twin));
+    snap(s->g, s, after);
+    check_state(s, after);
+    for (int64_t c = 0; c < s->n; ++c)
+        if (s->kinds[c] != DPSM_CELL_SAND && memcmp(&after->h[c], &before->h[c], sizeof(double)) != 0)
+            die("the held height of cell %lld changed from %.17g to %.17g", (long long)c, before->h[c], after->h[c]);
+}
+
 static void op_step(reader_t *r) {
     g_op = "dpsm_step";
     slot_t *s = pick_slot(r);
@@ -818,15 +830,8 @@ static void op_step(reader_t *r) {
         unsnap(&before);
         return;
     }
-    if (*dpsm_last_error(s->g)) die("dpsm_step succeeded but left the message \"%s\"", dpsm_last_error(s->g));
-    if (dpsm_step(s->twin, dt) != DPSM_OK) die("the twin's step failed: %s", dpsm_last_error(s->twin));
-
     snap_t after;
-    snap(s->g, s, &after);
-    check_state(s, &after);
-    for (int64_t c = 0; c < s->n; ++c)
-        if (s->kinds[c] != DPSM_CELL_SAND && memcmp(&after.h[c], &before.h[c], sizeof(double)) != 0)
-            die("the held height of cell %lld changed from %.17g to %.17g", (long long)c, before.h[c], after.h[c]);
+    after_step(s, dt, &before, &after);
     if (!source_active(s) && hi >= lo) {
         const double magnitude = fmax(fmax(fabs(hi), fabs(lo)), DBL_MIN);
         for (int64_t c = 0; c < s->n; ++c) {
@@ -908,15 +913,8 @@ static void op_relax(reader_t *r) {
         check_failed(s, s->g, &before, st, g_op);
     } else {
         g_work += (double)limit * (double)s->n;
-        if (*dpsm_last_error(s->g)) die("dpsm_step succeeded but left the message \"%s\"", dpsm_last_error(s->g));
-        if (dpsm_step(s->twin, dt) != DPSM_OK) die("the twin's step failed: %s", dpsm_last_error(s->twin));
         snap_t after;
-        snap(s->g, s, &after);
-        check_state(s, &after);
-        for (int64_t c = 0; c < s->n; ++c)
-            if (s->kinds[c] != DPSM_CELL_SAND && memcmp(&after.h[c], &before.h[c], sizeof(double)) != 0)
-                die("the held height of cell %lld changed from %.17g to %.17g", (long long)c, before.h[c],
-                    after.h[c]);
+        after_step(s, dt, &before, &after);
         const double evaluations = after.info[DPSM_INFO_SUBSTEPS], at_rest = after.info[DPSM_INFO_AT_REST];
         if (!(evaluations >= 1.0 && evaluations <= (double)limit))
             die("SUBSTEPS = %g relaxed to rest, with at most %lld allowed", evaluations, (long long)limit);
