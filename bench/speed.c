@@ -199,6 +199,11 @@ int cmd_idle(int argc, char **argv) {
  * the angle of repose: 22.89. Also the reference loop run to rest. */
 int cmd_cone(int argc, char **argv) {
     const double tolerance = argc > 0 ? atof(argv[0]) : DPSM_DEFAULT_REST_TOLERANCE;
+    const int fast_runs = argc > 1 ? atoi(argv[1]) : 10;
+    if (fast_runs < 1) {
+        fprintf(stderr, "dpsm-bench cone: runs must be at least 1, not %s\n", argv[1]);
+        return 1;
+    }
     const int64_t n = 101;
     const double theta = 33.0 * kPi / 180.0, exact_top = 22.89;
     double *h = xcalloc((size_t)(n * n), sizeof(double));
@@ -207,12 +212,13 @@ int cmd_cone(int argc, char **argv) {
     printf("method,tolerance,seconds,substeps,top,top_error_percent\n");
 
     /* dpsm's time-accurate sub-steps (the default), then its fast relaxation
-     * to rest; the best of three runs, and of ten for the relaxation to rest,
-     * whose few hundredths of a second a busy machine disturbs the most. */
+     * to rest; the best of three runs, and of fast_runs (10) for the
+     * relaxation to rest, whose few hundredths of a second a busy machine
+     * disturbs the most. */
     double dt = 0.0;
     for (int relaxation = DPSM_RELAX_TIME_ACCURATE; relaxation <= DPSM_RELAX_TO_REST; ++relaxation) {
         double seconds = INFINITY, substeps = 0.0, rest = 0.0, top = 0.0;
-        const int runs = relaxation == DPSM_RELAX_TO_REST ? 10 : 3;
+        const int runs = relaxation == DPSM_RELAX_TO_REST ? fast_runs : 3;
         for (int run = 0; run < runs; ++run) {
             dpsm_grid *g = open_table(n, h, 0);
             CHECK(g, dpsm_set_repose_angle(g, theta));
