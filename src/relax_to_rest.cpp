@@ -180,7 +180,7 @@ public:
         // The active set then computes only the cells that y moved or that
         // touch a moving face, as in any sub-step.
         grid_.copy_heights_between_sweeps(y, live_);  // no residuals here
-        tiled_sweep(grid_, 1, dt_, levels_, /*residuals=*/false);  // all 0 here
+        tiled_sweep(grid_, 1, dt_, levels_, /*find_excess=*/true, /*residuals=*/false);  // all 0 here
         // The cells the sweep changed join the box (it writes whole tiles
         // where little or nothing moves); those already in it need no look.
         const double *next = grid_.heights().data(), *from = y.data();

@@ -4,9 +4,11 @@
 // uses one of them throughout, which keeps its results independent of how the
 // grid is cut into tiles and shared among threads.
 //
-// rsqrt is the one place they differ in arithmetic: Lanes1 divides by sqrt,
-// Lanes8 refines the hardware's 14-bit estimate by two Newton steps (to within
-// a few ulp), which avoids the divider, the bottleneck of this kernel.
+// They differ in arithmetic in two places. rsqrt: Lanes1 divides by sqrt,
+// Lanes8 refines the hardware's 14-bit estimate by a series to the third
+// order (to within a few ulp), which avoids the divider, the bottleneck of
+// this kernel. fma: fused in Lanes8, two roundings in Lanes1 (which runs
+// where the CPU may have no fused multiply-add).
 // rsqrt_fast is for a factor that multiplies a result rather than cancels in a
 // difference: Lanes8 takes one Newton step, within 6e-9 relative and never
 // above the exact value.
@@ -31,6 +33,9 @@ struct Lanes1 {
     static Lanes1 load_partial(const double *p, int) { return {*p}; }
     void store(double *p) const { *p = v; }
     void store_partial(double *p, int) const { *p = v; }
+    void store_where(double *p, Mask m) const {
+        if (m) *p = v;
+    }
     static Mask first_lanes(int n) { return n > 0; }
     static Mask kind_is(const std::uint8_t *p, std::uint8_t k) { return *p == k; }
 
@@ -41,6 +46,14 @@ struct Lanes1 {
     friend Mask operator!=(Lanes1 a, Lanes1 b) { return a.v != b.v; }
     friend Lanes1 max(Lanes1 a, Lanes1 b) { return {a.v > b.v ? a.v : b.v}; }
     friend Lanes1 select(Mask m, Lanes1 a, Lanes1 b) { return m ? a : b; }
+    // Not fused: the generic kernel runs on CPUs without FMA.
+    friend Lanes1 fma(Lanes1 a, Lanes1 b, Lanes1 c) { return {a.v * b.v + c.v}; }
+    friend Lanes1 fnma(Lanes1 a, Lanes1 b, Lanes1 c) { return {c.v - a.v * b.v}; }
+    friend Lanes1 mul_where(Mask m, Lanes1 a, Lanes1 b) { return {m ? a.v * b.v : 0.0}; }
+    friend Lanes1 max_where(Mask m, Lanes1 a, Lanes1 b) { return {m && b.v > a.v ? b.v : a.v}; }
+    // [the last lane of prev, the first lanes of cur] and [the last lanes of cur, the first of next].
+    static Lanes1 shift_west(Lanes1 prev, Lanes1) { return prev; }
+    static Lanes1 shift_east(Lanes1, Lanes1 next) { return next; }
     friend Lanes1 rsqrt(Lanes1 a) { return {1.0 / std::sqrt(a.v)}; }
     friend Lanes1 rsqrt_fast(Lanes1 a) { return {1.0 / std::sqrt(a.v)}; }
     static Mask any_nonzero(Lanes1 a, Lanes1 b, Lanes1 c, Lanes1 d) {
@@ -50,6 +63,8 @@ struct Lanes1 {
     static Mask either(Mask a, Mask b) { return a || b; }
     static Mask but_not(Mask a, Mask b) { return a && !b; }
     static bool any(Mask m) { return m; }
+    static unsigned bits(Mask m) { return m ? 1u : 0u; }
+    static Mask from_bits(unsigned b) { return (b & 1u) != 0; }
     static int first(Mask) { return 0; }
     static int last(Mask) { return 0; }
     static double sum(Lanes1 a) { return a.v; }
@@ -67,6 +82,7 @@ struct Lanes8 {
     static Lanes8 load_partial(const double *p, int n) { return {_mm512_maskz_loadu_pd(first_lanes(n), p)}; }
     void store(double *p) const { _mm512_storeu_pd(p, v); }
     void store_partial(double *p, int n) const { _mm512_mask_storeu_pd(p, first_lanes(n), v); }
+    void store_where(double *p, Mask m) const { _mm512_mask_storeu_pd(p, m, v); }
     static Mask first_lanes(int n) { return static_cast<Mask>(n >= 8 ? 0xFF : n <= 0 ? 0 : (1u << n) - 1u); }
     static Mask kind_is(const std::uint8_t *p, std::uint8_t k) {
         const __m128i bytes = _mm_loadl_epi64(reinterpret_cast<const __m128i *>(p));
@@ -80,13 +96,24 @@ struct Lanes8 {
     friend Mask operator!=(Lanes8 a, Lanes8 b) { return _mm512_cmp_pd_mask(a.v, b.v, _CMP_NEQ_UQ); }
     friend Lanes8 max(Lanes8 a, Lanes8 b) { return {_mm512_max_pd(a.v, b.v)}; }
     friend Lanes8 select(Mask m, Lanes8 a, Lanes8 b) { return {_mm512_mask_blend_pd(m, b.v, a.v)}; }
+    friend Lanes8 fma(Lanes8 a, Lanes8 b, Lanes8 c) { return {_mm512_fmadd_pd(a.v, b.v, c.v)}; }
+    friend Lanes8 fnma(Lanes8 a, Lanes8 b, Lanes8 c) { return {_mm512_fnmadd_pd(a.v, b.v, c.v)}; }
+    friend Lanes8 mul_where(Mask m, Lanes8 a, Lanes8 b) { return {_mm512_maskz_mul_pd(m, a.v, b.v)}; }
+    friend Lanes8 max_where(Mask m, Lanes8 a, Lanes8 b) { return {_mm512_mask_max_pd(a.v, m, a.v, b.v)}; }
+    static Lanes8 shift_west(Lanes8 prev, Lanes8 cur) {
+        return {_mm512_castsi512_pd(_mm512_alignr_epi64(_mm512_castpd_si512(cur.v), _mm512_castpd_si512(prev.v), 7))};
+    }
+    static Lanes8 shift_east(Lanes8 cur, Lanes8 next) {
+        return {_mm512_castsi512_pd(_mm512_alignr_epi64(_mm512_castpd_si512(next.v), _mm512_castpd_si512(cur.v), 1))};
+    }
+    // y0 (1 - e)^(-1/2) with e = 1 - a y0^2 and the series cut after e^3:
+    // |e| < 2^-13, so what is cut is below 7e-17 relative.
     friend Lanes8 rsqrt(Lanes8 a) {
-        const __m512d half_a = _mm512_mul_pd(_mm512_set1_pd(0.5), a.v);
-        const __m512d three_halves = _mm512_set1_pd(1.5);
-        __m512d y = _mm512_rsqrt14_pd(a.v);
-        y = _mm512_mul_pd(y, _mm512_fnmadd_pd(half_a, _mm512_mul_pd(y, y), three_halves));
-        y = _mm512_mul_pd(y, _mm512_fnmadd_pd(half_a, _mm512_mul_pd(y, y), three_halves));
-        return {y};
+        const __m512d y = _mm512_rsqrt14_pd(a.v);
+        const __m512d e = _mm512_fnmadd_pd(a.v, _mm512_mul_pd(y, y), _mm512_set1_pd(1.0));
+        __m512d series = _mm512_fmadd_pd(e, _mm512_set1_pd(5.0 / 16.0), _mm512_set1_pd(3.0 / 8.0));
+        series = _mm512_fmadd_pd(series, e, _mm512_set1_pd(0.5));
+        return {_mm512_fmadd_pd(_mm512_mul_pd(y, e), series, y)};
     }
     friend Lanes8 rsqrt_fast(Lanes8 a) {
         const __m512d y = _mm512_rsqrt14_pd(a.v);
@@ -103,6 +130,8 @@ struct Lanes8 {
     static Mask either(Mask a, Mask b) { return static_cast<Mask>(a | b); }
     static Mask but_not(Mask a, Mask b) { return static_cast<Mask>(a & ~b); }
     static bool any(Mask m) { return m != 0; }
+    static unsigned bits(Mask m) { return m; }
+    static Mask from_bits(unsigned b) { return static_cast<Mask>(b); }
     static int first(Mask m) { return __builtin_ctz(m); }
     static int last(Mask m) { return 31 - __builtin_clz(m); }
     static double sum(Lanes8 a) {

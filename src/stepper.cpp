@@ -129,7 +129,9 @@ void step(Grid &grid, double dt) {
             std::vector<LevelSummary> levels;
             for (std::int64_t k = 0; k < substeps && !info.at_rest; k += ActiveSet::kMaxLevels) {
                 const int count = static_cast<int>(std::min<std::int64_t>(ActiveSet::kMaxLevels, substeps - k));
-                const double visited = static_cast<double>(tiled_sweep(grid, count, sub_dt, levels));
+                // The step reports the largest excess slope of its last sub-step.
+                const bool last_sweep = k + count >= substeps;
+                const double visited = static_cast<double>(tiled_sweep(grid, count, sub_dt, levels, last_sweep));
                 for (const LevelSummary &level : levels) {
                     if (!book(level.moved, level.outflow_rate, level.max_excess, level.unmet_mass, level.sourced_mass))
                         break;

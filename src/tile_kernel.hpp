@@ -20,20 +20,22 @@ struct TileRect {
 };
 
 struct TileLevelParams {
-    double nu, tan_theta, threshold2;  // threshold2: (tan(theta) (1 + tol))^2
-    double inv_dx, inv_dy, half_inv_dx, half_inv_dy;
+    double nu, tan_theta;
+    double dx, dy, inv_dx, inv_dy, half_inv_dx, half_inv_dy;
     double dt;
     double x_face_length, y_face_length;  // dy and dx: flux per unit length to mass per unit time
+    double rest_factor = 1.0;  // 1 + tol: a face's threshold is tan(theta) times this
     // Carry what rounding drops from each height in its residual (a TwoSum).
     // Without, residuals are neither read nor written: they must be 0.
     bool residuals = true;
+    // Find the largest excess slope (TileLevelStats::max_excess); without, it stays 0.
+    bool track_excess = true;
     // Read by the physics kernel only (tile_kernel_physics.cpp).
-    double rest_factor = 1.0;  // 1 + tol: a face's threshold is tan(theta) times this
     double flux_exponent = 1.0;
     double tan_static = 0.0;  // hysteresis: the threshold between cells at rest
     bool hysteresis = false, bed = false, angle_field = false;
     double bed_film = 0.0;  // sand this thin above the bed is left in place (see dpsm_set_bedrock)
-    double cell_area = 1.0;  // dx dy
+    double cell_area = 1.0;  // dx dy: heights per sub-step to mass
 };
 
 // What one level did, over the tile itself (moved and max_excess also over
@@ -53,6 +55,7 @@ struct TileBuffers {
     std::vector<double> h[2], residual[2], source;
     std::vector<std::uint8_t> kind;
     std::vector<double> rows;  // scratch rows for faces and transverse slopes
+    std::vector<unsigned> chunk_bits;  // scratch lane bits, per chunk of a row
     // The physics kernel's inputs and scratch, sized only when a grid uses it.
     std::vector<double> bed, tan_theta;
     std::vector<std::uint8_t> moving[2];

@@ -21,6 +21,7 @@ void TileBuffers::resize(int w, int h_) {
     source.assign(cells, 0.0);
     kind.assign(cells, kSand);
     rows.assign(static_cast<std::size_t>(9) * (w + 32), 0.0);
+    chunk_bits.assign(static_cast<std::size_t>(4) * (w + 1), 0u);
 }
 
 static bool use_avx512() {

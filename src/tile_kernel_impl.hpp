@@ -1,63 +1,91 @@
 // The tile kernel, written once over a lane type (simd.hpp). Included by
 // tile_kernel_generic.cpp and tile_kernel_avx512.cpp, each of which compiles
 // it for its own CPU.
+//
+// One pass over the rows of the region does everything for a row: the
+// transverse slopes of the next row, the faces towards it, the faces along
+// the row and the row's update. The x faces run one chunk of lanes ahead of
+// the update, so a cell's east face is its neighbour chunk's west face moved
+// by one lane (a register shuffle, no store and reload); the y faces towards
+// the next row wait in a row of scratch for that row. Faces are computed once,
+// already scaled to heights per sub-step (nu dt / dx), so the update adds four
+// numbers. What the level did (motion, the cells touching moving faces) is
+// kept as lane bits in integer registers, off the vector units.
+//
+// Loads read whole vectors, also past the region's last column (the buffer
+// has room); those lanes are computed and thrown away: they carry no flux,
+// count for nothing and are never stored into the heights.
 #pragma once
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <utility>
 
 #include "grid.hpp"
 #include "simd.hpp"
 #include "tile_kernel.hpp"
 
+#if defined(__GNUC__) || defined(__clang__)
+// Everything the kernel calls is inlined into it, so its constants and row
+// pointers stay in registers rather than behind the lambdas' references.
+#define DPSM_KERNEL_FLATTEN __attribute__((flatten))
+#else
+#define DPSM_KERNEL_FLATTEN
+#endif
+
 namespace dpsm {
 
 template <class V, bool Masked, bool Isotropic, bool Source>
-void advance_tile_level(TileBuffers &b, int in, const TileRect &reg, const TileRect &tile, const TileLevelParams &p,
-                        TileLevelStats &st) {
+DPSM_KERNEL_FLATTEN void advance_tile_level(TileBuffers &b, int in, const TileRect &reg, const TileRect &tile,
+                                            const TileLevelParams &p, TileLevelStats &st) {
     using M = typename V::Mask;
     constexpr int w = V::width;
     const int W = b.width;
     const double *h = b.h[in].data();
     const double *res = b.residual[in].data();
-    double *h_out = b.h[1 - in].data();
-    double *res_out = b.residual[1 - in].data();
+    double *__restrict h_out = b.h[1 - in].data();
+    double *__restrict res_out = b.residual[1 - in].data();
     const std::uint8_t *kind = b.kind.data();
     const double *q = b.source.data();
     const int n = reg.c1 - reg.c0;
-    const int stride = ((n + 2) / w + 2) * w;
-    double *__restrict ty = b.rows.data();
-    double *__restrict fx = ty + stride;
-    double *fy_below = fx + stride, *fy_above = fy_below + stride;
-    double *tx_lo = fy_above + stride, *tx_hi = tx_lo + stride;
-    // Masked tiles: each cell's outflow rate of the row, summed one by one in
-    // column order and row by row, so that the sum does not depend on where
-    // the computed region starts (lanes would group the cells by it): a tile
-    // visited whole or in part, or after a restart, books the same outflow.
-    double *outflow_row = tx_hi + stride;
-    double outflow = 0.0;
+    const int chunks = (n + w - 1) / w;
+    // Rows of scratch, each a vector longer than the region (whole-vector stores).
+    const int stride = (chunks + 1) * w;
+    double *__restrict tx_lo = b.rows.data();     // transverse slopes of this row
+    double *__restrict tx_hi = tx_lo + stride;    // and of the next
+    double *__restrict fy_below = tx_hi + stride; // faces from the row below, towards this row
+    double *__restrict fy_above = fy_below + stride;
+    double *__restrict outflow_row = fy_above + stride;
+    // Per chunk, as lane bits: which of its y faces carry sand, below and
+    // above the row; which of its lanes are tile cells; which of those
+    // touched a moving face in some row.
+    unsigned *__restrict carries_below = b.chunk_bits.data();
+    unsigned *__restrict carries_above = carries_below + chunks;
+    unsigned *__restrict in_tile = carries_above + chunks;
+    unsigned *__restrict moved_columns_of = in_tile + chunks;
 
-    const V zero = V::broadcast(0.0), one = V::broadcast(1.0), half = V::broadcast(0.5);
-    const V nu = V::broadcast(p.nu), tan_theta = V::broadcast(p.tan_theta), threshold2 = V::broadcast(p.threshold2);
-    const V inv_dx = V::broadcast(p.inv_dx), inv_dy = V::broadcast(p.inv_dy);
-    const V half_inv_dx = V::broadcast(p.half_inv_dx), half_inv_dy = V::broadcast(p.half_inv_dy);
-    const V dt = V::broadcast(p.dt);
-    const V x_len = V::broadcast(p.x_face_length), y_len = V::broadcast(p.y_face_length);
-    const M all = V::first_lanes(w);
-    V steepest2 = zero;  // largest squared slope of a face that carries sand
-    M moved = V::first_lanes(0);
-    // The tile's cells that moved: rows, and columns as bits from tile.c0.
-    int moved_r0 = st.hot_r0, moved_r1 = st.hot_r1;
-    std::uint64_t moved_columns = 0;
-
-    auto load = [](const double *ptr, int m) { return m == w ? V::load(ptr) : V::load_partial(ptr, m); };
-    auto store = [](double *ptr, V v, int m) {
-        if (m == w)
-            v.store(ptr);
-        else
-            v.store_partial(ptr, m);
+    const V zero = V::broadcast(0.0);
+    // A face's slopes are taken in units of its spacing d (dx for x faces):
+    // D = d^2 |grad h|^2 = dh_n^2 + (d grad_t h)^2 needs no division by d,
+    // and with it the flux in height per sub-step is
+    //   nu dt / d^2 * dh_n (|grad h| - tan(theta)) / (|grad h| sqrt(1 + |grad h|^2))
+    //   = (nu dt / d) * dh_n * (1 - d tan(theta) / sqrt(D)) / sqrt(d^2 + D).
+    struct Direction {
+        V tan_d, threshold2, spacing2, scale;  // d tan(theta), (d tan(theta) (1 + tol))^2, d^2, nu dt / d
+        V transverse;                          // a central difference across, to d times a face's transverse slope
+        V steepest2;                           // largest D of a face that carries sand
     };
+    auto direction = [&](double d, double d_across) {
+        const double threshold = p.tan_theta * p.rest_factor * d;
+        return Direction{V::broadcast(p.tan_theta * d), V::broadcast(threshold * threshold), V::broadcast(d * d),
+                         V::broadcast(p.nu * p.dt / d), V::broadcast(0.25 * d / d_across), zero};
+    };
+    Direction along_x = direction(p.dx, p.dy), along_y = direction(p.dy, p.dx);
+    const V dt = V::broadcast(p.dt);
+    const bool track_excess = p.track_excess;
+
+    auto valid_lanes = [&](int count) { return V::first_lanes(count); };
     // A wall neighbour mirrors the cell that asks (zero normal gradient).
     auto mirrored = [&](V h_cell, V h_next, const std::uint8_t *kind_next) {
         if constexpr (Masked) return select(V::kind_is(kind_next, kWall), h_cell, h_next);
@@ -68,131 +96,185 @@ void advance_tile_level(TileBuffers &b, int in, const TileRect &reg, const TileR
         if constexpr (Masked)
             return V::but_not(V::either(V::kind_is(ka, kSand), V::kind_is(kb, kSand)),
                               V::either(V::kind_is(ka, kWall), V::kind_is(kb, kWall)));
-        return all;
+        return V::first_lanes(w);
     };
-    // The flux law on the full slope (gn along the face normal, gt across),
-    // positive from the first cell to the second; zero up to the threshold.
-    // 1 - tan(theta) / |g| cancels near the threshold, so 1/|g| is refined to
-    // full precision; 1/sqrt(1 + |g|^2) only scales the flux and takes the
-    // cheaper refinement.
-    auto face_flux = [&](V gn, V gt, M open, double *flux_out, int m) {
-        const V u = gn * gn + gt * gt;
-        const M hot = V::both(u > threshold2, open);
-        const V r1 = rsqrt(max(u, threshold2));
-        const V r2 = rsqrt_fast(one + u);
-        const V flux = select(hot, nu * gn * (one - tan_theta * r1) * r2, zero);
+    // The flux law on the full slope (dn the height difference across the
+    // face, dt d times the slope along it), positive from the first cell to
+    // the second; zero up to the threshold and on faces that are not `open`.
+    // 1 - d tan(theta) / sqrt(D) cancels near the threshold, so 1/sqrt(D) is
+    // refined to full precision; 1/sqrt(d^2 + D) only scales the flux and takes
+    // the cheaper refinement. Lanes at or below the threshold may compute
+    // infinities or NaN (1/sqrt(0)); they are masked out. `carries` tells the
+    // faces whose flux is not zero (even where the scaled flux is too small to
+    // change a height: a tiny dt).
+    auto face_flux = [&](V dn, V dt_, M open, Direction &d, M &carries) {
+        const V D = fma(dn, dn, dt_ * dt_);
+        const M hot = V::both(D > d.threshold2, open);
+        const V flux = mul_where(hot, dn * fnma(d.tan_d, rsqrt(D), V::broadcast(1.0)), rsqrt_fast(d.spacing2 + D));
+        carries = flux != zero;
         // Only faces that carry sand count: a face that is steep only across
-        // its normal (gn = 0) carries none, and a tile at rest is not visited,
+        // its normal (dn = 0) carries none, and a tile at rest is not visited,
         // so counting it would make the figure depend on the active set.
-        steepest2 = max(steepest2, select(flux != zero, u, zero));
-        store(flux_out, flux, m);
+        if (track_excess) d.steepest2 = max_where(carries, d.steepest2, D);
+        return flux * d.scale;
     };
-    // Central differences along x of row r, for the faces across it.
-    auto slopes_along_x = [&](int r, double *out) {
-        for (int k = 0; k < n; k += w) {
-            const int m = std::min(w, n - k), c = r * W + reg.c0 + k;
-            const V hc = load(h + c, m);
-            const V east = mirrored(hc, load(h + c + 1, m), kind + c + 1);
-            const V west = mirrored(hc, load(h + c - 1, m), kind + c - 1);
-            store(out + k, (east - west) * half_inv_dx, m);
-        }
+    // Central differences along x at cells c .. c + w - 1, scaled for the y faces.
+    auto slopes_along_x = [&](int c) {
+        const V hc = V::load(h + c);
+        return (mirrored(hc, V::load(h + c + 1), kind + c + 1) - mirrored(hc, V::load(h + c - 1), kind + c - 1)) *
+               along_y.transverse;
     };
-    // Faces between rows r and r + 1.
-    auto faces_along_y = [&](int r, const double *tx_r, const double *tx_r1, double *flux_out) {
-        for (int k = 0; k < n; k += w) {
-            const int m = std::min(w, n - k), c = r * W + reg.c0 + k;
-            const V gn = (load(h + c, m) - load(h + c + W, m)) * inv_dy;
-            const V gt = Isotropic ? half * (load(tx_r + k, m) + load(tx_r1 + k, m)) : zero;
-            face_flux(gn, gt, open_face(kind + c, kind + c + W), flux_out + k, m);
-        }
+    auto slopes_along_y = [&](int c) {
+        const V hc = V::load(h + c);
+        return (mirrored(hc, V::load(h + c + W), kind + c + W) - mirrored(hc, V::load(h + c - W), kind + c - W)) *
+               along_x.transverse;
+    };
+    // The faces between cells c and c + W, given the transverse slopes of both rows.
+    auto faces_along_y = [&](int c, V tx_here, V tx_next, M valid, M &carries) {
+        const V dn = V::load(h + c) - V::load(h + c + W);
+        const V dt_ = Isotropic ? tx_here + tx_next : zero;
+        return face_flux(dn, dt_, V::both(valid, open_face(kind + c, kind + c + W)), along_y, carries);
+    };
+    // The faces between cells c - 1 and c, given the transverse slopes of both columns.
+    auto faces_along_x = [&](int c, V ty_west, V ty_here, M valid, M &carries) {
+        const V dn = V::load(h + c - 1) - V::load(h + c);
+        const V dt_ = Isotropic ? ty_west + ty_here : zero;
+        return face_flux(dn, dt_, V::both(valid, open_face(kind + c - 1, kind + c)), along_x, carries);
     };
 
-    if constexpr (Isotropic) {
-        slopes_along_x(reg.r0 - 1, tx_lo);
-        slopes_along_x(reg.r0, tx_hi);
+    // The y faces between the first row and the one below it.
+    for (int j = 0; j < chunks; ++j) {
+        const int c = (reg.r0 - 1) * W + reg.c0 + j * w;
+        V tx_below = zero, tx_first = zero;
+        if constexpr (Isotropic) {
+            tx_below = slopes_along_x(c);
+            tx_first = slopes_along_x(c + W);
+            tx_first.store(tx_lo + j * w);
+        }
+        M carries;
+        faces_along_y(c, tx_below, tx_first, valid_lanes(n - j * w), carries).store(fy_below + j * w);
+        carries_below[j] = V::bits(carries);
     }
-    faces_along_y(reg.r0 - 1, tx_lo, tx_hi, fy_below);
+    for (int j = 0; j < chunks; ++j) {
+        const int col = reg.c0 + j * w;
+        in_tile[j] = V::bits(V::but_not(V::first_lanes(tile.c1 - col), V::first_lanes(tile.c0 - col)));
+        moved_columns_of[j] = 0;
+    }
+
+    unsigned moved = 0;  // lanes of cells that moved, anywhere in the region
+    int moved_r0 = st.hot_r0, moved_r1 = st.hot_r1;
+    double outflow = 0.0;
+    // The x faces are needed up to the east face of the last cell: a chunk
+    // further when the last chunk is full.
+    const bool last_chunk_full = n % w == 0;
 
     for (int r = reg.r0; r < reg.r1; ++r) {
-        const int row = r * W;
-        if constexpr (Isotropic) {
-            std::swap(tx_lo, tx_hi);
-            slopes_along_x(r + 1, tx_hi);
-        }
-        faces_along_y(r, tx_lo, tx_hi, fy_above);
-
-        // Faces between columns c - 1 and c of row r, c = c0 .. c1.
-        if constexpr (Isotropic) {
-            for (int t = 0; t < n + 2; t += w) {
-                const int m = std::min(w, n + 2 - t), c = row + reg.c0 - 1 + t;
-                const V hc = load(h + c, m);
-                const V north = mirrored(hc, load(h + c + W, m), kind + c + W);
-                const V south = mirrored(hc, load(h + c - W, m), kind + c - W);
-                store(ty + t, (north - south) * half_inv_dy, m);
-            }
-        }
-        for (int k = 0; k < n + 1; k += w) {
-            const int m = std::min(w, n + 1 - k), c = row + reg.c0 - 1 + k;
-            const V gn = (load(h + c, m) - load(h + c + 1, m)) * inv_dx;
-            const V gt = Isotropic ? half * (load(ty + k, m) + load(ty + k + 1, m)) : zero;
-            face_flux(gn, gt, open_face(kind + c, kind + c + 1), fx + k, m);
-        }
-
+        const int row = r * W + reg.c0;
         const bool row_in_tile = r >= tile.r0 && r < tile.r1;
-        for (int k = 0; k < n; k += w) {
-            const int m = std::min(w, n - k), col = reg.c0 + k, c = row + col;
-            const V hc = load(h + c, m), rc = p.residuals ? load(res + c, m) : zero;
-            const V f_west = load(fx + k, m), f_east = load(fx + k + 1, m);
-            const V f_south = load(fy_below + k, m), f_north = load(fy_above + k, m);
-            V increment = ((f_west - f_east) * inv_dx + (f_south - f_north) * inv_dy) * dt;
-            if constexpr (Source) increment = increment + load(q + c, m) * dt;
-            // h + increment as a TwoSum, carrying what rounding drops.
-            const V b_ = increment + rc;
-            V sum = hc + b_;
+        unsigned row_hot = 0;
+        // The west faces of the first chunk.
+        V ty_here = Isotropic ? slopes_along_y(row) : zero;
+        M x_carries;
+        V x_west = faces_along_x(row, Isotropic ? slopes_along_y(row - 1) : zero, ty_here, valid_lanes(n + 1),
+                                 x_carries);
+        unsigned west_bits = V::bits(x_carries);
+        for (int j = 0; j < chunks; ++j) {
+            const int c = row + j * w, k = j * w;
+            const M valid = valid_lanes(n - k);
+            // The y faces towards the next row.
+            V tx_next = zero;
+            if constexpr (Isotropic) {
+                tx_next = slopes_along_x(c + W);
+                tx_next.store(tx_hi + k);
+            }
+            M y_carries;
+            const V f_north = faces_along_y(c, V::load(tx_lo + k), tx_next, valid, y_carries);
+            f_north.store(fy_above + k);
+            const unsigned north_bits = V::bits(y_carries);
+            carries_above[j] = north_bits;
+            // The west faces of the next chunk, whose first lane is this chunk's last east face.
+            V x_next = zero, ty_next = zero;
+            unsigned next_bits = 0;
+            if (j + 1 < chunks || last_chunk_full) {
+                if constexpr (Isotropic) ty_next = slopes_along_y(c + w);
+                x_next = faces_along_x(c + w, V::shift_west(ty_here, ty_next), ty_next, valid_lanes(n + 1 - k - w),
+                                       x_carries);
+                next_bits = V::bits(x_carries);
+            }
+            const V f_west = x_west, f_east = V::shift_east(x_west, x_next);
+            const unsigned east_bits = (west_bits >> 1) | (next_bits << (w - 1));
+            const V f_south = V::load(fy_below + k);
+
+            // The update: h + increment as a TwoSum, carrying what rounding drops.
+            const V hc = V::load(h + c);
+            V increment = (f_west - f_east) + (f_south - f_north);
+            if constexpr (Source) increment = fma(V::load(q + c), dt, increment);
+            M sand = valid;
+            if constexpr (Masked) sand = V::both(valid, V::kind_is(kind + c, kSand));
             // Cells that do not move keep height and residual bit for bit, as
             // they would in a tile that is not visited.
-            M sand = all;
-            if constexpr (Masked) sand = V::kind_is(kind + c, kSand);
             const M changes = V::both(sand, increment != zero);
+            V sum;
             if (p.residuals) {
+                const V rc = V::load(res + c);
+                const V b_ = increment + rc;
+                sum = hc + b_;
                 const V b_virtual = sum - hc;
                 const V err = (hc - (sum - b_virtual)) + (b_ - b_virtual);
-                store(res_out + c, select(changes, err, rc), m);
+                select(changes, err, rc).store_where(res_out + c, valid);
+            } else {
+                sum = hc + increment;
             }
-            sum = select(changes, sum, hc);
-            store(h_out + c, sum, m);
+            select(changes, sum, hc).store_where(h_out + c, valid);
 
             // Motion is sand carried by a face, even where an increment is too
             // small to change a height (a tiny dt): such a cell stays hot.
-            const M carried = V::any_nonzero(f_west, f_east, f_south, f_north);
-            moved = V::either(moved, V::either(changes, carried));
-            if (!row_in_tile) continue;
-            const M in_tile =
-                V::both(V::but_not(V::first_lanes(tile.c1 - col), V::first_lanes(tile.c0 - col)), V::first_lanes(m));
-            const M hot = V::both(V::either(changes, carried), in_tile);
-            if (V::any(hot)) {
-                moved_r0 = std::min(moved_r0, r);
-                moved_r1 = std::max(moved_r1, r + 1);
-                const int shift = col - tile.c0;
-                const std::uint64_t bits = static_cast<std::uint64_t>(hot);
-                moved_columns |= shift >= 0 ? bits << shift : bits >> -shift;
+            const unsigned hot =
+                (V::bits(changes) | west_bits | east_bits | carries_below[j] | north_bits) & V::bits(valid);
+            moved |= hot;
+            if (row_in_tile) {
+                const unsigned hot_in_tile = hot & in_tile[j];
+                moved_columns_of[j] |= hot_in_tile;
+                row_hot |= hot_in_tile;
             }
             if constexpr (Masked) {
                 // Sand that this tile's cells send into sinks (open cells and
                 // the outside of open sides); what sinks feed them counts negative.
-                const V east = select(V::kind_is(kind + c + 1, kOpen), f_east, zero);
-                const V west = select(V::kind_is(kind + c - 1, kOpen), f_west, zero);
-                const V north = select(V::kind_is(kind + c + W, kOpen), f_north, zero);
-                const V south = select(V::kind_is(kind + c - W, kOpen), f_south, zero);
-                const V rate = (east - west) * x_len + (north - south) * y_len;
-                store(outflow_row + k, select(V::both(sand, in_tile), rate, zero), m);
+                if (row_in_tile) {
+                    const V east = select(V::kind_is(kind + c + 1, kOpen), f_east, zero);
+                    const V west = select(V::kind_is(kind + c - 1, kOpen), f_west, zero);
+                    const V north = select(V::kind_is(kind + c + W, kOpen), f_north, zero);
+                    const V south = select(V::kind_is(kind + c - W, kOpen), f_south, zero);
+                    const M counted = V::both(sand, V::from_bits(in_tile[j]));
+                    select(counted, (east - west) + (north - south), zero).store(outflow_row + k);
+                }
             }
+            x_west = x_next;
+            west_bits = next_bits;
+            ty_here = ty_next;
+        }
+        if (row_hot) {
+            moved_r0 = std::min(moved_r0, r);
+            moved_r1 = std::max(moved_r1, r + 1);
         }
         if constexpr (Masked) {
+            // Each cell's outflow summed one by one in column order and row by
+            // row, so that the sum does not depend on where the computed region
+            // starts (lanes would group the cells by it): a tile visited whole
+            // or in part, or after a restart, books the same outflow.
             if (row_in_tile)
                 for (int k = 0; k < n; ++k) outflow += outflow_row[k];
         }
+        std::swap(tx_lo, tx_hi);
         std::swap(fy_below, fy_above);
+        std::swap(carries_below, carries_above);
+    }
+
+    std::uint64_t moved_columns = 0;  // as bits from tile.c0
+    for (int j = 0; j < chunks; ++j) {
+        const int shift = reg.c0 + j * w - tile.c0;
+        const std::uint64_t bits = moved_columns_of[j];
+        moved_columns |= shift >= 0 ? bits << shift : bits >> -shift;
     }
     if (moved_columns) {
         st.hot_r0 = moved_r0;
@@ -200,10 +282,12 @@ void advance_tile_level(TileBuffers &b, int in, const TileRect &reg, const TileR
         st.hot_c0 = std::min(st.hot_c0, tile.c0 + __builtin_ctzll(moved_columns));
         st.hot_c1 = std::max(st.hot_c1, tile.c0 + 64 - __builtin_clzll(moved_columns));
     }
-    st.moved = st.moved || V::any(moved);
-    const double steepest = std::sqrt(V::hmax(steepest2));
+    st.moved = st.moved || moved != 0;
+    const double steepest =
+        std::max(std::sqrt(V::hmax(along_x.steepest2)) * p.inv_dx, std::sqrt(V::hmax(along_y.steepest2)) * p.inv_dy);
     if (steepest > 0.0) st.max_excess = std::max(st.max_excess, steepest - p.tan_theta);
-    st.outflow_rate += outflow;
+    // The outflow in heights per sub-step, as mass per unit time.
+    st.outflow_rate += outflow * (p.cell_area / p.dt);
 }
 
 template <class V>

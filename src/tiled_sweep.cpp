@@ -267,7 +267,8 @@ void prepare_tiled_sweep(Grid &grid, int threads) {
     ws.origin.reserve(2 * tiles);
 }
 
-std::int64_t tiled_sweep(Grid &grid, int levels, double dt, std::vector<LevelSummary> &summaries, bool residuals) {
+std::int64_t tiled_sweep(Grid &grid, int levels, double dt, std::vector<LevelSummary> &summaries, bool find_excess,
+                         bool residuals) {
     const Geometry &geo = grid.geometry();
     ActiveSet &active = grid.active_set();
     TiledWorkspace &ws = grid.tiled_workspace();
@@ -279,22 +280,19 @@ std::int64_t tiled_sweep(Grid &grid, int levels, double dt, std::vector<LevelSum
     ws.stats.assign(static_cast<std::size_t>(visits) * levels, TileLevelStats{});
     ws.origin.assign(static_cast<std::size_t>(2 * visits), 0);
 
-    const double tan_theta = grid.tan_repose();
-    const double threshold = tan_theta * (1.0 + grid.rest_tolerance());
-    TileLevelParams params{grid.mobility(), tan_theta,       threshold * threshold, 1.0 / geo.dx,
-                           1.0 / geo.dy,    0.5 / geo.dx,    0.5 / geo.dy,          dt,
-                           geo.dy,          geo.dx};
+    TileLevelParams params{grid.mobility(), grid.tan_repose(), geo.dx, geo.dy, 1.0 / geo.dx, 1.0 / geo.dy,
+                           0.5 / geo.dx,    0.5 / geo.dy,      dt,     geo.dy, geo.dx};
     const bool physics = grid.uses_physics(), hysteresis = grid.hysteresis();
     residuals = residuals || physics;  // the physics kernel always carries them
     params.residuals = residuals;
+    params.cell_area = geo.dx * geo.dy;
+    params.rest_factor = 1.0 + grid.rest_tolerance();
     if (physics) {
-        params.rest_factor = 1.0 + grid.rest_tolerance();
         params.flux_exponent = grid.flux_exponent();
         params.tan_static = grid.tan_static();
         params.hysteresis = hysteresis;
         params.bed = !grid.bed().empty();
         params.angle_field = !grid.tan_field().empty();
-        params.cell_area = geo.dx * geo.dy;
         params.bed_film = bed_film(grid);
     }
     const bool isotropic = grid.scheme() == kIsotropic;
@@ -350,7 +348,9 @@ std::int64_t tiled_sweep(Grid &grid, int levels, double dt, std::vector<LevelSum
         const TileRect tile = in_buffer(cells);
         int in = 0;
         for (int s = 1; s <= levels; ++s) {
-            kernel(b, in, in_buffer(level_cells[s - 1]), tile, params,
+            TileLevelParams level_params = params;
+            level_params.track_excess = find_excess && s == levels;
+            kernel(b, in, in_buffer(level_cells[s - 1]), tile, level_params,
                    ws.stats[static_cast<std::size_t>(k) * levels + (s - 1)]);
             in = 1 - in;
         }

@@ -18,7 +18,7 @@ class Grid;
 struct LevelSummary {
     bool moved = false;         // some face carried sand in this sub-step
     double outflow_rate = 0.0;  // mass per unit time into sinks
-    double max_excess = 0.0;    // largest |grad h| - tan(theta) over faces that carried sand
+    double max_excess = 0.0;    // largest |grad h| - tan(theta) over faces that carried sand (if found: tiled_sweep)
     double unmet_mass = 0.0;    // erosion asked for where no sand lay above the bed
     double sourced_mass = 0.0;  // with a bed: what the source put on (or took from) the sand
 };
@@ -59,8 +59,10 @@ void tiled_workspace_changed(TiledWorkspace &ws, const ActiveSet &active, const 
 // fills one summary per level; returns the number of cells it visited.
 // Without residuals (the relaxation to rest, which has no use for them) every
 // residual must be 0 and stays 0, and the heights are those the sweep with
-// them would give; the physics kernel always carries them.
+// them would give; the physics kernel always carries them. The largest
+// excess slope costs a little on every face, so it is found on the last
+// level only, and only with find_excess (elsewhere it is 0).
 std::int64_t tiled_sweep(Grid &grid, int levels, double dt, std::vector<LevelSummary> &summaries,
-                         bool residuals = true);
+                         bool find_excess, bool residuals = true);
 
 }  // namespace dpsm

@@ -1071,6 +1071,71 @@ static void test_last_error_is_per_grid(void **state) {
     dpsm_destroy(a);
 }
 
+/* The largest excess slope of a 2D step that does not reach rest: that of
+ * the faces carrying sand in its last sub-step, |grad h| - tan(theta) with
+ * the isotropic gradient (normal difference, transverse central differences
+ * averaged; a wall mirrors the cell that asks), as recomputed here from the
+ * heights before that sub-step. A step of 6 sub-steps ends inside a sweep of
+ * several levels, one of 1 sub-step in a sweep of its own. */
+static double steepest_isotropic_face(const double *h, int nx, int ny, double dx, double dy, double threshold) {
+#define H(i, j) h[(i) + nx * (j)]
+#define CLAMPED(i, j, ci, cj) ((i) < 0 || (j) < 0 || (i) >= nx || (j) >= ny ? H(ci, cj) : H(i, j))
+    double steepest = 0.0;
+    for (int j = 0; j < ny; ++j)
+        for (int i = 0; i + 1 < nx; ++i) { /* x faces between (i, j) and (i + 1, j) */
+            const double gn = (H(i + 1, j) - H(i, j)) / dx;
+            const double ty0 = (CLAMPED(i, j + 1, i, j) - CLAMPED(i, j - 1, i, j)) / (2.0 * dy);
+            const double ty1 = (CLAMPED(i + 1, j + 1, i + 1, j) - CLAMPED(i + 1, j - 1, i + 1, j)) / (2.0 * dy);
+            const double g = sqrt(gn * gn + 0.25 * (ty0 + ty1) * (ty0 + ty1));
+            if (g > threshold && gn != 0.0 && g > steepest) steepest = g;
+        }
+    for (int j = 0; j + 1 < ny; ++j)
+        for (int i = 0; i < nx; ++i) { /* y faces between (i, j) and (i, j + 1) */
+            const double gn = (H(i, j + 1) - H(i, j)) / dy;
+            const double tx0 = (CLAMPED(i + 1, j, i, j) - CLAMPED(i - 1, j, i, j)) / (2.0 * dx);
+            const double tx1 = (CLAMPED(i + 1, j + 1, i, j + 1) - CLAMPED(i - 1, j + 1, i, j + 1)) / (2.0 * dx);
+            const double g = sqrt(gn * gn + 0.25 * (tx0 + tx1) * (tx0 + tx1));
+            if (g > threshold && gn != 0.0 && g > steepest) steepest = g;
+        }
+#undef CLAMPED
+#undef H
+    return steepest;
+}
+
+static void test_step_info_max_excess_slope_2d(void **state) {
+    (void)state;
+    enum { NX = 48, NY = 40 };
+    const double dx = 0.5, dy = 0.7, tan_theta = tan(DPSM_DEFAULT_REPOSE_ANGLE);
+    static double h[NX * NY], before_last[NX * NY];
+    for (int j = 0; j < NY; ++j)
+        for (int i = 0; i < NX; ++i)
+            h[i + NX * j] = 0.9 * dx * i + 0.3 * dy * j + 0.4 * sin(0.5 * i) * cos(0.7 * j);
+    dpsm_grid *whole = NULL, *split = NULL;
+    CHECK_OK(NULL, dpsm_create_2d(NX, NY, dx, dy, &whole));
+    CHECK_OK(NULL, dpsm_create_2d(NX, NY, dx, dy, &split));
+    double sdt = 0.0;
+    CHECK_OK(whole, dpsm_stable_dt(whole, &sdt));
+    CHECK_OK(whole, dpsm_set_heights(whole, h));
+    CHECK_OK(split, dpsm_set_heights(split, h));
+    CHECK_OK(whole, dpsm_step(whole, 6.0 * sdt));
+    CHECK_OK(split, dpsm_step(split, 5.0 * sdt));
+    CHECK_OK(split, dpsm_get_heights(split, before_last));
+    CHECK_OK(split, dpsm_step(split, sdt));
+    const double expected =
+        steepest_isotropic_face(before_last, NX, NY, dx, dy, tan_theta * (1.0 + DPSM_DEFAULT_REST_TOLERANCE)) -
+        tan_theta;
+    REQUIRE(expected > 0.1, "the test's surface is not steep enough: excess %g", expected);
+    const dpsm_grid *grids[2] = {whole, split};
+    for (int k = 0; k < 2; ++k) {
+        REQUIRE(step_info_of(grids[k], DPSM_INFO_AT_REST) == 0.0, "the steep surface came to rest");
+        const double excess = step_info_of(grids[k], DPSM_INFO_MAX_EXCESS_SLOPE);
+        REQUIRE(fabs(excess - expected) <= 1e-9 * expected, "%s: largest excess slope %.17g, recomputed %.17g",
+                k == 0 ? "one step of 6 sub-steps" : "a step of 1 sub-step", excess, expected);
+    }
+    dpsm_destroy(whole);
+    dpsm_destroy(split);
+}
+
 /* Step information: 0 before the first step; after a collapse to rest the
  * sub-steps, time and rest flag; after a driven step exactly dt. */
 static void test_step_info(void **state) {
@@ -2121,6 +2186,7 @@ int main(int argc, char **argv) {
         cmocka_unit_test(test_last_error_cleared_by_every_successful_call),
         cmocka_unit_test(test_last_error_is_per_grid),
         cmocka_unit_test(test_step_info),
+        cmocka_unit_test(test_step_info_max_excess_slope_2d),
         cmocka_unit_test(test_work_limit),
         cmocka_unit_test(test_step_info_excess_counts_faces_that_carry),
         cmocka_unit_test(test_step_info_at_rest_means_nothing_moved),
