@@ -23,6 +23,20 @@
 
 namespace dpsm::simd {
 
+// Asks the caches for the lines of count elements from p, to read or to write.
+template <bool ForWriting, class T>
+inline void prefetch(const T *p, int count) {
+#if defined(__GNUC__) || defined(__clang__)
+    constexpr int per_line = 64 / static_cast<int>(sizeof(T));
+    for (int i = 0; i < count; i += per_line) __builtin_prefetch(p + i, ForWriting ? 1 : 0, 3);
+    // The last line, which the steps above miss when p is not at a line's start.
+    if (count > 0) __builtin_prefetch(p + count - 1, ForWriting ? 1 : 0, 3);
+#else
+    (void)p;
+    (void)count;
+#endif
+}
+
 struct Lanes1 {
     static constexpr int width = 1;
     using Mask = bool;
@@ -30,11 +44,15 @@ struct Lanes1 {
 
     static Lanes1 broadcast(double x) { return {x}; }
     static Lanes1 load(const double *p) { return {*p}; }
+    static Lanes1 load(const float *p) { return {static_cast<double>(*p)}; }
     static Lanes1 load_partial(const double *p, int) { return {*p}; }
     void store(double *p) const { *p = v; }
     void store_partial(double *p, int) const { *p = v; }
     void store_where(double *p, Mask m) const {
         if (m) *p = v;
+    }
+    void store_where(float *p, Mask m) const {
+        if (m) *p = static_cast<float>(v);
     }
     static Mask first_lanes(int n) { return n > 0; }
     static Mask kind_is(const std::uint8_t *p, std::uint8_t k) { return *p == k; }
@@ -79,10 +97,12 @@ struct Lanes8 {
 
     static Lanes8 broadcast(double x) { return {_mm512_set1_pd(x)}; }
     static Lanes8 load(const double *p) { return {_mm512_loadu_pd(p)}; }
+    static Lanes8 load(const float *p) { return {_mm512_cvtps_pd(_mm256_loadu_ps(p))}; }
     static Lanes8 load_partial(const double *p, int n) { return {_mm512_maskz_loadu_pd(first_lanes(n), p)}; }
     void store(double *p) const { _mm512_storeu_pd(p, v); }
     void store_partial(double *p, int n) const { _mm512_mask_storeu_pd(p, first_lanes(n), v); }
     void store_where(double *p, Mask m) const { _mm512_mask_storeu_pd(p, m, v); }
+    void store_where(float *p, Mask m) const { _mm256_mask_storeu_ps(p, m, _mm512_cvtpd_ps(v)); }
     static Mask first_lanes(int n) { return static_cast<Mask>(n >= 8 ? 0xFF : n <= 0 ? 0 : (1u << n) - 1u); }
     static Mask kind_is(const std::uint8_t *p, std::uint8_t k) {
         const __m128i bytes = _mm_loadl_epi64(reinterpret_cast<const __m128i *>(p));

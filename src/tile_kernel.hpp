@@ -15,6 +15,11 @@
 
 namespace dpsm {
 
+// How many rows ahead a copy or a level that reads or writes the grid asks
+// the caches for the grid's rows (a fully active sweep of 2048^2 cells on one
+// core: 192-204 Mcells/s without, 290-307 with 4 to 8 rows ahead).
+constexpr int kRowsAhead = 6;
+
 struct TileRect {
     int r0, r1, c0, c1;  // rows [r0, r1), columns [c0, c1), in buffer coordinates
 };
@@ -64,21 +69,50 @@ struct TileBuffers {
     void resize_physics();
 };
 
-// Advances the cells of `region` by one level, from slot `in` to slot 1 - in.
-// `tile` is the part of the region whose statistics count.
-using TileLevelFunction = void (*)(TileBuffers &buffers, int in, const TileRect &region, const TileRect &tile,
-                                   const TileLevelParams &params, TileLevelStats &stats);
+// Where a level of the tile kernel reads and writes its cells. Cell (r, c)
+// in the buffer's coordinates is element r * stride + c of each array read
+// and r * out_stride + c of each array written: the buffer's slots, or, on a
+// tile whose sweep reads its cells straight from the grid (first level) or
+// writes them straight into the next grid (last level), the grid's arrays
+// shifted to the buffer's origin. Residuals are double in the buffer and
+// float in the grid: one of each pair is set. Reads may run a vector past the
+// region's last column (the caller makes sure the arrays reach that far).
+struct LevelCells {
+    const double *h = nullptr;
+    const double *residual = nullptr;
+    const float *residual_grid = nullptr;
+    const double *source = nullptr;      // per sand cell; 0 elsewhere (read by kernels with a source)
+    const std::uint8_t *kind = nullptr;  // (read by masked kernels, which always work in the buffer)
+    int stride = 0;
+    double *h_out = nullptr;
+    double *residual_out = nullptr;
+    float *residual_grid_out = nullptr;
+    int out_stride = 0;
+};
+
+// Slot `in` of the buffer to slot 1 - in.
+LevelCells buffer_level_cells(TileBuffers &buffers, int in);
+
+// Advances the cells of `region` by one level. `tile` is the part of the
+// region whose statistics count; `buffers` gives the scratch rows.
+using TileKernel = void (*)(TileBuffers &buffers, const LevelCells &cells, const TileRect &region,
+                            const TileRect &tile, const TileLevelParams &params, TileLevelStats &stats);
 
 // The kernel for a tile: masked (walls, sinks or ghosts in reach), isotropic
-// or pairwise, with or without a source. The widest lanes this CPU has.
-TileLevelFunction select_tile_kernel(bool masked, bool isotropic, bool source);
+// or pairwise, with or without a source, reading its residuals from the grid
+// or the buffer, writing them to the grid or the buffer (masked kernels: the
+// buffer only). The widest lanes this CPU has.
+TileKernel select_tile_kernel(bool masked, bool isotropic, bool source, bool grid_in = false, bool grid_out = false);
 // Whether the kernels chosen run in AVX-512 (this CPU has it, DPSM_NO_AVX512 is not set).
 bool tile_kernels_use_avx512();
 
 // The kernel of a grid that uses a bed, an angle field, a flux exponent or
 // hysteresis (tile_kernel_physics.cpp): plain scalar code, used for every tile
 // of such a grid (it reads cell kinds always), so that every face of the grid
-// is computed by the same arithmetic.
-TileLevelFunction select_physics_tile_kernel(bool isotropic, bool source);
+// is computed by the same arithmetic. It works in the buffer only, from slot
+// `in` to slot 1 - in.
+using PhysicsTileKernel = void (*)(TileBuffers &buffers, int in, const TileRect &region, const TileRect &tile,
+                                   const TileLevelParams &params, TileLevelStats &stats);
+PhysicsTileKernel select_physics_tile_kernel(bool isotropic, bool source);
 
 }  // namespace dpsm

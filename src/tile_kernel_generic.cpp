@@ -6,7 +6,7 @@
 namespace dpsm {
 
 #if defined(DPSM_HAVE_AVX512_KERNEL)
-TileLevelFunction tile_kernel_avx512(bool masked, bool isotropic, bool source);
+TileKernel tile_kernel_avx512(bool masked, bool isotropic, bool source, bool grid_in, bool grid_out);
 #endif
 
 void TileBuffers::resize(int w, int h_) {
@@ -42,13 +42,26 @@ bool tile_kernels_use_avx512() {
     return avx512;
 }
 
-TileLevelFunction select_tile_kernel(bool masked, bool isotropic, bool source) {
+LevelCells buffer_level_cells(TileBuffers &b, int in) {
+    LevelCells cells;
+    cells.h = b.h[in].data();
+    cells.residual = b.residual[in].data();
+    cells.source = b.source.data();
+    cells.kind = b.kind.data();
+    cells.stride = b.width;
+    cells.h_out = b.h[1 - in].data();
+    cells.residual_out = b.residual[1 - in].data();
+    cells.out_stride = b.width;
+    return cells;
+}
+
+TileKernel select_tile_kernel(bool masked, bool isotropic, bool source, bool grid_in, bool grid_out) {
     const bool avx512 = tile_kernels_use_avx512();
 #if defined(DPSM_HAVE_AVX512_KERNEL)
-    if (avx512) return tile_kernel_avx512(masked, isotropic, source);
+    if (avx512) return tile_kernel_avx512(masked, isotropic, source, grid_in, grid_out);
 #endif
     (void)avx512;
-    return tile_kernel_for<simd::Lanes1>(masked, isotropic, source);
+    return tile_kernel_for<simd::Lanes1>(masked, isotropic, source, grid_in, grid_out);
 }
 
 }  // namespace dpsm

@@ -20,6 +20,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <type_traits>
 #include <utility>
 
 #include "grid.hpp"
@@ -36,18 +37,25 @@
 
 namespace dpsm {
 
-template <class V, bool Masked, bool Isotropic, bool Source>
-DPSM_KERNEL_FLATTEN void advance_tile_level(TileBuffers &b, int in, const TileRect &reg, const TileRect &tile,
-                                            const TileLevelParams &p, TileLevelStats &st) {
+// GridIn, GridOut: the residuals read from / written to the grid (float), not the buffer.
+template <class V, bool Masked, bool Isotropic, bool Source, bool GridIn, bool GridOut>
+DPSM_KERNEL_FLATTEN void advance_tile_level(TileBuffers &b, const LevelCells &io, const TileRect &reg,
+                                            const TileRect &tile, const TileLevelParams &p, TileLevelStats &st) {
     using M = typename V::Mask;
     constexpr int w = V::width;
-    const int W = b.width;
-    const double *h = b.h[in].data();
-    const double *res = b.residual[in].data();
-    double *__restrict h_out = b.h[1 - in].data();
-    double *__restrict res_out = b.residual[1 - in].data();
-    const std::uint8_t *kind = b.kind.data();
-    const double *q = b.source.data();
+    const int W = io.stride, W_out = io.out_stride;
+    const double *h = io.h;
+    const auto *res = [&] {
+        if constexpr (GridIn) return io.residual_grid;
+        else return io.residual;
+    }();
+    double *__restrict h_out = io.h_out;
+    auto *__restrict res_out = [&] {
+        if constexpr (GridOut) return io.residual_grid_out;
+        else return io.residual_out;
+    }();
+    const std::uint8_t *kind = io.kind;
+    const double *q = io.source;
     const int n = reg.c1 - reg.c0;
     const int chunks = (n + w - 1) / w;
     // Rows of scratch, each a vector longer than the region (whole-vector stores).
@@ -87,15 +95,15 @@ DPSM_KERNEL_FLATTEN void advance_tile_level(TileBuffers &b, int in, const TileRe
 
     auto valid_lanes = [&](int count) { return V::first_lanes(count); };
     // A wall neighbour mirrors the cell that asks (zero normal gradient).
-    auto mirrored = [&](V h_cell, V h_next, const std::uint8_t *kind_next) {
-        if constexpr (Masked) return select(V::kind_is(kind_next, kWall), h_cell, h_next);
+    auto mirrored = [&](V h_cell, V h_next, int next) {
+        if constexpr (Masked) return select(V::kind_is(kind + next, kWall), h_cell, h_next);
         return h_next;
     };
     // Open faces: no wall on either side, sand on at least one.
-    auto open_face = [&](const std::uint8_t *ka, const std::uint8_t *kb) {
+    auto open_face = [&](int a, int b_) {
         if constexpr (Masked)
-            return V::but_not(V::either(V::kind_is(ka, kSand), V::kind_is(kb, kSand)),
-                              V::either(V::kind_is(ka, kWall), V::kind_is(kb, kWall)));
+            return V::but_not(V::either(V::kind_is(kind + a, kSand), V::kind_is(kind + b_, kSand)),
+                              V::either(V::kind_is(kind + a, kWall), V::kind_is(kind + b_, kWall)));
         return V::first_lanes(w);
     };
     // The flux law on the full slope (dn the height difference across the
@@ -121,25 +129,25 @@ DPSM_KERNEL_FLATTEN void advance_tile_level(TileBuffers &b, int in, const TileRe
     // Central differences along x at cells c .. c + w - 1, scaled for the y faces.
     auto slopes_along_x = [&](int c) {
         const V hc = V::load(h + c);
-        return (mirrored(hc, V::load(h + c + 1), kind + c + 1) - mirrored(hc, V::load(h + c - 1), kind + c - 1)) *
+        return (mirrored(hc, V::load(h + c + 1), c + 1) - mirrored(hc, V::load(h + c - 1), c - 1)) *
                along_y.transverse;
     };
     auto slopes_along_y = [&](int c) {
         const V hc = V::load(h + c);
-        return (mirrored(hc, V::load(h + c + W), kind + c + W) - mirrored(hc, V::load(h + c - W), kind + c - W)) *
+        return (mirrored(hc, V::load(h + c + W), c + W) - mirrored(hc, V::load(h + c - W), c - W)) *
                along_x.transverse;
     };
     // The faces between cells c and c + W, given the transverse slopes of both rows.
     auto faces_along_y = [&](int c, V tx_here, V tx_next, M valid, M &carries) {
         const V dn = V::load(h + c) - V::load(h + c + W);
         const V dt_ = Isotropic ? tx_here + tx_next : zero;
-        return face_flux(dn, dt_, V::both(valid, open_face(kind + c, kind + c + W)), along_y, carries);
+        return face_flux(dn, dt_, V::both(valid, open_face(c, c + W)), along_y, carries);
     };
     // The faces between cells c - 1 and c, given the transverse slopes of both columns.
     auto faces_along_x = [&](int c, V ty_west, V ty_here, M valid, M &carries) {
         const V dn = V::load(h + c - 1) - V::load(h + c);
         const V dt_ = Isotropic ? ty_west + ty_here : zero;
-        return face_flux(dn, dt_, V::both(valid, open_face(kind + c - 1, kind + c)), along_x, carries);
+        return face_flux(dn, dt_, V::both(valid, open_face(c - 1, c)), along_x, carries);
     };
 
     // The y faces between the first row and the one below it.
@@ -169,7 +177,23 @@ DPSM_KERNEL_FLATTEN void advance_tile_level(TileBuffers &b, int in, const TileRe
     const bool last_chunk_full = n % w == 0;
 
     for (int r = reg.r0; r < reg.r1; ++r) {
-        const int row = r * W + reg.c0;
+        const int row = r * W + reg.c0, row_out = r * W_out + reg.c0;
+        // Rows straight from or into the grid are far from this core's caches;
+        // asked for a few rows ahead, they arrive while this row computes.
+        if constexpr (GridIn) {
+            if (r + kRowsAhead <= reg.r1) {
+                const int ahead = row + kRowsAhead * W - 1;  // a row as the faces read it: c0 - 1 .. c1
+                simd::prefetch<false>(h + ahead, n + 2);
+                simd::prefetch<false>(res + ahead, n + 2);
+                if constexpr (Source) simd::prefetch<false>(q + ahead, n + 2);
+            }
+        }
+        if constexpr (GridOut) {
+            if (r + kRowsAhead < reg.r1) {
+                simd::prefetch<true>(h_out + row_out + kRowsAhead * W_out, n);
+                simd::prefetch<true>(res_out + row_out + kRowsAhead * W_out, n);
+            }
+        }
         const bool row_in_tile = r >= tile.r0 && r < tile.r1;
         unsigned row_hot = 0;
         // The west faces of the first chunk.
@@ -221,11 +245,11 @@ DPSM_KERNEL_FLATTEN void advance_tile_level(TileBuffers &b, int in, const TileRe
                 sum = hc + b_;
                 const V b_virtual = sum - hc;
                 const V err = (hc - (sum - b_virtual)) + (b_ - b_virtual);
-                select(changes, err, rc).store_where(res_out + c, valid);
+                select(changes, err, rc).store_where(res_out + row_out + k, valid);
             } else {
                 sum = hc + increment;
             }
-            select(changes, sum, hc).store_where(h_out + c, valid);
+            select(changes, sum, hc).store_where(h_out + row_out + k, valid);
 
             // Motion is sand carried by a face, even where an increment is too
             // small to change a height (a tiny dt): such a cell stays hot.
@@ -272,8 +296,9 @@ DPSM_KERNEL_FLATTEN void advance_tile_level(TileBuffers &b, int in, const TileRe
 
     std::uint64_t moved_columns = 0;  // as bits from tile.c0
     for (int j = 0; j < chunks; ++j) {
+        const std::uint64_t bits = moved_columns_of[j];  // tile lanes only, so the shift stays below 64
+        if (bits == 0) continue;
         const int shift = reg.c0 + j * w - tile.c0;
-        const std::uint64_t bits = moved_columns_of[j];
         moved_columns |= shift >= 0 ? bits << shift : bits >> -shift;
     }
     if (moved_columns) {
@@ -291,18 +316,25 @@ DPSM_KERNEL_FLATTEN void advance_tile_level(TileBuffers &b, int in, const TileRe
 }
 
 template <class V>
-TileLevelFunction tile_kernel_for(bool masked, bool isotropic, bool source) {
-    const int which = (masked ? 4 : 0) + (isotropic ? 2 : 0) + (source ? 1 : 0);
-    switch (which) {
-        case 0: return advance_tile_level<V, false, false, false>;
-        case 1: return advance_tile_level<V, false, false, true>;
-        case 2: return advance_tile_level<V, false, true, false>;
-        case 3: return advance_tile_level<V, false, true, true>;
-        case 4: return advance_tile_level<V, true, false, false>;
-        case 5: return advance_tile_level<V, true, false, true>;
-        case 6: return advance_tile_level<V, true, true, false>;
-        default: return advance_tile_level<V, true, true, true>;
+TileKernel tile_kernel_for(bool masked, bool isotropic, bool source, bool grid_in, bool grid_out) {
+    // Masked kernels work in the buffer only (tile_kernel.hpp).
+    if (masked) {
+        if (isotropic)
+            return source ? advance_tile_level<V, true, true, true, false, false>
+                          : advance_tile_level<V, true, true, false, false, false>;
+        return source ? advance_tile_level<V, true, false, true, false, false>
+                      : advance_tile_level<V, true, false, false, false, false>;
     }
+    auto choose = [&](auto isotropic_, auto source_) -> TileKernel {
+        constexpr bool I = decltype(isotropic_)::value, S = decltype(source_)::value;
+        if (grid_in)
+            return grid_out ? advance_tile_level<V, false, I, S, true, true> : advance_tile_level<V, false, I, S, true, false>;
+        return grid_out ? advance_tile_level<V, false, I, S, false, true> : advance_tile_level<V, false, I, S, false, false>;
+    };
+    using yes = std::true_type;
+    using no = std::false_type;
+    if (isotropic) return source ? choose(yes{}, yes{}) : choose(yes{}, no{});
+    return source ? choose(no{}, yes{}) : choose(no{}, no{});
 }
 
 }  // namespace dpsm

@@ -181,7 +181,7 @@ void advance_tile_level_physics(TileBuffers &b, int in, const TileRect &reg, con
 
 }  // namespace
 
-TileLevelFunction select_physics_tile_kernel(bool isotropic, bool source) {
+PhysicsTileKernel select_physics_tile_kernel(bool isotropic, bool source) {
     if (isotropic) return source ? advance_tile_level_physics<true, true> : advance_tile_level_physics<true, false>;
     return source ? advance_tile_level_physics<false, true> : advance_tile_level_physics<false, false>;
 }

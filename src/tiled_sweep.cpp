@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
+#include <limits>
 
 #if defined(_OPENMP)
 #include <omp.h>
@@ -11,6 +13,7 @@
 #include "active_set.hpp"
 #include "decomposition.hpp"
 #include "grid.hpp"
+#include "simd.hpp"
 
 namespace dpsm {
 
@@ -18,6 +21,9 @@ namespace {
 
 constexpr int kBufferSide = ActiveSet::kTile + 2 * (ActiveSet::kMaxLevels + 1);
 constexpr std::int64_t kCellsForThreads = 8 * ActiveSet::kTile * ActiveSet::kTile;
+// The longest grid row a tile kernel reads or writes in place: its indices
+// (rows of the buffer times the row length) stay within an int.
+constexpr std::int64_t kMaxDirectRowLength = std::numeric_limits<int>::max() / (2 * kBufferSide);
 
 int thread_count(int requested) {
 #if defined(_OPENMP)
@@ -74,9 +80,11 @@ std::uint8_t ghost_kind(const Grid &grid, std::int64_t i, std::int64_t j) {
     return open ? kOpen : kWall;
 }
 
-// Copies a tile and its halo into the buffers, ghosts beyond the edge.
-void gather(const Grid &grid, TileBuffers &b, std::int64_t gi0, std::int64_t gj0, bool masked, bool source,
-            bool residuals) {
+// Copies a tile and its halo into the buffers, ghosts beyond the edge: the
+// heights (and residuals) unless `heights` is false, the kinds of masked
+// tiles, the sources of tiles that have them.
+void gather(const Grid &grid, TileBuffers &b, std::int64_t gi0, std::int64_t gj0, bool heights, bool masked,
+            bool source, bool residuals) {
     const Geometry &geo = grid.geometry();
     const double *h = grid.heights().data();
     const float *res = grid.residuals().data();
@@ -96,18 +104,30 @@ void gather(const Grid &grid, TileBuffers &b, std::int64_t gi0, std::int64_t gj0
         const int c_in1 = row_in ? static_cast<int>(std::clamp<std::int64_t>(geo.nx - gi0, c_in0, b.width)) : b.width;
         auto ghosts = [&](int c0, int c1) {
             for (int c = c0; c < c1; ++c) {
-                hb[c] = 0.0;
-                rb[c] = 0.0;
+                if (heights) {
+                    hb[c] = 0.0;
+                    rb[c] = 0.0;
+                }
                 if (masked) kb[c] = ghost_kind(grid, gi0 + c, j);
                 if (source) qb[c] = 0.0;
             }
         };
         ghosts(0, c_in0);
+        // The same span some rows ahead, so that the copies wait on several rows at once.
+        const std::int64_t j_ahead = j + kRowsAhead;
+        if (c_in0 < c_in1 && r + kRowsAhead < b.height && j_ahead < geo.ny) {
+            const std::size_t at = static_cast<std::size_t>(j_ahead * geo.nx + gi0 + c_in0);
+            const int count = c_in1 - c_in0;
+            if (heights) simd::prefetch<false>(h + at, count);
+            if (heights && residuals) simd::prefetch<false>(res + at, count);
+            if (masked || source) simd::prefetch<false>(kind + at, count);
+            if (source) simd::prefetch<false>(q + at, count);
+        }
         if (c_in0 < c_in1) {
             const std::size_t at = static_cast<std::size_t>(j * geo.nx + gi0 + c_in0);
             const int count = c_in1 - c_in0;
-            std::memcpy(hb + c_in0, h + at, sizeof(double) * count);
-            if (residuals) widen(res + at, rb + c_in0, count);
+            if (heights) std::memcpy(hb + c_in0, h + at, sizeof(double) * count);
+            if (heights && residuals) widen(res + at, rb + c_in0, count);
             if (masked) std::memcpy(kb + c_in0, kind + at, count);
             if (source)
                 for (int c = 0; c < count; ++c) qb[c_in0 + c] = kind[at + c] == kSand ? q[at + c] : 0.0;
@@ -296,6 +316,10 @@ std::int64_t tiled_sweep(Grid &grid, int levels, double dt, std::vector<LevelSum
         params.bed_film = bed_film(grid);
     }
     const bool isotropic = grid.scheme() == kIsotropic;
+    // DPSM_COPY_TILES=1 copies every tile into a buffer and back (no tile is
+    // read or written in place), for tests that show it changes no result.
+    const char *copy_all = std::getenv("DPSM_COPY_TILES");
+    const bool in_place = !(copy_all && *copy_all && *copy_all != '0');
     const int threads = thread_count(grid.threads());
     std::int64_t visited_cells = 0;
     for (const CellBox &cells : ws.boxes) visited_cells += (cells.i1 - cells.i0) * (cells.j1 - cells.j0);
@@ -327,8 +351,18 @@ std::int64_t tiled_sweep(Grid &grid, int levels, double dt, std::vector<LevelSum
         // (Both kernels round alike: src/CMakeLists.txt.)
         const bool inside = gi0 >= 0 && gj0 >= 0 && gi0 + b.width <= geo.nx && gj0 + b.height <= geo.ny;
         const bool masked = active.masked(t) || !inside;
+        // A tile that every level computes whole and that needs no ghosts
+        // reads its first level straight from the grid and writes its last
+        // straight into the scratch: no copies (which cost about a third of a
+        // fully active sweep). Its first level's whole-vector loads run up to
+        // a vector past the read box, still within the grid's arrays unless
+        // the box ends at the grid's last row and column.
+        // (The kernel indexes a row of the grid by an int.)
+        constexpr int kVectorSlack = 8;
+        const bool direct = in_place && !physics && !masked && residuals && every_cell && geo.nx <= kMaxDirectRowLength &&
+                            (gj0 + b.height < geo.ny || gi0 + b.width + kVectorSlack <= geo.nx);
         // The physics kernel reads cell kinds on every tile.
-        gather(grid, b, gi0, gj0, masked || physics, source, residuals);
+        if (!direct || source) gather(grid, b, gi0, gj0, !direct, masked || physics, source, residuals);
         if (halo_store && !inside) gather_halo(grid, *halo_store, b, gi0, gj0, masked || physics, source);
         if (physics) gather_physics(grid, halo_store, b, gi0, gj0);
         if (!every_cell) {
@@ -343,21 +377,46 @@ std::int64_t tiled_sweep(Grid &grid, int levels, double dt, std::vector<LevelSum
             return TileRect{static_cast<int>(box.j0 - gj0), static_cast<int>(box.j1 - gj0),
                             static_cast<int>(box.i0 - gi0), static_cast<int>(box.i1 - gi0)};
         };
-        const TileLevelFunction kernel =
-            physics ? select_physics_tile_kernel(isotropic, source) : select_tile_kernel(masked, isotropic, source);
         const TileRect tile = in_buffer(cells);
+        const std::size_t origin = direct ? static_cast<std::size_t>(gj0 * geo.nx + gi0) : 0;  // the buffer's (0, 0)
         int in = 0;
         for (int s = 1; s <= levels; ++s) {
             TileLevelParams level_params = params;
             level_params.track_excess = find_excess && s == levels;
-            kernel(b, in, in_buffer(level_cells[s - 1]), tile, level_params,
-                   ws.stats[static_cast<std::size_t>(k) * levels + (s - 1)]);
+            TileLevelStats &stats = ws.stats[static_cast<std::size_t>(k) * levels + (s - 1)];
+            const TileRect region = in_buffer(level_cells[s - 1]);
+            if (physics) {
+                select_physics_tile_kernel(isotropic, source)(b, in, region, tile, level_params, stats);
+            } else {
+                LevelCells io = buffer_level_cells(b, in);
+                const bool grid_in = direct && s == 1, grid_out = direct && s == levels;
+                if (grid_in) {
+                    io.h = grid.heights().data() + origin;
+                    io.residual = nullptr;
+                    io.residual_grid = grid.residuals().data() + origin;
+                    if (source) io.source = grid.source().data() + origin;  // all sand: unmasked
+                    io.stride = static_cast<int>(geo.nx);
+                }
+                if (grid_out) {
+                    io.h_out = ws.heights.data() + origin;
+                    io.residual_out = nullptr;
+                    io.residual_grid_out = ws.residuals.data() + origin;
+                    io.out_stride = static_cast<int>(geo.nx);
+                }
+                select_tile_kernel(masked, isotropic, source, grid_in, grid_out)(b, io, region, tile, level_params,
+                                                                                 stats);
+            }
             in = 1 - in;
         }
-        for (int r = tile.r0; r < tile.r1; ++r) {
+        for (int r = tile.r0; r < tile.r1 && !direct; ++r) {
             const std::size_t from = static_cast<std::size_t>(r) * b.width + tile.c0;
             const std::size_t to = static_cast<std::size_t>((gj0 + r) * geo.nx + gi0 + tile.c0);
             const int count = tile.c1 - tile.c0;
+            if (r + kRowsAhead < tile.r1) {
+                const std::size_t ahead = to + static_cast<std::size_t>(kRowsAhead * geo.nx);
+                simd::prefetch<true>(ws.heights.data() + ahead, count);
+                simd::prefetch<true>(ws.residuals.data() + ahead, count);
+            }
             std::memcpy(ws.heights.data() + to, b.h[in].data() + from, sizeof(double) * count);
             if (residuals)
                 narrow(b.residual[in].data() + from, ws.residuals.data() + to, count);
