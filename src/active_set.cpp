@@ -107,6 +107,15 @@ void ActiveSet::set_remote_activity(const std::vector<CellBox> &hot, const std::
     for (const CellBox &box : sources) spread(box.grown(1), true);
 }
 
+CellBox ActiveSet::sources_near(std::int64_t t) const {
+    const std::int64_t ti = t % tiles_x_, tj = t / tiles_x_;
+    CellBox near;
+    for (std::int64_t uj = std::max<std::int64_t>(0, tj - 1); uj <= std::min(tiles_y_ - 1, tj + 1); ++uj)
+        for (std::int64_t ui = std::max<std::int64_t>(0, ti - 1); ui <= std::min(tiles_x_ - 1, ti + 1); ++ui)
+            near.add(source_[ui + tiles_x_ * uj]);
+    return near;
+}
+
 bool ActiveSet::may_move() const {
     for (std::int64_t t = 0; t < tiles(); ++t)
         if (!hot_[t].empty() || !source_[t].empty()) return true;

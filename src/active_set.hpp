@@ -77,6 +77,10 @@ public:
                         std::vector<CellBox> &seeds) const;
 
     CellBox &hot(std::int64_t t) { return hot_[t]; }
+    // The box of this grid's cells with a source in tile t and the tiles
+    // around it: all a sweep of t reads (the sources of a distributed grid's
+    // neighbours come with its halo).
+    CellBox sources_near(std::int64_t t) const;
     bool masked(std::int64_t t) const { return masked_[t] != 0; }
     bool has_source(std::int64_t t) const {
         return has_source_[t] != 0 || (!remote_source_.empty() && remote_source_[t] != 0);

@@ -71,10 +71,11 @@ struct TileBuffers {
 
 // Where a level of the tile kernel reads and writes its cells. Cell (r, c)
 // in the buffer's coordinates is element r * stride + c of each array read
-// and r * out_stride + c of each array written: the buffer's slots, or, on a
-// tile whose sweep reads its cells straight from the grid (first level) or
-// writes them straight into the next grid (last level), the grid's arrays
-// shifted to the buffer's origin. Residuals are double in the buffer and
+// and (r - out_row0) * out_stride + c - out_col0 of each array written: the
+// buffer's slots, or, on a tile whose sweep reads its cells straight from the
+// grid (first level) or writes them straight into the next grid (last level),
+// the grid's arrays from the cell at the buffer's origin (read) or at the
+// first cell written (written). Residuals are double in the buffer and
 // float in the grid: one of each pair is set. Reads may run a vector past the
 // region's last column (the caller makes sure the arrays reach that far).
 struct LevelCells {
@@ -88,6 +89,7 @@ struct LevelCells {
     double *residual_out = nullptr;
     float *residual_grid_out = nullptr;
     int out_stride = 0;
+    int out_row0 = 0, out_col0 = 0;  // the cell of the buffer's coordinates at the start of the arrays written
 };
 
 // Slot `in` of the buffer to slot 1 - in.

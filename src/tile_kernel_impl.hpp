@@ -177,7 +177,7 @@ DPSM_KERNEL_FLATTEN void advance_tile_level(TileBuffers &b, const LevelCells &io
     const bool last_chunk_full = n % w == 0;
 
     for (int r = reg.r0; r < reg.r1; ++r) {
-        const int row = r * W + reg.c0, row_out = r * W_out + reg.c0;
+        const int row = r * W + reg.c0, row_out = (r - io.out_row0) * W_out + reg.c0 - io.out_col0;
         // Rows straight from or into the grid are far from this core's caches;
         // asked for a few rows ahead, they arrive while this row computes.
         if constexpr (GridIn) {
@@ -317,24 +317,24 @@ DPSM_KERNEL_FLATTEN void advance_tile_level(TileBuffers &b, const LevelCells &io
 
 template <class V>
 TileKernel tile_kernel_for(bool masked, bool isotropic, bool source, bool grid_in, bool grid_out) {
-    // Masked kernels work in the buffer only (tile_kernel.hpp).
-    if (masked) {
-        if (isotropic)
-            return source ? advance_tile_level<V, true, true, true, false, false>
-                          : advance_tile_level<V, true, true, false, false, false>;
-        return source ? advance_tile_level<V, true, false, true, false, false>
-                      : advance_tile_level<V, true, false, false, false, false>;
-    }
-    auto choose = [&](auto isotropic_, auto source_) -> TileKernel {
-        constexpr bool I = decltype(isotropic_)::value, S = decltype(source_)::value;
-        if (grid_in)
-            return grid_out ? advance_tile_level<V, false, I, S, true, true> : advance_tile_level<V, false, I, S, true, false>;
-        return grid_out ? advance_tile_level<V, false, I, S, false, true> : advance_tile_level<V, false, I, S, false, false>;
+    // Masked kernels read the buffer only (tile_kernel.hpp).
+    auto choose = [&](auto masked_, auto isotropic_, auto source_) -> TileKernel {
+        constexpr bool Mk = decltype(masked_)::value, I = decltype(isotropic_)::value, S = decltype(source_)::value;
+        if constexpr (!Mk) {
+            if (grid_in)
+                return grid_out ? advance_tile_level<V, false, I, S, true, true>
+                                : advance_tile_level<V, false, I, S, true, false>;
+        }
+        return grid_out ? advance_tile_level<V, Mk, I, S, false, true> : advance_tile_level<V, Mk, I, S, false, false>;
     };
     using yes = std::true_type;
     using no = std::false_type;
-    if (isotropic) return source ? choose(yes{}, yes{}) : choose(yes{}, no{});
-    return source ? choose(no{}, yes{}) : choose(no{}, no{});
+    if (masked) {
+        if (isotropic) return source ? choose(yes{}, yes{}, yes{}) : choose(yes{}, yes{}, no{});
+        return source ? choose(yes{}, no{}, yes{}) : choose(yes{}, no{}, no{});
+    }
+    if (isotropic) return source ? choose(no{}, yes{}, yes{}) : choose(no{}, yes{}, no{});
+    return source ? choose(no{}, no{}, yes{}) : choose(no{}, no{}, no{});
 }
 
 }  // namespace dpsm

@@ -82,9 +82,10 @@ std::uint8_t ghost_kind(const Grid &grid, std::int64_t i, std::int64_t j) {
 
 // Copies a tile and its halo into the buffers, ghosts beyond the edge: the
 // heights (and residuals) unless `heights` is false, the kinds of masked
-// tiles, the sources of tiles that have them.
+// tiles, the sources of tiles that have them (those in `sources`, the box of
+// every nonzero source: the rest are 0 and need no copy from the grid).
 void gather(const Grid &grid, TileBuffers &b, std::int64_t gi0, std::int64_t gj0, bool heights, bool masked,
-            bool source, bool residuals) {
+            bool source, const CellBox &sources, bool residuals) {
     const Geometry &geo = grid.geometry();
     const double *h = grid.heights().data();
     const float *res = grid.residuals().data();
@@ -109,9 +110,18 @@ void gather(const Grid &grid, TileBuffers &b, std::int64_t gi0, std::int64_t gj0
                     rb[c] = 0.0;
                 }
                 if (masked) kb[c] = ghost_kind(grid, gi0 + c, j);
-                if (source) qb[c] = 0.0;
             }
         };
+        // The row's sources: the span within `sources`, zero around it.
+        int q0 = b.width, q1 = b.width;
+        if (source) {
+            if (row_in && j >= sources.j0 && j < sources.j1) {
+                q0 = static_cast<int>(std::clamp<std::int64_t>(sources.i0 - gi0, c_in0, c_in1));
+                q1 = static_cast<int>(std::clamp<std::int64_t>(sources.i1 - gi0, q0, c_in1));
+            }
+            std::fill(qb, qb + q0, 0.0);
+            std::fill(qb + q1, qb + b.width, 0.0);
+        }
         ghosts(0, c_in0);
         // The same span some rows ahead, so that the copies wait on several rows at once.
         const std::int64_t j_ahead = j + kRowsAhead;
@@ -120,8 +130,7 @@ void gather(const Grid &grid, TileBuffers &b, std::int64_t gi0, std::int64_t gj0
             const int count = c_in1 - c_in0;
             if (heights) simd::prefetch<false>(h + at, count);
             if (heights && residuals) simd::prefetch<false>(res + at, count);
-            if (masked || source) simd::prefetch<false>(kind + at, count);
-            if (source) simd::prefetch<false>(q + at, count);
+            if (masked) simd::prefetch<false>(kind + at, count);
         }
         if (c_in0 < c_in1) {
             const std::size_t at = static_cast<std::size_t>(j * geo.nx + gi0 + c_in0);
@@ -129,8 +138,11 @@ void gather(const Grid &grid, TileBuffers &b, std::int64_t gi0, std::int64_t gj0
             if (heights) std::memcpy(hb + c_in0, h + at, sizeof(double) * count);
             if (heights && residuals) widen(res + at, rb + c_in0, count);
             if (masked) std::memcpy(kb + c_in0, kind + at, count);
-            if (source)
-                for (int c = 0; c < count; ++c) qb[c_in0 + c] = kind[at + c] == kSand ? q[at + c] : 0.0;
+        }
+        if (q0 < q1) {
+            // Sources act on sand cells only (every cell of an unmasked tile).
+            const std::size_t at = static_cast<std::size_t>(j * geo.nx + gi0 + q0);
+            for (int c = 0; c < q1 - q0; ++c) qb[q0 + c] = masked && kind[at + c] != kSand ? 0.0 : q[at + c];
         }
         ghosts(c_in1, b.width);
     }
@@ -351,18 +363,23 @@ std::int64_t tiled_sweep(Grid &grid, int levels, double dt, std::vector<LevelSum
         // (Both kernels round alike: src/CMakeLists.txt.)
         const bool inside = gi0 >= 0 && gj0 >= 0 && gi0 + b.width <= geo.nx && gj0 + b.height <= geo.ny;
         const bool masked = active.masked(t) || !inside;
-        // A tile that every level computes whole and that needs no ghosts
-        // reads its first level straight from the grid and writes its last
-        // straight into the scratch: no copies (which cost about a third of a
-        // fully active sweep). Its first level's whole-vector loads run up to
-        // a vector past the read box, still within the grid's arrays unless
-        // the box ends at the grid's last row and column.
-        // (The kernel indexes a row of the grid by an int.)
+        // Copies cost about a third of a fully active sweep, so where it can a
+        // visit works in place. Its last level computes exactly its cells and
+        // writes them straight into the scratch. Its first level reads
+        // straight from the grid if every level computes all that the next
+        // one reads (else later levels would need cells the first one leaves
+        // alone) and the visit needs no ghosts; its whole-vector loads run up
+        // to a vector past the read box, still within the grid's arrays unless
+        // the box ends at the grid's last row and column. The kernel indexes
+        // a row of the grid by an int.
         constexpr int kVectorSlack = 8;
-        const bool direct = in_place && !physics && !masked && residuals && every_cell && geo.nx <= kMaxDirectRowLength &&
-                            (gj0 + b.height < geo.ny || gi0 + b.width + kVectorSlack <= geo.nx);
+        const bool out_in_place = in_place && !physics && residuals && geo.nx <= kMaxDirectRowLength &&
+                                  level_cells[levels - 1] == cells;
+        const bool in_in_place = out_in_place && !masked && every_cell &&
+                                 (gj0 + b.height < geo.ny || gi0 + b.width + kVectorSlack <= geo.nx);
         // The physics kernel reads cell kinds on every tile.
-        if (!direct || source) gather(grid, b, gi0, gj0, !direct, masked || physics, source, residuals);
+        if (!in_in_place || source)
+            gather(grid, b, gi0, gj0, !in_in_place, masked || physics, source, active.sources_near(t), residuals);
         if (halo_store && !inside) gather_halo(grid, *halo_store, b, gi0, gj0, masked || physics, source);
         if (physics) gather_physics(grid, halo_store, b, gi0, gj0);
         if (!every_cell) {
@@ -378,7 +395,9 @@ std::int64_t tiled_sweep(Grid &grid, int levels, double dt, std::vector<LevelSum
                             static_cast<int>(box.i0 - gi0), static_cast<int>(box.i1 - gi0)};
         };
         const TileRect tile = in_buffer(cells);
-        const std::size_t origin = direct ? static_cast<std::size_t>(gj0 * geo.nx + gi0) : 0;  // the buffer's (0, 0)
+        auto grid_index = [&](std::int64_t r, std::int64_t c) {  // of the buffer's cell (r, c)
+            return static_cast<std::size_t>((gj0 + r) * geo.nx + gi0 + c);
+        };
         int in = 0;
         for (int s = 1; s <= levels; ++s) {
             TileLevelParams level_params = params;
@@ -389,28 +408,32 @@ std::int64_t tiled_sweep(Grid &grid, int levels, double dt, std::vector<LevelSum
                 select_physics_tile_kernel(isotropic, source)(b, in, region, tile, level_params, stats);
             } else {
                 LevelCells io = buffer_level_cells(b, in);
-                const bool grid_in = direct && s == 1, grid_out = direct && s == levels;
-                if (grid_in) {
+                const bool grid_in = in_in_place && s == 1, grid_out = out_in_place && s == levels;
+                if (grid_in) {  // from the buffer's (0, 0), inside the grid
+                    const std::size_t origin = grid_index(0, 0);
                     io.h = grid.heights().data() + origin;
                     io.residual = nullptr;
                     io.residual_grid = grid.residuals().data() + origin;
                     if (source) io.source = grid.source().data() + origin;  // all sand: unmasked
                     io.stride = static_cast<int>(geo.nx);
                 }
-                if (grid_out) {
+                if (grid_out) {  // from the first of the visit's cells
+                    const std::size_t origin = grid_index(tile.r0, tile.c0);
                     io.h_out = ws.heights.data() + origin;
                     io.residual_out = nullptr;
                     io.residual_grid_out = ws.residuals.data() + origin;
                     io.out_stride = static_cast<int>(geo.nx);
+                    io.out_row0 = tile.r0;
+                    io.out_col0 = tile.c0;
                 }
                 select_tile_kernel(masked, isotropic, source, grid_in, grid_out)(b, io, region, tile, level_params,
                                                                                  stats);
             }
             in = 1 - in;
         }
-        for (int r = tile.r0; r < tile.r1 && !direct; ++r) {
+        for (int r = tile.r0; r < tile.r1 && !out_in_place; ++r) {
             const std::size_t from = static_cast<std::size_t>(r) * b.width + tile.c0;
-            const std::size_t to = static_cast<std::size_t>((gj0 + r) * geo.nx + gi0 + tile.c0);
+            const std::size_t to = grid_index(r, tile.c0);
             const int count = tile.c1 - tile.c0;
             if (r + kRowsAhead < tile.r1) {
                 const std::size_t ahead = to + static_cast<std::size_t>(kRowsAhead * geo.nx);
