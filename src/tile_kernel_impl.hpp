@@ -172,9 +172,6 @@ DPSM_KERNEL_FLATTEN void advance_tile_level(TileBuffers &b, const LevelCells &io
     unsigned moved = 0;  // lanes of cells that moved, anywhere in the region
     int moved_r0 = st.hot_r0, moved_r1 = st.hot_r1;
     double outflow = 0.0;
-    // The x faces are needed up to the east face of the last cell: a chunk
-    // further when the last chunk is full.
-    const bool last_chunk_full = n % w == 0;
 
     for (int r = reg.r0; r < reg.r1; ++r) {
         const int row = r * W + reg.c0, row_out = (r - io.out_row0) * W_out + reg.c0 - io.out_col0;
@@ -196,37 +193,60 @@ DPSM_KERNEL_FLATTEN void advance_tile_level(TileBuffers &b, const LevelCells &io
         }
         const bool row_in_tile = r >= tile.r0 && r < tile.r1;
         unsigned row_hot = 0;
-        // The west faces of the first chunk.
-        V ty_here = Isotropic ? slopes_along_y(row) : zero;
-        M x_carries;
-        V x_west = faces_along_x(row, Isotropic ? slopes_along_y(row - 1) : zero, ty_here, valid_lanes(n + 1),
-                                 x_carries);
-        unsigned west_bits = V::bits(x_carries);
-        for (int j = 0; j < chunks; ++j) {
+        // Software-pipelined: iteration j updates chunk j from faces found in
+        // the iterations before (its y faces in j - 1, its x faces in j - 2
+        // and j - 1) while it finds the y faces of chunk j + 1 and the x faces
+        // of chunk j + 2, so that no update waits on the long chains of the
+        // flux law (dpsm-bench throughput: about 5 % faster than finding a
+        // chunk's faces in the iteration that updates it).
+        auto y_faces_of = [&](int j, unsigned &bits) {
             const int c = row + j * w, k = j * w;
-            const M valid = valid_lanes(n - k);
-            // The y faces towards the next row.
             V tx_next = zero;
             if constexpr (Isotropic) {
                 tx_next = slopes_along_x(c + W);
                 tx_next.store(tx_hi + k);
             }
-            M y_carries;
-            const V f_north = faces_along_y(c, V::load(tx_lo + k), tx_next, valid, y_carries);
-            f_north.store(fy_above + k);
-            const unsigned north_bits = V::bits(y_carries);
-            carries_above[j] = north_bits;
-            // The west faces of the next chunk, whose first lane is this chunk's last east face.
-            V x_next = zero, ty_next = zero;
-            unsigned next_bits = 0;
-            if (j + 1 < chunks || last_chunk_full) {
-                if constexpr (Isotropic) ty_next = slopes_along_y(c + w);
-                x_next = faces_along_x(c + w, V::shift_west(ty_here, ty_next), ty_next, valid_lanes(n + 1 - k - w),
-                                       x_carries);
-                next_bits = V::bits(x_carries);
-            }
-            const V f_west = x_west, f_east = V::shift_east(x_west, x_next);
-            const unsigned east_bits = (west_bits >> 1) | (next_bits << (w - 1));
+            M carries;
+            const V f = faces_along_y(c, V::load(tx_lo + k), tx_next, valid_lanes(n - k), carries);
+            f.store(fy_above + k);
+            bits = V::bits(carries);
+            carries_above[j] = bits;
+            return f;
+        };
+        // The x faces west of chunk j's cells, given the transverse slopes of
+        // the cells before them and of the chunk itself.
+        auto x_faces_of = [&](int j, V ty_west, V ty_here, unsigned &bits) {
+            M carries;
+            const V f = faces_along_x(row + j * w, ty_west, ty_here, valid_lanes(n + 1 - j * w), carries);
+            bits = V::bits(carries);
+            return f;
+        };
+        // The x faces are needed up to the east face of the last cell: a chunk
+        // further when the last chunk is full.
+        const int x_chunks = chunks + (n % w == 0 ? 1 : 0);
+        unsigned north_bits_next = 0, x0_bits = 0, x1_bits = 0;
+        V f_north_next = y_faces_of(0, north_bits_next);
+        V ty_last = Isotropic ? slopes_along_y(row) : zero;  // of the last chunk whose x faces are found
+        V x0 = x_faces_of(0, Isotropic ? slopes_along_y(row - 1) : zero, ty_last, x0_bits), x1 = zero;
+        auto next_x_faces = [&](int j, V &faces, unsigned &bits) {
+            const V ty = Isotropic ? slopes_along_y(row + j * w) : zero;
+            faces = x_faces_of(j, V::shift_west(ty_last, ty), ty, bits);
+            ty_last = ty;
+        };
+        if (x_chunks > 1) next_x_faces(1, x1, x1_bits);
+        for (int j = 0; j < chunks; ++j) {
+            const int c = row + j * w, k = j * w;
+            const M valid = valid_lanes(n - k);
+            const V f_north = f_north_next, f_west = x0, f_east = V::shift_east(x0, x1);
+            const unsigned north_bits = north_bits_next, west_bits = x0_bits;
+            const unsigned east_bits = (x0_bits >> 1) | (x1_bits << (w - 1));
+            // The faces of the chunks ahead.
+            if (j + 1 < chunks) f_north_next = y_faces_of(j + 1, north_bits_next);
+            x0 = x1;
+            x0_bits = x1_bits;
+            x1 = zero;
+            x1_bits = 0;
+            if (j + 2 < x_chunks) next_x_faces(j + 2, x1, x1_bits);
             const V f_south = V::load(fy_below + k);
 
             // The update: h + increment as a TwoSum, carrying what rounding drops.
@@ -273,9 +293,6 @@ DPSM_KERNEL_FLATTEN void advance_tile_level(TileBuffers &b, const LevelCells &io
                     select(counted, (east - west) + (north - south), zero).store(outflow_row + k);
                 }
             }
-            x_west = x_next;
-            west_bits = next_bits;
-            ty_here = ty_next;
         }
         if (row_hot) {
             moved_r0 = std::min(moved_r0, r);
