@@ -1,9 +1,10 @@
 #!/usr/bin/env bash
 # Regenerates the figures behind docs/performance.md: builds dpsm-bench, runs
-# the speed benchmarks (throughput, sparse, idle, cone, steps) into
-# docs/data/speed_*.csv and plots the throughput into docs/figures/.
+# the speed benchmarks (throughput, sparse, idle, cone, steps, and the tile
+# kernel alone) into docs/data/speed_*.csv and plots the throughput into
+# docs/figures/.
 #
-#   bash bench/run_speed.sh        # about 8 minutes on 2 cores (the steps study takes 4-5), on a quiet machine
+#   bash bench/run_speed.sh        # about 3 minutes on 2 cores (the steps study takes 1-2), on a quiet machine
 #
 # BUILD_DIR (default build-bench) is the build tree; PYTHON (default
 # /usr/bin/python3) runs the plot, which needs python3-matplotlib.
@@ -17,7 +18,7 @@ figures=$root/docs/figures
 
 cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=Release -DDPSM_BUILD_BENCH=ON \
       -DDPSM_BUILD_TESTS=OFF -DDPSM_BUILD_DOCS=OFF -DDPSM_BUILD_EXAMPLES=OFF >/dev/null
-cmake --build "$build" --target dpsm-bench
+cmake --build "$build" --target dpsm-bench dpsm-bench-kernel
 bench=$build/bench/dpsm-bench
 mkdir -p "$data" "$figures"
 
@@ -36,6 +37,9 @@ for what in throughput sparse idle cone steps; do
   cat "$data/speed_$what.csv"
 done
 "$bench" cone 1e-3 | tail -n +2 >> "$data/speed_cone.csv"
+echo ">> dpsm-bench-kernel"
+"$build/bench/dpsm-bench-kernel" > "$data/speed_kernel.csv"
+cat "$data/speed_kernel.csv"
 echo "load average after: $(cut -d' ' -f1-3 /proc/loadavg)" >> "$data/speed_provenance.txt"
 "$python" "$root/bench/plot_speed.py" "$data/speed_throughput.csv" "$figures/speed_throughput.png"
 "$python" "$root/bench/fill_performance.py" "$data" "$root/docs/performance.md"
