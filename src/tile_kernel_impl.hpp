@@ -4,13 +4,14 @@
 //
 // One pass over the rows of the region does everything for a row: the
 // transverse slopes of the next row, the faces towards it, the faces along
-// the row and the row's update. The x faces run one chunk of lanes ahead of
-// the update, so a cell's east face is its neighbour chunk's west face moved
+// the row and the row's update. The faces run ahead of the update (the y
+// faces one chunk of lanes, the x faces two), so that no update waits on the
+// flux law, and a cell's east face is its neighbour chunk's west face moved
 // by one lane (a register shuffle, no store and reload); the y faces towards
-// the next row wait in a row of scratch for that row. Faces are computed once,
-// already scaled to heights per sub-step (nu dt / dx), so the update adds four
-// numbers. What the level did (motion, the cells touching moving faces) is
-// kept as lane bits in integer registers, off the vector units.
+// the next row wait in a row of scratch for that row. Faces are computed
+// once, already scaled to heights per sub-step (nu dt / d), so the update
+// adds four numbers. What the level did (motion, the cells touching moving
+// faces) is kept as lane bits in integer registers, off the vector units.
 //
 // Loads read whole vectors, also past the region's last column (the buffer
 // has room); those lanes are computed and thrown away: they carry no flux,
