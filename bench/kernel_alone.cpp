@@ -77,7 +77,7 @@ int main(int argc, char **argv) {
     for (const Variant &v : variants) {
         double checksum = 0.0;
         const double seconds = run(dpsm::select_tile_kernel(v.masked, v.isotropic, v.source), visits, rounds, &checksum);
-        std::printf("%d,%s,%.1f,%.3f,%.15e\n", dpsm::tile_kernels_use_avx512() ? 8 : 1, v.name, cells / seconds / 1e6,
+        std::printf("%d,%s,%.1f,%.3f,%.15e\n", dpsm::tile_kernel_lanes(), v.name, cells / seconds / 1e6,
                     seconds / cells * 1e9, checksum);
         std::fflush(stdout);
     }

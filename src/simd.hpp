@@ -1,23 +1,25 @@
-// The two lane types the tile kernel is written for: Lanes1 (one double, any
-// CPU) and Lanes8 (eight doubles in an AVX-512 register). The kernel is one
-// template over them, so both compute every face by the same formula; a run
-// uses one of them throughout, which keeps its results independent of how the
-// grid is cut into tiles and shared among threads.
+// The lane types the tile kernel is written for: Lanes1 (one double, any
+// CPU), Lanes4 (four doubles in an AVX2 register) and Lanes8 (eight doubles
+// in an AVX-512 register). The kernel is one template over them, so all
+// compute every face by the same formula; a run uses one of them throughout,
+// which keeps its results independent of how the grid is cut into tiles and
+// shared among threads.
 //
-// They differ in arithmetic in two places. rsqrt: Lanes1 divides by sqrt,
-// Lanes8 refines the hardware's 14-bit estimate by a series to the third
-// order (within 1.4e-16 relative), which avoids the divider, the bottleneck of
-// this kernel. fma: fused in Lanes8, two roundings in Lanes1 (which runs
-// where the CPU may have no fused multiply-add).
-// rsqrt_fast is for a factor that multiplies a result rather than cancels in a
-// difference: Lanes8 takes one Newton step, within 6e-9 relative and above
-// the exact value by rounding at most.
+// They differ in arithmetic in two places. rsqrt: Lanes1 and Lanes4 divide
+// by sqrt; Lanes8 refines the hardware's 14-bit estimate by a series to the
+// third order (within 1.4e-16 relative), which avoids the divider, the
+// bottleneck of this kernel. rsqrt_fast is for a factor that multiplies a
+// result rather than cancels in a difference: Lanes8 takes one Newton step,
+// within 6e-9 relative and above the exact value by rounding at most. fma:
+// fused in Lanes4 and Lanes8, two roundings in Lanes1 (which runs where the
+// CPU may have no fused multiply-add).
 #pragma once
 
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 
-#if defined(__AVX512F__)
+#if defined(__AVX512F__) || defined(__AVX2__)
 #include <immintrin.h>
 #endif
 
@@ -137,6 +139,78 @@ struct Lanes8 {
         _mm512_store_pd(x, a.v);
         double m = x[0];
         for (int i = 1; i < 8; ++i) m = x[i] > m ? x[i] : m;
+        return m;
+    }
+};
+#endif
+
+#if defined(__AVX2__) && defined(__FMA__)
+// Four doubles in an AVX2 register, for CPUs without AVX-512. AVX2 has no
+// mask registers: a mask is a vector of all-ones or all-zero lanes. It has
+// no reciprocal square root estimate in double: rsqrt divides by sqrt, as
+// Lanes1 does (one rounding more than Lanes1's `1 / sqrt`, none fewer).
+struct Lanes4 {
+    static constexpr int width = 4;
+    struct Mask {
+        __m256d m;
+    };
+    __m256d v;
+
+    static Lanes4 broadcast(double x) { return {_mm256_set1_pd(x)}; }
+    static Lanes4 load(const double *p) { return {_mm256_loadu_pd(p)}; }
+    static Lanes4 load(const float *p) { return {_mm256_cvtps_pd(_mm_loadu_ps(p))}; }
+    void store(double *p) const { _mm256_storeu_pd(p, v); }
+    void store_where(double *p, Mask m) const { _mm256_maskstore_pd(p, _mm256_castpd_si256(m.m), v); }
+    void store_where(float *p, Mask m) const {
+        // The lanes' masks, 64 bits each, narrowed to 32 as the floats are.
+        const __m256i low_halves = _mm256_permutevar8x32_epi32(_mm256_castpd_si256(m.m), _mm256_setr_epi32(0, 2, 4, 6, 0, 0, 0, 0));
+        _mm_maskstore_ps(p, _mm256_castsi256_si128(low_halves), _mm256_cvtpd_ps(v));
+    }
+    static Mask first_lanes(int n) {
+        return {_mm256_cmp_pd(_mm256_setr_pd(0.0, 1.0, 2.0, 3.0), _mm256_set1_pd(static_cast<double>(n)), _CMP_LT_OQ)};
+    }
+    static Mask kind_is(const std::uint8_t *p, std::uint8_t k) {
+        std::int32_t four;
+        std::memcpy(&four, p, sizeof four);
+        const __m256i kinds = _mm256_cvtepu8_epi64(_mm_cvtsi32_si128(four));
+        return {_mm256_castsi256_pd(_mm256_cmpeq_epi64(kinds, _mm256_set1_epi64x(k)))};
+    }
+
+    friend Lanes4 operator+(Lanes4 a, Lanes4 b) { return {_mm256_add_pd(a.v, b.v)}; }
+    friend Lanes4 operator-(Lanes4 a, Lanes4 b) { return {_mm256_sub_pd(a.v, b.v)}; }
+    friend Lanes4 operator*(Lanes4 a, Lanes4 b) { return {_mm256_mul_pd(a.v, b.v)}; }
+    friend Mask operator>(Lanes4 a, Lanes4 b) { return {_mm256_cmp_pd(a.v, b.v, _CMP_GT_OQ)}; }
+    friend Mask operator!=(Lanes4 a, Lanes4 b) { return {_mm256_cmp_pd(a.v, b.v, _CMP_NEQ_UQ)}; }
+    friend Lanes4 select(Mask m, Lanes4 a, Lanes4 b) { return {_mm256_blendv_pd(b.v, a.v, m.m)}; }
+    friend Lanes4 fma(Lanes4 a, Lanes4 b, Lanes4 c) { return {_mm256_fmadd_pd(a.v, b.v, c.v)}; }
+    friend Lanes4 fnma(Lanes4 a, Lanes4 b, Lanes4 c) { return {_mm256_fnmadd_pd(a.v, b.v, c.v)}; }
+    friend Lanes4 mul_where(Mask m, Lanes4 a, Lanes4 b) { return {_mm256_and_pd(m.m, _mm256_mul_pd(a.v, b.v))}; }
+    friend Lanes4 max_where(Mask m, Lanes4 a, Lanes4 b) {
+        return {_mm256_blendv_pd(a.v, _mm256_max_pd(a.v, b.v), m.m)};
+    }
+    // [prev3, cur0, cur1, cur2] and [cur1, cur2, cur3, next0].
+    static Lanes4 shift_west(Lanes4 prev, Lanes4 cur) {
+        return {_mm256_shuffle_pd(_mm256_permute2f128_pd(prev.v, cur.v, 0x21), cur.v, 0x5)};
+    }
+    static Lanes4 shift_east(Lanes4 cur, Lanes4 next) {
+        return {_mm256_shuffle_pd(cur.v, _mm256_permute2f128_pd(cur.v, next.v, 0x21), 0x5)};
+    }
+    friend Lanes4 rsqrt(Lanes4 a) { return {_mm256_div_pd(_mm256_set1_pd(1.0), _mm256_sqrt_pd(a.v))}; }
+    friend Lanes4 rsqrt_fast(Lanes4 a) { return rsqrt(a); }
+    static Mask both(Mask a, Mask b) { return {_mm256_and_pd(a.m, b.m)}; }
+    static Mask either(Mask a, Mask b) { return {_mm256_or_pd(a.m, b.m)}; }
+    static Mask but_not(Mask a, Mask b) { return {_mm256_andnot_pd(b.m, a.m)}; }
+    static unsigned bits(Mask m) { return static_cast<unsigned>(_mm256_movemask_pd(m.m)); }
+    static Mask from_bits(unsigned b) {
+        const __m256i lane_bits = _mm256_setr_epi64x(1, 2, 4, 8);
+        const __m256i set = _mm256_and_si256(_mm256_set1_epi64x(static_cast<long long>(b)), lane_bits);
+        return {_mm256_castsi256_pd(_mm256_cmpeq_epi64(set, lane_bits))};
+    }
+    static double hmax(Lanes4 a) {
+        alignas(32) double x[4];
+        _mm256_store_pd(x, a.v);
+        double m = x[0];
+        for (int i = 1; i < 4; ++i) m = x[i] > m ? x[i] : m;
         return m;
     }
 };

@@ -105,7 +105,10 @@ using TileKernel = void (*)(TileBuffers &buffers, const LevelCells &cells, const
 // or the buffer, writing them to the grid or the buffer (masked kernels: the
 // buffer only). The widest lanes this CPU has.
 TileKernel select_tile_kernel(bool masked, bool isotropic, bool source, bool grid_in = false, bool grid_out = false);
-// Whether the kernels chosen run in AVX-512 (this CPU has it, DPSM_NO_AVX512 is not set).
+// The lanes of the kernels chosen: 8 (AVX-512), 4 (AVX2 and FMA) or 1, the
+// widest this CPU has that DPSM_NO_AVX512=1 or DPSM_NO_AVX2=1 does not rule out.
+int tile_kernel_lanes();
+// Whether the kernels chosen run in AVX-512.
 bool tile_kernels_use_avx512();
 
 // The kernel of a grid that uses a bed, an angle field, a flux exponent or

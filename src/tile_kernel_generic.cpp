@@ -8,6 +8,9 @@ namespace dpsm {
 #if defined(DPSM_HAVE_AVX512_KERNEL)
 TileKernel tile_kernel_avx512(bool masked, bool isotropic, bool source, bool grid_in, bool grid_out);
 #endif
+#if defined(DPSM_HAVE_AVX2_KERNEL)
+TileKernel tile_kernel_avx2(bool masked, bool isotropic, bool source, bool grid_in, bool grid_out);
+#endif
 
 void TileBuffers::resize(int w, int h_) {
     width = w;
@@ -24,23 +27,33 @@ void TileBuffers::resize(int w, int h_) {
     chunk_bits.assign(static_cast<std::size_t>(4) * (w + 1), 0u);
 }
 
-static bool use_avx512() {
-#if defined(DPSM_HAVE_AVX512_KERNEL)
-    // DPSM_NO_AVX512=1 forces the generic kernel (to compare the two).
-    const char *off = std::getenv("DPSM_NO_AVX512");
-    if (off && *off && *off != '0') return false;
-    __builtin_cpu_init();
-    return __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512bw") &&
-           __builtin_cpu_supports("avx512vl") && __builtin_cpu_supports("avx512dq");
-#else
-    return false;
-#endif
+// DPSM_NO_AVX512=1 and DPSM_NO_AVX2=1 rule those kernels out, so that one
+// machine can run (and the tests compare) every kernel it has.
+[[maybe_unused]] static bool ruled_out(const char *variable) {
+    const char *value = std::getenv(variable);
+    return value && *value && *value != '0';
 }
 
-bool tile_kernels_use_avx512() {
-    static const bool avx512 = use_avx512();
-    return avx512;
+static int widest_lanes() {
+#if defined(DPSM_HAVE_AVX512_KERNEL)
+    __builtin_cpu_init();
+    if (!ruled_out("DPSM_NO_AVX512") && __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512bw") &&
+        __builtin_cpu_supports("avx512vl") && __builtin_cpu_supports("avx512dq"))
+        return 8;
+#endif
+#if defined(DPSM_HAVE_AVX2_KERNEL)
+    __builtin_cpu_init();
+    if (!ruled_out("DPSM_NO_AVX2") && __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma")) return 4;
+#endif
+    return 1;
 }
+
+int tile_kernel_lanes() {
+    static const int lanes = widest_lanes();
+    return lanes;
+}
+
+bool tile_kernels_use_avx512() { return tile_kernel_lanes() == 8; }
 
 LevelCells buffer_level_cells(TileBuffers &b, int in) {
     LevelCells cells;
@@ -56,12 +69,15 @@ LevelCells buffer_level_cells(TileBuffers &b, int in) {
 }
 
 TileKernel select_tile_kernel(bool masked, bool isotropic, bool source, bool grid_in, bool grid_out) {
-    const bool avx512 = tile_kernels_use_avx512();
+    switch (tile_kernel_lanes()) {
 #if defined(DPSM_HAVE_AVX512_KERNEL)
-    if (avx512) return tile_kernel_avx512(masked, isotropic, source, grid_in, grid_out);
+        case 8: return tile_kernel_avx512(masked, isotropic, source, grid_in, grid_out);
 #endif
-    (void)avx512;
-    return tile_kernel_for<simd::Lanes1>(masked, isotropic, source, grid_in, grid_out);
+#if defined(DPSM_HAVE_AVX2_KERNEL)
+        case 4: return tile_kernel_avx2(masked, isotropic, source, grid_in, grid_out);
+#endif
+        default: return tile_kernel_for<simd::Lanes1>(masked, isotropic, source, grid_in, grid_out);
+    }
 }
 
 }  // namespace dpsm
