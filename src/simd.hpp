@@ -39,6 +39,14 @@ inline void prefetch(const T *p, int count) {
 #endif
 }
 
+// The largest of a vector's lanes, stored.
+template <int N>
+inline double largest_of(const double (&x)[N]) {
+    double m = x[0];
+    for (int i = 1; i < N; ++i) m = x[i] > m ? x[i] : m;
+    return m;
+}
+
 struct Lanes1 {
     static constexpr int width = 1;
     using Mask = bool;
@@ -137,9 +145,7 @@ struct Lanes8 {
     static double hmax(Lanes8 a) {
         alignas(64) double x[8];
         _mm512_store_pd(x, a.v);
-        double m = x[0];
-        for (int i = 1; i < 8; ++i) m = x[i] > m ? x[i] : m;
-        return m;
+        return largest_of(x);
     }
 };
 #endif
@@ -209,9 +215,7 @@ struct Lanes4 {
     static double hmax(Lanes4 a) {
         alignas(32) double x[4];
         _mm256_store_pd(x, a.v);
-        double m = x[0];
-        for (int i = 1; i < 4; ++i) m = x[i] > m ? x[i] : m;
-        return m;
+        return largest_of(x);
     }
 };
 #endif

@@ -379,7 +379,8 @@ std::int64_t tiled_sweep(Grid &grid, int levels, double dt, std::vector<LevelSum
                                  (gj0 + b.height < geo.ny || gi0 + b.width + kVectorSlack <= geo.nx);
         // The physics kernel reads cell kinds on every tile.
         if (!in_in_place || source)
-            gather(grid, b, gi0, gj0, !in_in_place, masked || physics, source, active.sources_near(t), residuals);
+            gather(grid, b, gi0, gj0, !in_in_place, masked || physics, source,
+                   source ? active.sources_near(t) : CellBox{}, residuals);
         if (halo_store && !inside) gather_halo(grid, *halo_store, b, gi0, gj0, masked || physics, source);
         if (physics) gather_physics(grid, halo_store, b, gi0, gj0);
         if (!every_cell) {
