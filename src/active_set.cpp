@@ -10,6 +10,13 @@ namespace dpsm {
 namespace {
 // How far a sweep reads beyond its tile: its levels plus one ring of ghosts.
 constexpr std::int64_t kReach = ActiveSet::kMaxLevels + 1;
+
+// DPSM_VISIT_ALL_TILES=1 turns the active set off, for tests that show it
+// changes no result.
+bool visit_all_tiles() {
+    const char *all = std::getenv("DPSM_VISIT_ALL_TILES");
+    return all && *all && *all != '0';
+}
 }  // namespace
 
 template <class Visit>
@@ -135,10 +142,7 @@ void ActiveSet::tiles_to_visit(int levels, std::vector<std::int64_t> &tiles, std
     tiles.clear();
     boxes.clear();
     seeds.clear();
-    // DPSM_VISIT_ALL_TILES=1 turns the active set off, for tests that show it
-    // changes no result.
-    const char *all = std::getenv("DPSM_VISIT_ALL_TILES");
-    const bool visit_all = all && *all && *all != '0';
+    const bool visit_all = visit_all_tiles();
     for (std::int64_t tj = 0; tj < tiles_y_; ++tj)
         for (std::int64_t ti = 0; ti < tiles_x_; ++ti) {
             const std::int64_t t = ti + tiles_x_ * tj;
@@ -176,6 +180,20 @@ void ActiveSet::tiles_to_visit(int levels, std::vector<std::int64_t> &tiles, std
             boxes.push_back(reached);
             seeds.push_back(seed);
         }
+}
+
+CellBox ActiveSet::first_level_bounds() const {
+    CellBox grid;
+    grid.add(0, nx_, 0, ny_);
+    if (visit_all_tiles()) return grid;
+    // At one level a sweep reaches no farther than the boxes themselves.
+    CellBox bounds;
+    for (std::int64_t t = 0; t < tiles(); ++t) {
+        bounds.add(hot_[t].grown_within(0, grid));
+        bounds.add(source_[t].grown_within(1, grid));
+        if (!remote_.empty()) bounds.add(remote_[t].grown_within(0, grid));
+    }
+    return bounds;
 }
 
 }  // namespace dpsm

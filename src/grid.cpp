@@ -62,6 +62,17 @@ double Grid::sand_mass(const double *values) const {
 
 double Grid::total_mass() const { return sand_mass(heights_.data()); }
 
+double Grid::sand_mass_change(const double *from, const double *to, const CellBox &within) const {
+    CompensatedSum change;
+    const std::int64_t nx = geometry_.nx;
+    const std::int64_t i0 = std::max<std::int64_t>(within.i0, 0), i1 = std::min(within.i1, nx);
+    const std::int64_t j0 = std::max<std::int64_t>(within.j0, 0), j1 = std::min(within.j1, geometry_.ny);
+    for (std::int64_t j = j0; j < j1; ++j)
+        for (std::int64_t c = i0 + nx * j; c < i1 + nx * j; ++c)
+            if (kinds_[c] == kSand && to[c] != from[c]) change.add((to[c] - from[c]) * geometry_.cell_area(c));
+    return change.value();
+}
+
 void Grid::write_heights(const Block &block, const double *values, bool add) {
     // Book the difference cell by cell so that a host that changes a few cells
     // of a large pile gets the change exactly, not a difference of two large sums.
@@ -85,7 +96,7 @@ void Grid::write_heights(const Block &block, const double *values, bool add) {
     }
 }
 
-void Grid::set_heights_between_sweeps(const std::vector<double> &y, const CellBox &within) {
+void Grid::set_heights_between_sweeps(const double *y, const CellBox &within) {
     const std::int64_t nx = geometry_.nx, ny = geometry_.ny, side = ActiveSet::kTile;
     const std::int64_t wi0 = std::max<std::int64_t>(within.i0, 0), wi1 = std::min(within.i1, nx);
     const std::int64_t wj0 = std::max<std::int64_t>(within.j0, 0), wj1 = std::min(within.j1, ny);
@@ -97,7 +108,7 @@ void Grid::set_heights_between_sweeps(const std::vector<double> &y, const CellBo
             const std::int64_t j_begin = std::max(tj, wj0), j_end = std::min(tj + side, wj1);
             std::int64_t i0 = nx, i1 = -1, j0 = ny, j1 = -1;
             for (std::int64_t j = j_begin; j < j_end; ++j) {
-                const double *row_y = y.data() + nx * j;
+                const double *row_y = y + nx * j;
                 double *row_h = heights_.data() + nx * j;
                 float *row_r = residuals_.data() + nx * j;
                 auto differs = [&](std::int64_t i) { return row_h[i] != row_y[i] || row_r[i] != 0.0f; };
@@ -125,13 +136,13 @@ void Grid::set_heights_between_sweeps(const std::vector<double> &y, const CellBo
         }
 }
 
-void Grid::copy_heights_between_sweeps(const std::vector<double> &y, const CellBox &within) {
+void Grid::copy_heights_between_sweeps(const double *y, const CellBox &within) {
     const std::int64_t nx = geometry_.nx, ny = geometry_.ny, side = ActiveSet::kTile;
     const std::int64_t wi0 = std::max<std::int64_t>(within.i0, 0), wi1 = std::min(within.i1, nx);
     const std::int64_t wj0 = std::max<std::int64_t>(within.j0, 0), wj1 = std::min(within.j1, ny);
     if (wi0 >= wi1 || wj0 >= wj1) return;
     for (std::int64_t j = wj0; j < wj1; ++j)
-        std::copy(y.data() + nx * j + wi0, y.data() + nx * j + wi1, heights_.data() + nx * j + wi0);
+        std::copy(y + nx * j + wi0, y + nx * j + wi1, heights_.data() + nx * j + wi0);
     // Per tile, as the host's edits are.
     for (std::int64_t tj = wj0 - wj0 % side; tj < wj1; tj += side)
         for (std::int64_t ti = wi0 - wi0 % side; ti < wi1; ti += side) {
@@ -140,6 +151,11 @@ void Grid::copy_heights_between_sweeps(const std::vector<double> &y, const CellB
             if (active_) active_->mark_block(box.i0, box.j0, box.i1 - box.i0, box.j1 - box.j0);
             if (tiled_ && active_) tiled_workspace_changed(*tiled_, *active_, box);
         }
+}
+
+void Grid::drop_residuals() {
+    set_heights_between_sweeps(heights_.data(), residual_bounds_);
+    residual_bounds_ = CellBox{};
 }
 
 void Grid::read_heights(const Block &block, double *values) const {
@@ -186,6 +202,8 @@ void Grid::restore(GridState &&s) {
     side_open_ = s.side_open;
     heights_ = std::move(s.heights);
     residuals_ = std::move(s.residuals);
+    residual_bounds_ = CellBox{};
+    residual_bounds_.add(0, geometry_.nx, 0, geometry_.ny);
     kinds_ = std::move(s.kinds);
     source_ = std::move(s.source);
     bed_ = std::move(s.bed);

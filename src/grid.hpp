@@ -159,6 +159,12 @@ public:
     // source does not leak mass one half-ulp at a time.
     const std::vector<float> &residuals() const { return residuals_; }
     std::vector<float> &residuals_for_stepping() { return residuals_; }
+    // A sweep or step may have left residuals that are not 0 within the box.
+    void residuals_written(const CellBox &box) { residual_bounds_.add(box); }
+    // Every residual becomes 0, waking the cells whose residual was not (the
+    // relaxation to rest has no use for them); costs what the residuals that
+    // steps left behind cover, not the grid.
+    void drop_residuals();
     void swap_heights(std::vector<double> &heights, std::vector<float> &residuals) {
         heights_.swap(heights);
         residuals_.swap(residuals);
@@ -192,16 +198,20 @@ public:
     // height becomes y's and every residual 0, where y may differ from the
     // heights only within the box. Only the cells that change are looked at
     // again, as after a host's edit, but nothing is booked.
-    void set_heights_between_sweeps(const std::vector<double> &y, const CellBox &within);
+    void set_heights_between_sweeps(const double *y, const CellBox &within);
     // The same where every residual is 0 already: copies the box without a
     // look at which cells differ, and wakes all of it.
-    void copy_heights_between_sweeps(const std::vector<double> &y, const CellBox &within);
+    void copy_heights_between_sweeps(const double *y, const CellBox &within);
     void set_source(const double *q);                 // NULL: none
 
     // Mass on sand cells now, a compensated sum.
     double total_mass() const;
     // Mass of values (heights or source rates) on sand cells: sum v * area.
     double sand_mass(const double *values) const;
+    // The mass of `to` less that of `from` on the sand cells of a box, summed
+    // cell by cell, so that a change to a few cells of a large pile comes out
+    // exactly rather than as the difference of two large sums.
+    double sand_mass_change(const double *from, const double *to, const CellBox &within) const;
     MassLedger &ledger() { return ledger_; }
     const MassLedger &ledger() const { return ledger_; }
 
@@ -242,6 +252,7 @@ private:
 
     std::vector<double> heights_;
     std::vector<float> residuals_;
+    CellBox residual_bounds_;  // outside it every residual is 0
     std::vector<std::uint8_t> kinds_;
     std::vector<double> source_;
     std::vector<double> bed_;

@@ -187,6 +187,9 @@ void apply_rates(Grid &grid, double dt) {
     const std::vector<double> &rate = grid.rate_workspace();
     std::vector<double> &h = grid.heights_for_stepping();
     std::vector<float> &residual = grid.residuals_for_stepping();
+    CellBox all;
+    all.add(0, grid.geometry().nx, 0, grid.geometry().ny);
+    grid.residuals_written(all);
     const std::vector<std::uint8_t> &kind = grid.kinds();
     const std::vector<double> &q = grid.source();
     const std::vector<double> &zb = grid.bed();

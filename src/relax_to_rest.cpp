@@ -22,6 +22,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <memory>
+#include <utility>
 #include <vector>
 
 #include "dpsm/dpsm.h"
@@ -159,38 +161,53 @@ const CellLoops &cell_loops() {
     return plain;
 }
 
-// Evaluates the slide fluxes at heights y by one explicit sub-step of dt
-// from y: afterwards next() holds S(y), and S(y) - y is dt times the rates.
-// Returns the sub-step's summary (moved, largest excess slope).
+// The states of the relaxation (the RKC stages, momentum's points) and the
+// rates at a step's start, each an array over the whole grid of which only a
+// box is ever touched: a pile in one corner of a large grid costs its own
+// cells, in time and in pages of memory. Within the box `filled` every state
+// holds its value and every rate 0 until the relaxation computes one;
+// outside it nothing is defined and nothing is read.
 //
-// It keeps the box of cells that any sweep so far has changed: outside it
-// the grid holds the heights the relaxation started from, with no residuals,
-// and so must every state the caller makes (and its changes must be 0), which
-// lets every loop run over the box alone.
+// Evaluates the slide fluxes at heights y (one of the states) by one
+// explicit sub-step of dt from y: afterwards next() holds S(y), and S(y) - y
+// is dt times the rates. It keeps the box `live` of the cells that any sweep
+// so far has changed: outside it the grid holds the heights the relaxation
+// started from, and so must every state the caller makes (and its rates
+// must be 0), which lets every loop run over the live box alone.
 class Evaluator {
 public:
+    static constexpr int kStates = 4;
+
     Evaluator(Grid &grid, double dt) : grid_(grid), dt_(dt), nx_(grid.geometry().nx) {
-        // Residuals become 0 everywhere once, so that they hold outside the box.
-        CellBox all;
-        all.add(0, grid.geometry().nx, 0, grid.geometry().ny);
-        grid.set_heights_between_sweeps(grid.heights(), all);
+        const std::size_t cells = grid.heights().size();
+        // Not value-initialised: a page is touched only where the box grows.
+        for (auto &state : states_) state.reset(new double[cells]);
+        start_.reset(new double[cells]);
+        rates_.reset(new double[cells]);
+        grid.drop_residuals();  // the sweeps without residuals need them 0
     }
 
-    LevelSummary evaluate(const std::vector<double> &y) {
+    double *state(int k) { return states_[k].get(); }
+    double *rates() { return rates_.get(); }
+    const double *start() const { return start_.get(); }
+
+    LevelSummary evaluate(const double *y) {
         // The active set then computes only the cells that y moved or that
         // touch a moving face, as in any sub-step.
-        grid_.copy_heights_between_sweeps(y, live_);  // no residuals here
-        tiled_sweep(grid_, 1, dt_, levels_, /*find_excess=*/true, /*residuals=*/false);  // all 0 here
-        // The cells the sweep changed join the box (it writes whole tiles
-        // where little or nothing moves); those already in it need no look.
-        const double *next = grid_.heights().data(), *from = y.data();
-        const float *residual = grid_.residuals().data();
-        const CellBox &written = grid_.tiled_workspace().last_written;
+        grid_.copy_heights_between_sweeps(y, live_);
+        // Where the sweep may change cells, the states must hold the start:
+        // outside the live box, the grid holds it now.
+        fill(grid_.active_set().first_level_bounds());
+        visited_ += static_cast<double>(tiled_sweep(grid_, 1, dt_, levels_, /*find_excess=*/true,
+                                                    /*residuals=*/false));
+        // The cells the sweep changed join the live box (it writes whole
+        // tiles where little or nothing moves); those already in it need no look.
+        const double *next = grid_.heights().data();
+        const CellBox written = grid_.tiled_workspace().last_written.grown_within(0, filled_);
         const CellBox before = live_;
         for (std::int64_t j = written.j0; j < written.j1; ++j) {
-            const double *next_row = next + nx_ * j, *from_row = from + nx_ * j;
-            const float *residual_row = residual + nx_ * j;
-            auto changed = [&](std::int64_t i) { return next_row[i] != from_row[i] || residual_row[i] != 0.0f; };
+            const double *next_row = next + nx_ * j, *from_row = y + nx_ * j;
+            auto changed = [&](std::int64_t i) { return next_row[i] != from_row[i]; };
             // Where the row crosses the box, the cells left to look at lie on its two sides.
             const bool crosses = j >= before.j0 && j < before.j1;
             const std::int64_t left_end = crosses ? std::max(written.i0, before.i0) : written.i1;
@@ -208,29 +225,63 @@ public:
     // S(y) of the last evaluation, until the next one.
     const double *next() const { return grid_.heights().data(); }
 
-    // Calls f(first, end) for the cells of each row of the box.
+    // Calls f(first, end) for the cells of each row of the live box.
     template <class F>
     void for_rows(F &&f) const {
         for_rows(live_, f);
     }
-    // The grid's heights become y's.
-    void finish(const std::vector<double> &y) { grid_.set_heights_between_sweeps(y, live_); }
+    // The grid's heights become y's; returns the mass that left (the start's
+    // less y's, on the live box: elsewhere nothing changed).
+    double finish(const double *y) {
+        grid_.set_heights_between_sweeps(y, live_);
+        return grid_.sand_mass_change(y, start(), live_);
+    }
     std::int64_t evaluations() const { return evaluations_; }
+    double cells_visited() const { return visited_; }
 
 private:
     template <class F>
-    void for_rows(const CellBox &box, F &&f) const {
+    static void for_rows(const CellBox &box, std::int64_t nx, F &&f) {
         if (box.empty()) return;
         for (std::int64_t j = box.j0; j < box.j1; ++j)
-            f(static_cast<std::size_t>(box.i0 + nx_ * j), static_cast<std::size_t>(box.i1 + nx_ * j));
+            f(static_cast<std::size_t>(box.i0 + nx * j), static_cast<std::size_t>(box.i1 + nx * j));
+    }
+    template <class F>
+    void for_rows(const CellBox &box, F &&f) const {
+        for_rows(box, nx_, f);
+    }
+    // Widens `filled` to take in the box, with the grid's heights (the start
+    // there) in every state and 0 in the rates.
+    void fill(const CellBox &box) {
+        CellBox wider = filled_;
+        wider.add(box);
+        if (wider == filled_) return;
+        const double *h = grid_.heights().data();
+        auto fill_cells = [&](std::size_t c0, std::size_t c1) {
+            for (auto &state : states_) std::copy(h + c0, h + c1, state.get() + c0);
+            std::copy(h + c0, h + c1, start_.get() + c0);
+            std::fill(rates_.get() + c0, rates_.get() + c1, 0.0);
+        };
+        for (std::int64_t j = wider.j0; j < wider.j1; ++j) {
+            const std::size_t row = static_cast<std::size_t>(nx_ * j);
+            if (filled_.empty() || j < filled_.j0 || j >= filled_.j1) {
+                fill_cells(row + wider.i0, row + wider.i1);
+            } else {
+                fill_cells(row + wider.i0, row + filled_.i0);
+                fill_cells(row + filled_.i1, row + wider.i1);
+            }
+        }
+        filled_ = wider;
     }
 
     Grid &grid_;
     double dt_;
     std::int64_t nx_;
-    CellBox live_;
+    std::unique_ptr<double[]> states_[kStates], start_, rates_;
+    CellBox filled_, live_;
     std::vector<LevelSummary> levels_;
     std::int64_t evaluations_ = 0;
+    double visited_ = 0.0;
 };
 
 void require_supported(const Grid &grid) {
@@ -258,15 +309,22 @@ void require_supported(const Grid &grid) {
 void relax_to_rest(Grid &grid) {
     require_supported(grid);
     prepare_tiled_sweep(grid, grid.threads());  // allocates before anything changes
-    const std::size_t cells = grid.heights().size();
+    StepInfo info;
+    info.at_rest = true;
+    info.time_integrated = 0.0;
+    // At rest already: no tile can move, and no evaluation is needed to know it.
+    if (!grid.active_set().may_move()) {
+        grid.last_step() = info;
+        return;
+    }
     // All the memory first: an allocation that fails leaves the grid as it was.
-    // Outside the evaluator's box, states hold the start and changes are 0.
-    std::vector<double> y0 = grid.heights(), yjm1 = y0, yjm2 = y0, yj = y0, f0(cells);
-    const double mass_before = grid.total_mass();
     Evaluator rates(grid, stable_dt(grid));
+    // The states change roles by swapping these pointers; the evaluator only
+    // needs to know which arrays they are, not which is which.
+    double *y0 = rates.state(0), *yjm1 = rates.state(1), *yjm2 = rates.state(2), *yj = rates.state(3);
+    double *f0 = rates.rates();
     const double switch_excess = kSwitchExcessShare * std::tan(grid.min_repose_angle());
     const std::int64_t budget = grid.max_substeps();
-    StepInfo info;
     const CellLoops &loops = cell_loops();
 
     // The flow's path by RKC steps, while much sand moves.
@@ -307,25 +365,23 @@ void relax_to_rest(Grid &grid) {
             const double gamt = -(1.0 - rkc.b[j - 1] * rkc.T[j - 1]) * mut;
             const StageWeights weights{mu, nu, mut * tau, gamt * tau};
             rates.for_rows([&](std::size_t c0, std::size_t c1) {
-                loops.rkc_stage(c0, c1, y0.data(), yjm1.data(), yjm2.data(), next, f0.data(), weights, yj.data());
+                loops.rkc_stage(c0, c1, y0, yjm1, yjm2, next, f0, weights, yj);
             });
-            yjm2.swap(yjm1);
-            yjm1.swap(yj);
+            std::swap(yjm2, yjm1);
+            std::swap(yjm1, yj);
         }
-        y0.swap(yjm1);
+        std::swap(y0, yjm1);
     }
 
     // Momentum for the tail, where little sand is left to move.
-    std::vector<double> &x = y0, &x_prev = yjm1, &y = yjm2;
-    const auto copy = [&](std::vector<double> &to, const std::vector<double> &from) {
-        rates.for_rows([&](std::size_t c0, std::size_t c1) { std::copy(&from[c0], &from[c0] + (c1 - c0), &to[c0]); });
+    double *&x = y0, *&x_prev = yjm1, *&y = yjm2;
+    const auto copy = [&](double *to, const double *from) {
+        rates.for_rows([&](std::size_t c0, std::size_t c1) { std::copy(from + c0, from + c1, to + c0); });
     };
     copy(x_prev, x);
     for (std::int64_t k = 0; switched && !rested && rates.evaluations() < budget;) {
         const double beta = static_cast<double>(k) / static_cast<double>(k + 3);
-        rates.for_rows([&](std::size_t c0, std::size_t c1) {
-            loops.extrapolate(c0, c1, x.data(), x_prev.data(), beta, y.data());
-        });
+        rates.for_rows([&](std::size_t c0, std::size_t c1) { loops.extrapolate(c0, c1, x, x_prev, beta, y); });
         const LevelSummary at = rates.evaluate(y);
         const double *next = rates.next();
         last_excess = at.max_excess;
@@ -337,10 +393,8 @@ void relax_to_rest(Grid &grid) {
             continue;
         }
         MomentumStep step;
-        rates.for_rows([&](std::size_t c0, std::size_t c1) {
-            loops.momentum(c0, c1, next, y.data(), x.data(), x_prev.data(), step);
-        });
-        x.swap(x_prev);  // x_prev: the x before this step
+        rates.for_rows([&](std::size_t c0, std::size_t c1) { loops.momentum(c0, c1, next, y, x, x_prev, step); });
+        std::swap(x, x_prev);  // x_prev: the x before this step
         const auto total = [](const double *parts) { return (parts[0] + parts[1]) + (parts[2] + parts[3]); };
         if (total(step.along) < 0.0 || total(step.coasting) > kCoastingShare * total(step.motion)) {
             copy(x_prev, x);
@@ -351,13 +405,11 @@ void relax_to_rest(Grid &grid) {
     }
 
     // The state reached becomes the grid's (at rest, it already is).
-    rates.finish(x);
-    grid.ledger().outflow.add(mass_before - grid.total_mass());
+    grid.ledger().outflow.add(rates.finish(x));
     info.substeps = rates.evaluations();
     info.at_rest = rested;
-    info.time_integrated = 0.0;
     info.max_excess_slope = rested ? 0.0 : last_excess;
-    info.cell_updates = static_cast<double>(rates.evaluations()) * static_cast<double>(cells);
+    info.cell_updates = rates.cells_visited();
     grid.last_step() = info;
 }
 

@@ -501,6 +501,7 @@ std::int64_t tiled_sweep(Grid &grid, int levels, double dt, std::vector<LevelSum
         ws.last_written.add(ws.boxes[k]);
         ws.stale_tiles.push_back(ws.visit[k]);
     }
+    if (residuals) grid.residuals_written(ws.last_written);
 
     // New hot boxes: the cells touching moving faces in any level, grown by the
     // one cell a last move can make steep. Sums in tile order, whatever the threads.

@@ -253,6 +253,59 @@ static void test_after_time_accurate_steps(void **state) {
     free(a);
 }
 
+/* A pile in the corner of a large grid costs its own cells: it relaxes bit
+ * for bit as on a grid just large enough for it, visiting the same cells
+ * (DPSM_INFO_CELL_UPDATES counts those, not the grid's), and once it rests a
+ * step takes no evaluation at all. */
+static void test_pile_in_a_large_grid_costs_its_cells(void **state) {
+    (void)state;
+    enum { SMALL = 192, LARGE = 1024 };
+    dpsm_grid *g[2];
+    double *corner[2], updates[2], evaluations[2];
+    const int64_t n[2] = {SMALL, LARGE};
+    for (int k = 0; k < 2; ++k) {
+        CHECK_OK(NULL, dpsm_create_2d(n[k], n[k], 1.0, 1.0, &g[k]));
+        CHECK_OK(g[k], dpsm_set_repose_angle(g[k], 33.0 * kPi / 180.0));
+        CHECK_OK(g[k], dpsm_set_relaxation(g[k], DPSM_RELAX_TO_REST));
+        CHECK_OK(g[k], dpsm_step(g[k], 1.0)); /* flat: looks at every tile once */
+        enum { M = 61 };
+        double *pile = malloc(sizeof(double) * M * M);
+        for (int j = 0; j < M; ++j)
+            for (int i = 0; i < M; ++i) pile[i + M * j] = fmax(0.0, 30.0 - 1.5 * hypot(i - M / 2, j - M / 2));
+        CHECK_OK(g[k], dpsm_add_heights_region(g[k], 10, 10, M, M, pile));
+        free(pile);
+        CHECK_OK(g[k], dpsm_step(g[k], 1.0));
+        REQUIRE(step_info_of(g[k], DPSM_INFO_AT_REST) == 1.0, "%lld^2: the pile did not rest", (long long)n[k]);
+        REQUIRE(ledger_residual(g[k]) <= 1e-13, "%lld^2: ledger residual %g", (long long)n[k], ledger_residual(g[k]));
+        updates[k] = step_info_of(g[k], DPSM_INFO_CELL_UPDATES);
+        evaluations[k] = step_info_of(g[k], DPSM_INFO_SUBSTEPS);
+        corner[k] = malloc(sizeof(double) * SMALL * SMALL);
+        CHECK_OK(g[k], dpsm_get_heights_region(g[k], 0, 0, SMALL, SMALL, corner[k]));
+    }
+    REQUIRE(memcmp(corner[0], corner[1], sizeof(double) * SMALL * SMALL) == 0,
+            "the pile rests differently in a larger grid");
+    REQUIRE(evaluations[0] == evaluations[1] && evaluations[0] > 10.0, "evaluations %g and %g", evaluations[0],
+            evaluations[1]);
+    REQUIRE(updates[0] == updates[1] && updates[1] <= evaluations[1] * 9.0 * 64.0 * 64.0,
+            "cells visited: %g on %d^2, %g on %d^2 in %g evaluations", updates[0], SMALL, updates[1], LARGE,
+            evaluations[1]);
+    /* Nothing left out of the corner: the rest of the large grid is as flat as it was. */
+    double *rest_of_it = malloc(sizeof(double) * LARGE * (LARGE - SMALL));
+    CHECK_OK(g[1], dpsm_get_heights_region(g[1], 0, SMALL, LARGE, LARGE - SMALL, rest_of_it));
+    for (int64_t c = 0; c < (int64_t)LARGE * (LARGE - SMALL); ++c)
+        REQUIRE(rest_of_it[c] == 0.0, "sand at cell %lld beyond the corner", (long long)c);
+    free(rest_of_it);
+    CHECK_OK(g[1], dpsm_step(g[1], 1.0));
+    REQUIRE(step_info_of(g[1], DPSM_INFO_AT_REST) == 1.0 && step_info_of(g[1], DPSM_INFO_SUBSTEPS) == 0.0 &&
+                step_info_of(g[1], DPSM_INFO_CELL_UPDATES) == 0.0,
+            "at rest, a step took %g evaluations over %g cells", step_info_of(g[1], DPSM_INFO_SUBSTEPS),
+            step_info_of(g[1], DPSM_INFO_CELL_UPDATES));
+    for (int k = 0; k < 2; ++k) {
+        dpsm_destroy(g[k]);
+        free(corner[k]);
+    }
+}
+
 /* A restart file keeps the setting, and the loaded grid continues bit for bit. */
 static void test_restart_keeps_it(void **state) {
     (void)state;
@@ -356,6 +409,7 @@ int main(void) {
         cmocka_unit_test(test_independent_of_threads),
         cmocka_unit_test(test_limit_and_switching_back),
         cmocka_unit_test(test_after_time_accurate_steps),
+        cmocka_unit_test(test_pile_in_a_large_grid_costs_its_cells),
         cmocka_unit_test(test_restart_keeps_it),
         cmocka_unit_test(test_unsupported_scenes_refused),
     };

@@ -295,6 +295,11 @@ DPSM_API int dpsm_set_scheme(dpsm_grid *g, int scheme);
  * ::DPSM_INFO_TIME_INTEGRATED is 0, and ::DPSM_INFO_AT_REST is 1 unless the
  * sub-step limit (dpsm_set_max_substeps()) ran out first.
  *
+ * Like the time-accurate steps it costs what the scene needs: each evaluation
+ * visits only the tiles near moving sand (::DPSM_INFO_CELL_UPDATES counts
+ * their cells), its work arrays are touched only where sand moved, and a step
+ * on a surface at rest takes no evaluation at all.
+ *
  * In this version it relaxes 2D grids with the isotropic scheme, walls, open
  * sides and open cells at one level. dpsm_step() refuses it
  * (::DPSM_ERR_NOT_APPLICABLE, the grid unchanged) on 1D, axisymmetric and
