@@ -111,6 +111,7 @@ static void collapse_2d(const column *c, int n, int scheme, double *seconds, dou
     const double t0 = now_seconds();
     dpsm_grid *g = NULL;
     CHECK(NULL, dpsm_create_2d(n, n, dx, dx, &g));
+    CHECK(g, dpsm_set_relaxation(g, DPSM_RELAX_TIME_ACCURATE)); /* the model's own path, against the exact deposit */
     CHECK(g, dpsm_set_threads(g, g_threads));
     CHECK(g, dpsm_set_repose_angle(g, c->theta));
     CHECK(g, dpsm_set_scheme(g, scheme));

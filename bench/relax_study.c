@@ -805,6 +805,7 @@ int cmd_steps(int argc, char **argv) {
             const double tol = tolerances[t];
             dpsm_grid *g = NULL;
             CHECK(NULL, dpsm_create_2d(n, n, sc.dx, sc.dx, &g));
+            CHECK(g, dpsm_set_relaxation(g, DPSM_RELAX_TIME_ACCURATE));
             CHECK(g, dpsm_set_repose_angle(g, sc.theta));
             CHECK(g, dpsm_set_rest_tolerance(g, tol));
             for (int side = DPSM_XMIN; side <= DPSM_YMAX; ++side) CHECK(g, dpsm_set_boundary(g, side, DPSM_OPEN));

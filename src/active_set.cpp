@@ -143,9 +143,23 @@ void ActiveSet::tiles_to_visit(int levels, std::vector<std::int64_t> &tiles, std
     boxes.clear();
     seeds.clear();
     const bool visit_all = visit_all_tiles();
+    // Only the tiles next to one with activity can be reached: mark those
+    // first, so that a grid mostly at rest costs a byte per tile, not the
+    // look at nine neighbours' boxes.
+    near_activity_.assign(hot_.size(), visit_all ? 1 : 0);
+    for (std::int64_t tj = 0; tj < tiles_y_ && !visit_all; ++tj)
+        for (std::int64_t ti = 0; ti < tiles_x_; ++ti) {
+            const std::int64_t t = ti + tiles_x_ * tj;
+            if (!remote_.empty() && !remote_[t].empty()) near_activity_[t] = 1;
+            if (hot_[t].empty() && source_[t].empty()) continue;
+            for (std::int64_t uj = std::max<std::int64_t>(0, tj - 1); uj <= std::min(tiles_y_ - 1, tj + 1); ++uj)
+                for (std::int64_t ui = std::max<std::int64_t>(0, ti - 1); ui <= std::min(tiles_x_ - 1, ti + 1); ++ui)
+                    near_activity_[ui + tiles_x_ * uj] = 1;
+        }
     for (std::int64_t tj = 0; tj < tiles_y_; ++tj)
         for (std::int64_t ti = 0; ti < tiles_x_; ++ti) {
             const std::int64_t t = ti + tiles_x_ * tj;
+            if (!near_activity_[t]) continue;
             const CellBox cells = tile_cells(t);
             // Seeds farther than the sweep's reach from the tile do not matter to it.
             const CellBox near = cells.grown(2 * reach);
@@ -180,20 +194,6 @@ void ActiveSet::tiles_to_visit(int levels, std::vector<std::int64_t> &tiles, std
             boxes.push_back(reached);
             seeds.push_back(seed);
         }
-}
-
-CellBox ActiveSet::first_level_bounds() const {
-    CellBox grid;
-    grid.add(0, nx_, 0, ny_);
-    if (visit_all_tiles()) return grid;
-    // At one level a sweep reaches no farther than the boxes themselves.
-    CellBox bounds;
-    for (std::int64_t t = 0; t < tiles(); ++t) {
-        bounds.add(hot_[t].grown_within(0, grid));
-        bounds.add(source_[t].grown_within(1, grid));
-        if (!remote_.empty()) bounds.add(remote_[t].grown_within(0, grid));
-    }
-    return bounds;
 }
 
 }  // namespace dpsm

@@ -75,9 +75,6 @@ public:
     // its seeds: in sub-step s only cells within s - 1 of them can change.
     void tiles_to_visit(int levels, std::vector<std::int64_t> &tiles, std::vector<CellBox> &boxes,
                         std::vector<CellBox> &seeds) const;
-    // The box of every cell that a sweep's first sub-step may change: the
-    // union of the boxes tiles_to_visit(1, ...) gives, found without a list.
-    CellBox first_level_bounds() const;
 
     CellBox &hot(std::int64_t t) { return hot_[t]; }
     // The box of this grid's cells with a source in tile t and the tiles
@@ -108,6 +105,7 @@ private:
     std::vector<std::uint8_t> has_source_; // a source within a tile's reach
     std::vector<CellBox> remote_;             // per tile: remote boxes that may reach it (empty: serial)
     std::vector<std::uint8_t> remote_source_; // per tile: a remote source within reach (empty: serial)
+    mutable std::vector<std::uint8_t> near_activity_;  // tiles_to_visit's scratch: next to a tile with activity
 };
 
 }  // namespace dpsm

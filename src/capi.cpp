@@ -270,10 +270,11 @@ int dpsm_set_relaxation(dpsm_grid *g, int relaxation) {
     const char *fn = "dpsm_set_relaxation";
     return guarded(g, fn, [&] {
         require_grid(g, fn);
-        if (relaxation != DPSM_RELAX_TIME_ACCURATE && relaxation != DPSM_RELAX_TO_REST)
+        if (relaxation != DPSM_RELAX_TIME_ACCURATE && relaxation != DPSM_RELAX_TO_REST &&
+            relaxation != DPSM_RELAX_AUTO)
             fail(DPSM_ERR_UNKNOWN_ENUM, fn, "relaxation = ", relaxation,
-                 " is not DPSM_RELAX_TIME_ACCURATE or DPSM_RELAX_TO_REST");
-        g->core.set_relax_to_rest(relaxation == DPSM_RELAX_TO_REST);
+                 " is not DPSM_RELAX_TIME_ACCURATE, DPSM_RELAX_TO_REST or DPSM_RELAX_AUTO");
+        g->core.set_relaxation(static_cast<dpsm::Relaxation>(relaxation));
     });
 }
 

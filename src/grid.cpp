@@ -6,6 +6,7 @@
 
 #include "decomposition.hpp"
 #include "dpsm/dpsm.h"
+#include "relax_to_rest.hpp"
 #include "tiled_sweep.hpp"
 
 namespace dpsm {
@@ -45,6 +46,23 @@ double Grid::global_sum(double local) const { return decomposition_ ? decomposit
 TiledWorkspace &Grid::tiled_workspace() {
     if (!tiled_) tiled_ = std::make_unique<TiledWorkspace>();
     return *tiled_;
+}
+
+RelaxWorkspace &Grid::relax_workspace() {
+    if (!relax_) {
+        auto ws = std::make_unique<RelaxWorkspace>();
+        const std::size_t cells = heights_.size(), tiles = static_cast<std::size_t>(active_->tiles());
+        // Not value-initialised: a page is touched only where a step needs it.
+        for (auto &state : ws->states) state.reset(new double[cells]);
+        ws->start.reset(new double[cells]);
+        ws->rates.reset(new double[cells]);
+        ws->filled.resize(tiles);
+        ws->live.resize(tiles);
+        ws->filled_tiles.reserve(tiles);
+        ws->live_tiles.reserve(tiles);
+        relax_ = std::move(ws);
+    }
+    return *relax_;
 }
 
 void Grid::set_repose_angle(double theta) {
@@ -198,7 +216,7 @@ void Grid::restore(GridState &&s) {
     max_substeps_ = s.max_substeps;
     threads_ = s.threads;
     scheme_ = s.scheme;
-    relax_to_rest_ = s.relax_to_rest;
+    relaxation_ = s.relaxation;
     side_open_ = s.side_open;
     heights_ = std::move(s.heights);
     residuals_ = std::move(s.residuals);

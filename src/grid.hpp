@@ -17,6 +17,8 @@ enum Side { kXMin = 0, kXMax = 1, kYMin = 2, kYMax = 3 };
 enum CellKind : std::uint8_t { kSand = 0, kWall = 1, kOpen = 2 };
 
 enum Scheme { kPairwise = 0, kIsotropic = 1 };
+// How dpsm_step moves the surface (the values of DPSM_RELAX_*).
+enum Relaxation { kTimeAccurate = 0, kToRest = 1, kAutoRelaxation = 2 };
 
 struct Geometry {
     int dim;             // 1 or 2
@@ -40,6 +42,7 @@ struct Geometry {
 
 // What the last step did, for dpsm_get_step_info.
 struct TiledWorkspace;
+struct RelaxWorkspace;
 class Decomposition;
 
 struct StepInfo {
@@ -66,7 +69,7 @@ struct GridState {
     double flux_exponent = 1.0;
     double static_angle = 0.0;          // 0: no hysteresis
     std::vector<std::uint8_t> moving;   // empty unless static_angle > 0
-    bool relax_to_rest = false;         // dpsm_set_relaxation(DPSM_RELAX_TO_REST)
+    Relaxation relaxation = kTimeAccurate;  // what a restart file without a word of it meant
     MassLedger ledger;
     StepInfo last_step;
 };
@@ -140,10 +143,10 @@ public:
         return !bed_.empty() || !tan_field_.empty() || flux_exponent_ != 1.0 || hysteresis();
     }
 
-    // How dpsm_step moves the surface: time-accurate sub-steps (false) or the
-    // fast relaxation to rest (relax_to_rest.hpp).
-    bool relax_to_rest() const { return relax_to_rest_; }
-    void set_relax_to_rest(bool on) { relax_to_rest_ = on; }
+    // How dpsm_step moves the surface: time-accurate sub-steps, the fast
+    // relaxation to rest (relax_to_rest.hpp), or the second where it applies.
+    Relaxation relaxation() const { return relaxation_; }
+    void set_relaxation(Relaxation relaxation) { relaxation_ = relaxation; }
 
     bool side_open(int side) const { return side_open_[side]; }
     void set_side_open(int side, bool open) {
@@ -220,6 +223,8 @@ public:
     // The 2D sweep's active set and scratch (2D grids only).
     ActiveSet &active_set() { return *active_; }
     TiledWorkspace &tiled_workspace();
+    // The relaxation to rest's arrays (2D grids only), allocated on first use.
+    RelaxWorkspace &relax_workspace();
 
     StepInfo &last_step() { return last_step_; }
     const StepInfo &last_step() const { return last_step_; }
@@ -265,8 +270,9 @@ private:
     std::vector<double> rate_;
     std::unique_ptr<ActiveSet> active_;
     std::unique_ptr<TiledWorkspace> tiled_;
+    std::unique_ptr<RelaxWorkspace> relax_;
     Scheme scheme_;
-    bool relax_to_rest_ = false;
+    Relaxation relaxation_ = kAutoRelaxation;
     int threads_ = 0;
     std::int64_t wall_cells_ = 0;
     std::int64_t open_cells_ = 0;

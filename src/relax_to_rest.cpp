@@ -22,12 +22,14 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <utility>
 #include <vector>
 
 #include "dpsm/dpsm.h"
 #include "error.hpp"
+#include "ledger.hpp"
 #include "stepper.hpp"
 #include "tile_kernel.hpp"
 #include "tiled_sweep.hpp"
@@ -39,6 +41,10 @@ constexpr int kMaxStages = 20;
 constexpr double kStageSafety = 0.9;
 constexpr double kSwitchExcessShare = 0.05;  // of tan(theta): where momentum takes over
 constexpr double kCoastingShare = 0.9;
+// A state may stray this far (relative to the heights) beyond the start's
+// extremes, and a closed scene's mass this far (relative to the mass): rounding.
+constexpr double kBoundsSlack = 4.0 * std::numeric_limits<double>::epsilon();
+constexpr double kMassSlack = 1e-14;
 
 // The coefficients of a second-order RKC step of s stages (Sommeijer,
 // Shampine and Verwer 1997).
@@ -162,151 +168,223 @@ const CellLoops &cell_loops() {
 }
 
 // The states of the relaxation (the RKC stages, momentum's points) and the
-// rates at a step's start, each an array over the whole grid of which only a
-// box is ever touched: a pile in one corner of a large grid costs its own
-// cells, in time and in pages of memory. Within the box `filled` every state
-// holds its value and every rate 0 until the relaxation computes one;
-// outside it nothing is defined and nothing is read.
+// rates at a step's start, each an array over the whole grid of which only
+// the tiles near moving sand are ever touched: piles here and there on a
+// large grid cost their own cells, in time and in pages of memory. Within a
+// tile's box `filled` every state holds its value and every rate 0 until the
+// relaxation computes one; outside it nothing is defined and nothing is read.
 //
 // Evaluates the slide fluxes at heights y (one of the states) by one
 // explicit sub-step of dt from y: afterwards next() holds S(y), and S(y) - y
-// is dt times the rates. It keeps the box `live` of the cells that any sweep
-// so far has changed: outside it the grid holds the heights the relaxation
-// started from, and so must every state the caller makes (and its rates
-// must be 0), which lets every loop run over the live box alone.
+// is dt times the rates. It keeps per tile the box `live` of the cells that
+// any sweep so far has changed: outside those boxes the grid holds the
+// heights the relaxation started from, and so must every state the caller
+// makes (and its rates must be 0), which lets every loop run over the live
+// boxes alone.
 class Evaluator {
 public:
-    static constexpr int kStates = 4;
-
-    Evaluator(Grid &grid, double dt) : grid_(grid), dt_(dt), nx_(grid.geometry().nx) {
-        const std::size_t cells = grid.heights().size();
-        // Not value-initialised: a page is touched only where the box grows.
-        for (auto &state : states_) state.reset(new double[cells]);
-        start_.reset(new double[cells]);
-        rates_.reset(new double[cells]);
+    Evaluator(Grid &grid, double dt)
+        : grid_(grid), dt_(dt), nx_(grid.geometry().nx), ws_(grid.relax_workspace()) {
         grid.drop_residuals();  // the sweeps without residuals need them 0
     }
+    // Every box empty again, for the next step.
+    ~Evaluator() {
+        for (const std::int64_t t : ws_.filled_tiles) ws_.filled[t] = ws_.live[t] = CellBox{};
+        ws_.filled_tiles.clear();
+        ws_.live_tiles.clear();
+    }
+    Evaluator(const Evaluator &) = delete;
+    Evaluator &operator=(const Evaluator &) = delete;
 
-    double *state(int k) { return states_[k].get(); }
-    double *rates() { return rates_.get(); }
-    const double *start() const { return start_.get(); }
+    double *state(int k) { return ws_.states[k].get(); }
+    double *rates() { return ws_.rates.get(); }
 
     LevelSummary evaluate(const double *y) {
         // The active set then computes only the cells that y moved or that
         // touch a moving face, as in any sub-step.
-        grid_.copy_heights_between_sweeps(y, live_);
-        // Where the sweep may change cells, the states must hold the start:
-        // outside the live box, the grid holds it now.
-        fill(grid_.active_set().first_level_bounds());
-        visited_ += static_cast<double>(tiled_sweep(grid_, 1, dt_, levels_, /*find_excess=*/true,
-                                                    /*residuals=*/false));
-        // The cells the sweep changed join the live box (it writes whole
-        // tiles where little or nothing moves); those already in it need no look.
-        const double *next = grid_.heights().data();
-        const CellBox written = grid_.tiled_workspace().last_written.grown_within(0, filled_);
-        const CellBox before = live_;
-        for (std::int64_t j = written.j0; j < written.j1; ++j) {
-            const double *next_row = next + nx_ * j, *from_row = y + nx_ * j;
-            auto changed = [&](std::int64_t i) { return next_row[i] != from_row[i]; };
-            // Where the row crosses the box, the cells left to look at lie on its two sides.
-            const bool crosses = j >= before.j0 && j < before.j1;
-            const std::int64_t left_end = crosses ? std::max(written.i0, before.i0) : written.i1;
-            const std::int64_t right_begin = crosses ? std::min(written.i1, before.i1) : written.i0;
-            std::int64_t first = written.i0;
-            while (first < left_end && !changed(first)) ++first;
-            std::int64_t last = written.i1 - 1;
-            while (last >= right_begin && !changed(last)) --last;
-            if (first < left_end) live_.add(first, first + 1, j, j + 1);
-            if (last >= right_begin) live_.add(last, last + 1, j, j + 1);
+        for (const std::int64_t t : ws_.live_tiles) grid_.copy_heights_between_sweeps(y, ws_.live[t]);
+        last_visited_ = static_cast<double>(tiled_sweep(grid_, 1, dt_, levels_, /*find_excess=*/true,
+                                                        /*residuals=*/false));
+        visited_ += last_visited_;
+        // The sweep leaves the heights from before it in its scratch
+        // (tiled_sweep.hpp): y in the live boxes, the start elsewhere.
+        const TiledWorkspace &ws = grid_.tiled_workspace();
+        const double *next = grid_.heights().data(), *before = ws.heights.data();
+        bool new_tiles = false;
+        for (std::size_t k = 0; k < ws.visit.size(); ++k) {
+            const std::int64_t t = ws.visit[k];
+            const CellBox &written = ws.boxes[k];
+            if (written.empty()) continue;
+            fill(t, written, before);
+            // The cells it changed join the tile's live box (it writes whole
+            // boxes where little or nothing moves); those already in it need no look.
+            CellBox &live = ws_.live[t];
+            const CellBox was = live;
+            for (std::int64_t j = written.j0; j < written.j1; ++j) {
+                const double *next_row = next + nx_ * j, *from_row = before + nx_ * j;
+                auto changed = [&](std::int64_t i) { return next_row[i] != from_row[i]; };
+                // Where the row crosses the box, the cells left to look at lie on its two sides.
+                const bool crosses = j >= was.j0 && j < was.j1;
+                const std::int64_t left_end = crosses ? std::max(written.i0, was.i0) : written.i1;
+                const std::int64_t right_begin = crosses ? std::min(written.i1, was.i1) : written.i0;
+                std::int64_t first = written.i0;
+                while (first < left_end && !changed(first)) ++first;
+                std::int64_t last = written.i1 - 1;
+                while (last >= right_begin && !changed(last)) --last;
+                if (first < left_end) live.add(first, first + 1, j, j + 1);
+                if (last >= right_begin) live.add(last, last + 1, j, j + 1);
+            }
+            if (was.empty() && !live.empty()) {
+                ws_.live_tiles.push_back(t);
+                new_tiles = true;
+            }
         }
+        // Tile order, whatever the order of visits: the sums over the boxes
+        // must not depend on it.
+        if (new_tiles) std::sort(ws_.live_tiles.begin(), ws_.live_tiles.end());
         ++evaluations_;
         return levels_.front();
     }
     // S(y) of the last evaluation, until the next one.
     const double *next() const { return grid_.heights().data(); }
 
-    // Calls f(first, end) for the cells of each row of the live box.
+    // Calls f(first, end) for the cells of each row of the live boxes, tile by tile.
     template <class F>
     void for_rows(F &&f) const {
-        for_rows(live_, f);
+        for (const std::int64_t t : ws_.live_tiles) {
+            const CellBox &box = ws_.live[t];
+            for (std::int64_t j = box.j0; j < box.j1; ++j)
+                f(static_cast<std::size_t>(box.i0 + nx_ * j), static_cast<std::size_t>(box.i1 + nx_ * j));
+        }
     }
-    // The grid's heights become y's; returns the mass that left (the start's
-    // less y's, on the live box: elsewhere nothing changed).
-    double finish(const double *y) {
-        grid_.set_heights_between_sweeps(y, live_);
-        return grid_.sand_mass_change(y, start(), live_);
+    // The mass of the start less y's: what left, and what rounding took (on
+    // the live boxes: elsewhere nothing changed).
+    double mass_left(const double *y) const {
+        CompensatedSum left;
+        for (const std::int64_t t : ws_.live_tiles) left.add(grid_.sand_mass_change(y, ws_.start.get(), ws_.live[t]));
+        return left.value();
     }
+    // Whether y's sand lies within the extremes of the start's (and of the
+    // levels that open sides and cells hold), as every sub-step of the
+    // time-accurate scheme keeps it: its new heights mix those of the cells
+    // around. Every cell a sweep has read is in a filled box.
+    bool within_start_extremes(const double *y) const {
+        const std::uint8_t *kind = grid_.kinds().data();
+        double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+        auto take = [&](double v) {
+            lo = std::min(lo, v);
+            hi = std::max(hi, v);
+        };
+        const double *start = ws_.start.get();
+        for (const std::int64_t t : ws_.filled_tiles)
+            for_cells(ws_.filled[t], [&](std::size_t c) {
+                if (kind[c] == kSand) take(start[c]);
+            });
+        if (grid_.has_open_cells()) {
+            take(grid_.open_level_min());
+            take(grid_.open_level_max());
+        }
+        if (grid_.side_open(kXMin) || grid_.side_open(kXMax) || grid_.side_open(kYMin) || grid_.side_open(kYMax))
+            take(0.0);
+        const double slack = kBoundsSlack * std::max(std::fabs(lo), std::fabs(hi));
+        bool within = true;
+        for (const std::int64_t t : ws_.live_tiles)
+            for_cells(ws_.live[t], [&](std::size_t c) {
+                within = within && (kind[c] != kSand || (y[c] >= lo - slack && y[c] <= hi + slack));
+            });
+        return within;
+    }
+    // The grid's heights become y's.
+    void finish(const double *y) {
+        for (const std::int64_t t : ws_.live_tiles) grid_.set_heights_between_sweeps(y, ws_.live[t]);
+    }
+    // The grid's heights become the start's again, and every cell a sweep
+    // read may move: the active set as it was, or wider.
+    void restore_start() {
+        finish(ws_.start.get());
+        for (const std::int64_t t : ws_.filled_tiles) {
+            const CellBox &box = ws_.filled[t];
+            grid_.active_set().mark_block(box.i0, box.j0, box.i1 - box.i0, box.j1 - box.j0);
+        }
+    }
+    const double *start() const { return ws_.start.get(); }
     std::int64_t evaluations() const { return evaluations_; }
     double cells_visited() const { return visited_; }
+    double cells_visited_last() const { return last_visited_; }
 
 private:
     template <class F>
-    static void for_rows(const CellBox &box, std::int64_t nx, F &&f) {
-        if (box.empty()) return;
+    void for_cells(const CellBox &box, F &&f) const {
         for (std::int64_t j = box.j0; j < box.j1; ++j)
-            f(static_cast<std::size_t>(box.i0 + nx * j), static_cast<std::size_t>(box.i1 + nx * j));
+            for (std::int64_t i = box.i0; i < box.i1; ++i) f(static_cast<std::size_t>(i + nx_ * j));
     }
-    template <class F>
-    void for_rows(const CellBox &box, F &&f) const {
-        for_rows(box, nx_, f);
-    }
-    // Widens `filled` to take in the box, with the grid's heights (the start
-    // there) in every state and 0 in the rates.
-    void fill(const CellBox &box) {
-        CellBox wider = filled_;
+    // Widens tile t's box `filled` to take in the box, with the heights from
+    // before the sweep (the start there) in every state and 0 in the rates.
+    void fill(std::int64_t t, const CellBox &box, const double *before) {
+        CellBox &filled = ws_.filled[t];
+        CellBox wider = filled;
         wider.add(box);
-        if (wider == filled_) return;
-        const double *h = grid_.heights().data();
+        if (wider == filled) return;
+        if (filled.empty()) ws_.filled_tiles.push_back(t);
         auto fill_cells = [&](std::size_t c0, std::size_t c1) {
-            for (auto &state : states_) std::copy(h + c0, h + c1, state.get() + c0);
-            std::copy(h + c0, h + c1, start_.get() + c0);
-            std::fill(rates_.get() + c0, rates_.get() + c1, 0.0);
+            for (auto &state : ws_.states) std::copy(before + c0, before + c1, state.get() + c0);
+            std::copy(before + c0, before + c1, ws_.start.get() + c0);
+            std::fill(ws_.rates.get() + c0, ws_.rates.get() + c1, 0.0);
         };
         for (std::int64_t j = wider.j0; j < wider.j1; ++j) {
             const std::size_t row = static_cast<std::size_t>(nx_ * j);
-            if (filled_.empty() || j < filled_.j0 || j >= filled_.j1) {
+            if (filled.empty() || j < filled.j0 || j >= filled.j1) {
                 fill_cells(row + wider.i0, row + wider.i1);
             } else {
-                fill_cells(row + wider.i0, row + filled_.i0);
-                fill_cells(row + filled_.i1, row + wider.i1);
+                fill_cells(row + wider.i0, row + filled.i0);
+                fill_cells(row + filled.i1, row + wider.i1);
             }
         }
-        filled_ = wider;
+        filled = wider;
     }
 
     Grid &grid_;
     double dt_;
     std::int64_t nx_;
-    std::unique_ptr<double[]> states_[kStates], start_, rates_;
-    CellBox filled_, live_;
+    RelaxWorkspace &ws_;
     std::vector<LevelSummary> levels_;
     std::int64_t evaluations_ = 0;
-    double visited_ = 0.0;
+    double visited_ = 0.0, last_visited_ = 0.0;
 };
 
-void require_supported(const Grid &grid) {
-    const char *fn = "dpsm_step";
-    const auto refuse = [&](const char *what) {
-        fail(DPSM_ERR_NOT_APPLICABLE, fn, "the relaxation DPSM_RELAX_TO_REST does not support ", what,
-             " in this version; use DPSM_RELAX_TIME_ACCURATE (dpsm_set_relaxation)");
-    };
-    if (grid.geometry().dim != 2) refuse("1D or axisymmetric grids");
-    if (grid.decomposition()) refuse("distributed grids");
-    if (grid.scheme() != kIsotropic) refuse("the pairwise scheme (dpsm_set_scheme)");
-    if (!grid.bed().empty()) refuse("a bed (dpsm_set_bedrock)");
+}  // namespace
+
+const char *relaxation_unsupported(const Grid &grid) {
+    if (grid.geometry().dim != 2) return "1D or axisymmetric grids";
+    if (grid.decomposition()) return "distributed grids";
+    if (grid.scheme() != kIsotropic) return "the pairwise scheme (dpsm_set_scheme)";
+    if (!grid.bed().empty()) return "a bed (dpsm_set_bedrock)";
     // Both were seen to need far more evaluations, or never to rest, in a
     // relaxation tuned on the plain law; they stay with the time-accurate steps.
-    if (!grid.angle_field().empty()) refuse("an angle field (dpsm_set_repose_angle_field)");
-    if (grid.flux_exponent() != 1.0) refuse("a flux exponent other than 1 (dpsm_set_flux_exponent)");
-    if (grid.hysteresis()) refuse("a static angle (dpsm_set_static_angle)");
-    if (grid.source_active()) refuse("an active source (dpsm_set_source); add the deposit with dpsm_add_heights_region");
-    if (grid.has_open_cells() && grid.open_level_min() != grid.open_level_max())
-        refuse("open cells held at different levels (sand would flow for ever)");
+    if (!grid.angle_field().empty()) return "an angle field (dpsm_set_repose_angle_field)";
+    if (grid.flux_exponent() != 1.0) return "a flux exponent other than 1 (dpsm_set_flux_exponent)";
+    if (grid.hysteresis()) return "a static angle (dpsm_set_static_angle)";
+    if (grid.source_active()) return "an active source (dpsm_set_source); add the deposit with dpsm_add_heights_region";
+    const bool side_open =
+        grid.side_open(kXMin) || grid.side_open(kXMax) || grid.side_open(kYMin) || grid.side_open(kYMax);
+    if (grid.has_open_cells() && (grid.open_level_min() != grid.open_level_max() ||
+                                  (side_open && grid.open_level_min() != 0.0)))
+        return "open cells held at different levels, or at another than the open sides' 0 (sand would flow for ever)";
+    return nullptr;
+}
+
+namespace {
+
+void require_supported(const Grid &grid) {
+    if (const char *what = relaxation_unsupported(grid))
+        fail(DPSM_ERR_NOT_APPLICABLE, "dpsm_step", "the relaxation DPSM_RELAX_TO_REST does not support ", what,
+             " in this version; use DPSM_RELAX_TIME_ACCURATE (dpsm_set_relaxation)");
 }
 
 }  // namespace
 
-void relax_to_rest(Grid &grid) {
+bool relax_to_rest(Grid &grid, double &cells_visited) {
+    cells_visited = 0.0;
     require_supported(grid);
     prepare_tiled_sweep(grid, grid.threads());  // allocates before anything changes
     StepInfo info;
@@ -315,7 +393,7 @@ void relax_to_rest(Grid &grid) {
     // At rest already: no tile can move, and no evaluation is needed to know it.
     if (!grid.active_set().may_move()) {
         grid.last_step() = info;
-        return;
+        return true;
     }
     // All the memory first: an allocation that fails leaves the grid as it was.
     Evaluator rates(grid, stable_dt(grid));
@@ -404,13 +482,37 @@ void relax_to_rest(Grid &grid) {
         }
     }
 
+    // Where sand can leave, what left is booked as outflow, with the rounding
+    // of the combined stages; where it cannot, that rounding is all the
+    // change and is not outflow.
+    const double left = rates.mass_left(x);
+    const bool sinks = grid.has_open_cells() || grid.side_open(kXMin) || grid.side_open(kXMax) ||
+                       grid.side_open(kYMin) || grid.side_open(kYMax);
+    cells_visited = rates.cells_visited();
+    // The stages and momentum are not monotone and their sums round: on rough
+    // scenes they can leave a hole below the lowest start height, or lose
+    // more mass to rounding than the time-accurate steps would. Then the
+    // step is not the model's: the grid goes back to its start, for the
+    // caller to step in time.
+    const MassLedger &ledger = grid.ledger();
+    const double mass = std::fabs(ledger.external.value() + ledger.sourced.value() - ledger.outflow.value() -
+                                  ledger.unmet.value());
+    if (!rates.within_start_extremes(x) || (!sinks && std::fabs(left) > kMassSlack * mass)) {
+        rates.restore_start();
+        return false;
+    }
     // The state reached becomes the grid's (at rest, it already is).
-    grid.ledger().outflow.add(rates.finish(x));
-    info.substeps = rates.evaluations();
+    rates.finish(x);
+    if (sinks) grid.ledger().outflow.add(left);
+    // The evaluation that found rest moved nothing and is not counted, as a
+    // time-accurate sub-step that finds rest is not: a step on a surface at
+    // rest reads 0, however it was found so.
+    info.substeps = rates.evaluations() - (rested ? 1 : 0);
     info.at_rest = rested;
     info.max_excess_slope = rested ? 0.0 : last_excess;
-    info.cell_updates = rates.cells_visited();
+    info.cell_updates = rates.cells_visited() - (rested ? rates.cells_visited_last() : 0.0);
     grid.last_step() = info;
+    return true;
 }
 
 }  // namespace dpsm

@@ -5,14 +5,36 @@
 // momentum finish the small tail (docs/performance.md, "Larger steps").
 #pragma once
 
+#include <cstdint>
+#include <memory>
+#include <vector>
+
 #include "grid.hpp"
 
 namespace dpsm {
 
+// The relaxation's arrays, kept by the grid between steps so that each step
+// touches only the pages of the tiles where sand moves, not fresh ones
+// (relax_to_rest.cpp). Outside a step every box is empty.
+struct RelaxWorkspace {
+    static constexpr int kStates = 4;
+    std::unique_ptr<double[]> states[kStates], start, rates;  // over the grid, not initialised
+    std::vector<CellBox> filled, live;                       // per tile of the active set
+    std::vector<std::int64_t> filled_tiles, live_tiles;      // the tiles whose box is not empty
+};
+
 // Relaxes the grid to rest (or until its sub-step limit of flux evaluations),
-// booking what leaves through open sides and cells as outflow. Throws
-// Error(DPSM_ERR_NOT_APPLICABLE) before changing anything for a scene this
-// relaxation does not support.
-void relax_to_rest(Grid &grid);
+// booking what leaves through open sides and cells as outflow, and returns
+// true. Returns false with the grid as it was (but for residuals, dropped)
+// where the state it reached is not one the model's own steps could reach:
+// new extremes, or a closed scene's mass off by more than rounding; the
+// caller then steps in time. cells_visited: the work done either way.
+// Throws Error(DPSM_ERR_NOT_APPLICABLE) before changing anything for a scene
+// this relaxation does not support.
+bool relax_to_rest(Grid &grid, double &cells_visited);
+
+// What of the grid's scene the relaxation does not support, as a phrase for
+// a message; null when it supports all of it.
+const char *relaxation_unsupported(const Grid &grid);
 
 }  // namespace dpsm

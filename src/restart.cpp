@@ -47,9 +47,14 @@ constexpr std::uint32_t kHasMoving = 1u << 3;
 constexpr std::uint32_t kIsBlock = 1u << 4;
 // Version 2: dpsm_step relaxes to rest (dpsm_set_relaxation); no data of its own.
 constexpr std::uint32_t kRelaxToRest = 1u << 5;
-constexpr std::uint32_t kKnownFlags = kHasSource | kHasBed | kHasAngleField | kHasMoving | kIsBlock | kRelaxToRest;
-// The flags a file of version 1 cannot hold.
+// Version 3: dpsm_step relaxes to rest where the scene allows it (DPSM_RELAX_AUTO,
+// the default since that version). Without either flag: time-accurate.
+constexpr std::uint32_t kRelaxAuto = 1u << 6;
+constexpr std::uint32_t kKnownFlags =
+    kHasSource | kHasBed | kHasAngleField | kHasMoving | kIsBlock | kRelaxToRest | kRelaxAuto;
+// The flags a file of version 1 cannot hold, and those version 2 cannot.
 constexpr std::uint32_t kVersion2Flags = kIsBlock | kRelaxToRest;
+constexpr std::uint32_t kVersion3Flags = kRelaxAuto;
 
 
 // ---- CRC-32 (ISO-HDLC, as zlib, PNG and gzip: reflected 0xEDB88320) -------
@@ -143,7 +148,8 @@ std::uint32_t flags_of(const Grid &g) {
     if (!g.bed().empty()) flags |= kHasBed;
     if (!g.angle_field().empty()) flags |= kHasAngleField;
     if (!g.moving().empty()) flags |= kHasMoving;
-    if (g.relax_to_rest()) flags |= kRelaxToRest;
+    if (g.relaxation() == kToRest) flags |= kRelaxToRest;
+    if (g.relaxation() == kAutoRelaxation) flags |= kRelaxAuto;
     return flags;
 }
 
@@ -151,7 +157,8 @@ void write_header(Writer &w, const Grid &g, const RestartBlock &block) {
     const Geometry &geo = g.geometry();
     for (const std::uint8_t b : kMagic) w.u8(b);
     // The oldest version that holds the grid, so that older libraries read what they can.
-    w.u32(((flags_of(g) | (block.present ? kIsBlock : 0u)) & kVersion2Flags) ? 2u : 1u);
+    const std::uint32_t flags = flags_of(g) | (block.present ? kIsBlock : 0u);
+    w.u32((flags & kVersion3Flags) ? 3u : (flags & kVersion2Flags) ? 2u : 1u);
     w.u32(static_cast<std::uint32_t>(geo.dim));
     w.u32(geo.axisymmetric ? 1u : 0u);
     w.i64(geo.nx);
@@ -375,6 +382,10 @@ void check_layout(const Header &h, const std::string &path, const char *fn) {
     if ((h.flags & kVersion2Flags) && h.version < 2)
         bad("the flags ", hex32(h.flags & kVersion2Flags), " are set in a file of version ", h.version,
             " (they need version 2)");
+    if ((h.flags & kVersion3Flags) && h.version < 3)
+        bad("the flags ", hex32(h.flags & kVersion3Flags), " are set in a file of version ", h.version,
+            " (they need version 3)");
+    if ((h.flags & kRelaxToRest) && (h.flags & kRelaxAuto)) bad("both relaxation flags are set");
     if ((h.flags & kRelaxToRest) && h.dim != 2) bad("a grid of dim = ", h.dim, " cannot relax to rest");
     if ((h.flags & kIsBlock) && h.dim != 2) bad("a block of a distributed grid must have dim = 2, not ", h.dim);
     const std::uint64_t cells = static_cast<std::uint64_t>(h.nx) * static_cast<std::uint64_t>(h.ny);
@@ -599,7 +610,9 @@ void load_restart(const char *path, Geometry &geometry, GridState &state, Restar
     check_values(header, state, n, source, fn);
     check_block(header, block, source, fn);
     state.scheme = header.scheme == kIsotropic ? kIsotropic : kPairwise;
-    state.relax_to_rest = (header.flags & kRelaxToRest) != 0;
+    state.relaxation = (header.flags & kRelaxToRest)  ? kToRest
+                       : (header.flags & kRelaxAuto) ? kAutoRelaxation
+                                                     : kTimeAccurate;
     state.last_step.at_rest = header.at_rest != 0;
     for (int side = 0; side < 4; ++side) state.side_open[side] = header.side_open[side] != 0;
     geometry = Geometry{static_cast<int>(header.dim), header.axisymmetric != 0, header.nx, header.ny, header.dx, header.dy};

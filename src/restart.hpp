@@ -12,9 +12,11 @@ namespace dpsm {
 
 // The newest format version this library reads. It writes the oldest that
 // holds the grid: version 1 for a grid of its own, version 2 (version 1 and a
-// block record) for one rank's block of a distributed grid, so that older
-// libraries still read every file they could hold.
-constexpr std::uint32_t kRestartVersion = 2;
+// block record) for one rank's block of a distributed grid or a grid set to
+// DPSM_RELAX_TO_REST, version 3 for a grid left at the default relaxation
+// (DPSM_RELAX_AUTO), so that older libraries still read every file they
+// could hold.
+constexpr std::uint32_t kRestartVersion = 3;
 
 // Where a block file's grid lies in its distributed grid (version 2): its
 // place, which of how many ranks saved it, and the mark that all the files

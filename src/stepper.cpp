@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <sstream>
 
 #include "closure.hpp"
@@ -61,19 +62,34 @@ StepAgreement agree_before_step(Grid &grid, double dt) {
 }  // namespace
 
 void step(Grid &grid, double dt) {
-    if (grid.relax_to_rest()) {
-        // Not on a distributed grid (relax_to_rest refuses it): its peers may
-        // be waiting in the step's first agreement, so take part, refusing.
-        if (Decomposition *decomposition = grid.decomposition()) {
-            try {
-                decomposition->agree_before_step(grid, 0.0, true);
-            } catch (const Error &) {
-                // every rank throws; this one reports its own reason below
-            }
-        }
-        relax_to_rest(grid);  // no time scale: dt only says that time passed
+    // The default relaxes to rest where it can; a distributed grid cannot, on
+    // every rank alike, so its ranks all take the time-accurate path.
+    const bool relax = grid.relaxation() == kToRest ||
+                       (grid.relaxation() == kAutoRelaxation && relaxation_unsupported(grid) == nullptr);
+    if (!relax) {
+        step_in_time(grid, dt);
         return;
     }
+    // Not on a distributed grid (relax_to_rest refuses it): its peers may
+    // be waiting in the step's first agreement, so take part, refusing.
+    if (Decomposition *decomposition = grid.decomposition()) {
+        try {
+            decomposition->agree_before_step(grid, 0.0, true);
+        } catch (const Error &) {
+            // every rank throws; this one reports its own reason below
+        }
+    }
+    // No time scale: dt only says that time passed.
+    double tried = 0.0;
+    if (relax_to_rest(grid, tried)) return;
+    // Where the relaxation could not reach a rest of the model's own, the
+    // time-accurate sub-steps do, from the same start, for as long as it takes
+    // (the scene comes to rest by itself: the relaxation refuses the others).
+    step_in_time(grid, std::numeric_limits<double>::max());
+    grid.last_step().cell_updates += tried;
+}
+
+void step_in_time(Grid &grid, double dt) {
     const StepAgreement state = agree_before_step(grid, dt);  // first: it may set the smallest angle
     const double dt_max = stable_dt(grid);
     const double needed = std::ceil(dt / dt_max);

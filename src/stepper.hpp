@@ -10,9 +10,13 @@ namespace dpsm {
 // (see dpsm_stable_dt in dpsm.h).
 double stable_dt(const Grid &grid);
 
-// Advances exactly dt (or until rest). Throws Error(DPSM_ERR_WORK_LIMIT)
-// before changing anything if a scene that can flow forever needs more
-// sub-steps than the grid's limit.
+// dpsm_step: relaxes to rest or advances in time, as the grid's relaxation
+// asks (grid.hpp).
 void step(Grid &grid, double dt);
+
+// Advances exactly dt (or until rest) by time-accurate sub-steps. Throws
+// Error(DPSM_ERR_WORK_LIMIT) before changing anything if a scene that can
+// flow forever needs more sub-steps than the grid's limit.
+void step_in_time(Grid &grid, double dt);
 
 }  // namespace dpsm

@@ -29,7 +29,10 @@ struct LevelSummary {
 // not copy its cells back, the scratch is kept equal to the grid except in
 // the stale boxes (per tile: the cells the last sweep wrote, and those the
 // host changed since), which the next sweep copies from the grid where it
-// does not write them itself.
+// does not write them itself. Until the next sweep, the scratch holds the
+// heights from before the last one everywhere, and `visit` and `boxes` the
+// tiles it visited and the cells it wrote in each (the relaxation to rest
+// reads both).
 struct TiledWorkspace {
     std::vector<double> heights;     // the grid's heights but in the stale boxes
     std::vector<float> residuals;

@@ -28,11 +28,15 @@ static void visit_all_tiles(int on) {
 }
 
 /* A scene that uses everything: a resting rough bed, three steep patches far
- * apart, a source patch, an obstacle, an open cell and two open sides. */
-static dpsm_grid *make_scene(int scheme, int threads) {
+ * apart, a source patch, an obstacle, an open cell and two open sides. With
+ * DPSM_RELAX_AUTO its steps are time-accurate while the source acts and relax
+ * to rest once it is off (isotropic scheme); with DPSM_RELAX_TIME_ACCURATE
+ * they are time-accurate throughout. */
+static dpsm_grid *make_scene(int scheme, int relaxation, int threads) {
     dpsm_grid *g = NULL;
     CHECK_OK(NULL, dpsm_create_2d(NX, NY, 0.5, 0.5, &g));
     CHECK_OK(g, dpsm_set_scheme(g, scheme));
+    CHECK_OK(g, dpsm_set_relaxation(g, relaxation));
     CHECK_OK(g, dpsm_set_threads(g, threads));
     CHECK_OK(g, dpsm_set_boundary(g, DPSM_XMIN, DPSM_OPEN));
     CHECK_OK(g, dpsm_set_boundary(g, DPSM_YMAX, DPSM_OPEN));
@@ -61,9 +65,10 @@ static dpsm_grid *make_scene(int scheme, int threads) {
 
 /* Runs the scene: steps, then the source off and a region edit, then rest.
  * Returns the heights (caller frees) and the ledger and the work done. */
-static double *run_scene(int scheme, int threads, int visit_all, ledger_t *ledger, double *updates) {
+static double *run_scene(int scheme, int relaxation, int threads, int visit_all, ledger_t *ledger,
+                         double *updates) {
     visit_all_tiles(visit_all);
-    dpsm_grid *g = make_scene(scheme, threads);
+    dpsm_grid *g = make_scene(scheme, relaxation, threads);
     double u, dt;
     *updates = 0.0;
     CHECK_OK(g, dpsm_stable_dt(g, &dt));
@@ -94,16 +99,20 @@ static void assert_same_run(const double *a, const double *b, size_t cells, cons
     assert_memory_equal(la, lb, sizeof *la);
 }
 
+static const int kRelaxations[2] = {DPSM_RELAX_TIME_ACCURATE, DPSM_RELAX_AUTO};
+
 static void test_active_set_changes_no_result(void **state) {
     (void)state;
+    for (int r = 0; r < 2; ++r)
     for (int scheme = DPSM_SCHEME_PAIRWISE; scheme <= DPSM_SCHEME_ISOTROPIC; ++scheme) {
         ledger_t skip, all;
         double work_skip, work_all;
-        double *a = run_scene(scheme, 1, 0, &skip, &work_skip);
-        double *b = run_scene(scheme, 1, 1, &all, &work_all);
-        print_message("%s: cell updates %.3g with the active set, %.3g visiting every tile (%.1f%%); outflow %.6f\n",
-                      scheme ? "isotropic" : "pairwise", work_skip, work_all, 100.0 * work_skip / work_all,
-                      skip.outflow);
+        double *a = run_scene(scheme, kRelaxations[r], 1, 0, &skip, &work_skip);
+        double *b = run_scene(scheme, kRelaxations[r], 1, 1, &all, &work_all);
+        print_message("%s, %s: cell updates %.3g with the active set, %.3g visiting every tile (%.1f%%); outflow "
+                      "%.6f\n",
+                      scheme ? "isotropic" : "pairwise", r ? "auto" : "time-accurate", work_skip, work_all,
+                      100.0 * work_skip / work_all, skip.outflow);
         assert_same_run(a, b, (size_t)NX * NY, &skip, &all);
         assert_true(work_skip < 0.5 * work_all); /* it did skip */
         assert_true(skip.outflow > 0.0);         /* the open side and cell took sand */
@@ -116,17 +125,19 @@ static void test_active_set_changes_no_result(void **state) {
  * the library to share it among threads. */
 static void test_results_do_not_depend_on_threads(void **state) {
     (void)state;
-    ledger_t l1, l2, l3;
-    double w1, w2, w3;
-    double *a = run_scene(DPSM_SCHEME_ISOTROPIC, 1, 1, &l1, &w1);
-    double *b = run_scene(DPSM_SCHEME_ISOTROPIC, 2, 1, &l2, &w2);
-    double *c = run_scene(DPSM_SCHEME_ISOTROPIC, 3, 1, &l3, &w3);
-    assert_same_run(a, b, (size_t)NX * NY, &l1, &l2);
-    assert_same_run(a, c, (size_t)NX * NY, &l1, &l3);
-    assert_true(w1 == w2 && w1 == w3);
-    free(a);
-    free(b);
-    free(c);
+    for (int r = 0; r < 2; ++r) {
+        ledger_t l1, l2, l3;
+        double w1, w2, w3;
+        double *a = run_scene(DPSM_SCHEME_ISOTROPIC, kRelaxations[r], 1, 1, &l1, &w1);
+        double *b = run_scene(DPSM_SCHEME_ISOTROPIC, kRelaxations[r], 2, 1, &l2, &w2);
+        double *c = run_scene(DPSM_SCHEME_ISOTROPIC, kRelaxations[r], 3, 1, &l3, &w3);
+        assert_same_run(a, b, (size_t)NX * NY, &l1, &l2);
+        assert_same_run(a, c, (size_t)NX * NY, &l1, &l3);
+        assert_true(w1 == w2 && w1 == w3);
+        free(a);
+        free(b);
+        free(c);
+    }
 }
 
 /* Where skipping is tightest: motion that starts at the corners and edges of
@@ -279,39 +290,45 @@ static void test_tiles_in_place_match_copied_tiles(void **state) {
 }
 
 /* A surface at rest costs no cell update, however large; a few cells changed
- * by the host wake only the tiles around them. */
+ * by the host wake only the tiles around them. Both with time-accurate steps
+ * and with the default, which relaxes this scene to rest. */
 static void test_idle_and_local_updates(void **state) {
     (void)state;
     const int64_t n = 1024;
-    dpsm_grid *g = NULL;
-    CHECK_OK(NULL, dpsm_create_2d(n, n, 1.0, 1.0, &g));
     double *h = malloc(sizeof(double) * n * n);
     for (int64_t c = 0; c < n * n; ++c) h[c] = 0.3 * sin(0.01 * (double)(c % n)) + 0.2 * cos(0.013 * (double)(c / n));
-    CHECK_OK(g, dpsm_set_heights(g, h));
-    double updates, substeps;
-    CHECK_OK(g, dpsm_step(g, 10.0)); /* looks at every tile once: all at rest */
-    CHECK_OK(g, dpsm_get_step_info(g, DPSM_INFO_SUBSTEPS, &substeps));
-    assert_true(substeps == 0.0);
-    CHECK_OK(g, dpsm_step(g, 10.0));
-    CHECK_OK(g, dpsm_get_step_info(g, DPSM_INFO_CELL_UPDATES, &updates));
-    assert_true(updates == 0.0);
+    for (int r = 0; r < 2; ++r) {
+        dpsm_grid *g = NULL;
+        CHECK_OK(NULL, dpsm_create_2d(n, n, 1.0, 1.0, &g));
+        CHECK_OK(g, dpsm_set_relaxation(g, kRelaxations[r]));
+        CHECK_OK(g, dpsm_set_heights(g, h));
+        double updates, substeps;
+        CHECK_OK(g, dpsm_step(g, 10.0)); /* looks at every tile once: all at rest */
+        CHECK_OK(g, dpsm_get_step_info(g, DPSM_INFO_SUBSTEPS, &substeps));
+        assert_true(substeps == 0.0); /* a sub-step or evaluation that finds rest is not counted */
+        CHECK_OK(g, dpsm_step(g, 10.0));
+        CHECK_OK(g, dpsm_get_step_info(g, DPSM_INFO_CELL_UPDATES, &updates));
+        assert_true(updates == 0.0);
 
-    const double pile[4] = {5.0, 6.0, 5.5, 7.0};
-    CHECK_OK(g, dpsm_add_heights_region(g, 500, 600, 2, 2, pile));
-    CHECK_OK(g, dpsm_step(g, 1e6));
-    CHECK_OK(g, dpsm_get_step_info(g, DPSM_INFO_CELL_UPDATES, &updates));
-    CHECK_OK(g, dpsm_get_step_info(g, DPSM_INFO_SUBSTEPS, &substeps));
-    print_message("a 2x2 pile dropped on a %lldx%lld surface at rest: %.0f sub-steps, %.3g cell updates (%.2f cells "
-                  "per sub-step, grid %lld)\n",
-                  (long long)n, (long long)n, substeps, updates, updates / substeps, (long long)(n * n));
-    assert_true(substeps > 0.0);
-    assert_true(updates / substeps <= 9.0 * 64 * 64); /* at most the 3x3 tiles around it */
-    CHECK_OK(g, dpsm_step(g, 1e6));
-    CHECK_OK(g, dpsm_get_step_info(g, DPSM_INFO_CELL_UPDATES, &updates));
-    assert_true(updates == 0.0);
-    assert_true(ledger_residual(g) < 1e-13);
+        const double pile[4] = {5.0, 6.0, 5.5, 7.0};
+        CHECK_OK(g, dpsm_add_heights_region(g, 500, 600, 2, 2, pile));
+        CHECK_OK(g, dpsm_step(g, 1e6));
+        CHECK_OK(g, dpsm_get_step_info(g, DPSM_INFO_CELL_UPDATES, &updates));
+        CHECK_OK(g, dpsm_get_step_info(g, DPSM_INFO_SUBSTEPS, &substeps));
+        print_message("%s: a 2x2 pile dropped on a %lldx%lld surface at rest: %.0f sub-steps, %.3g cell updates "
+                      "(%.2f cells per sub-step, grid %lld)\n",
+                      r ? "auto" : "time-accurate", (long long)n, (long long)n, substeps, updates, updates / substeps,
+                      (long long)(n * n));
+        assert_true(step_info_of(g, DPSM_INFO_AT_REST) == 1.0);
+        assert_true(substeps > 0.0);
+        assert_true(updates / substeps <= 9.0 * 64 * 64); /* at most the 3x3 tiles around it */
+        CHECK_OK(g, dpsm_step(g, 1e6));
+        CHECK_OK(g, dpsm_get_step_info(g, DPSM_INFO_CELL_UPDATES, &updates));
+        assert_true(updates == 0.0);
+        assert_true(ledger_residual(g) < 1e-13);
+        dpsm_destroy(g);
+    }
     free(h);
-    dpsm_destroy(g);
 }
 
 int main(void) {

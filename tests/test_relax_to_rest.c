@@ -74,6 +74,7 @@ static double l1_share(const double *a, const double *b) {
 static void compare_with_time_accurate(const double *h0, const uint8_t *kinds, int open_sides, double tolerance,
                                        double max_l1, const char *name) {
     dpsm_grid *accurate = grid_of(h0, kinds, open_sides, 0), *fast = grid_of(h0, kinds, open_sides, 0);
+    CHECK_OK(accurate, dpsm_set_relaxation(accurate, DPSM_RELAX_TIME_ACCURATE));
     CHECK_OK(accurate, dpsm_set_rest_tolerance(accurate, tolerance));
     CHECK_OK(fast, dpsm_set_rest_tolerance(fast, tolerance));
     CHECK_OK(fast, dpsm_set_relaxation(fast, DPSM_RELAX_TO_REST));
@@ -191,6 +192,7 @@ static void test_limit_and_switching_back(void **state) {
     double *h = malloc(sizeof(double) * N * N), *a = malloc(sizeof(double) * N * N);
     cone(h);
     dpsm_grid *g = grid_of(h, NULL, 4, 0), *never = grid_of(h, NULL, 4, 0);
+    CHECK_OK(never, dpsm_set_relaxation(never, DPSM_RELAX_TIME_ACCURATE));
     CHECK_OK(g, dpsm_set_relaxation(g, DPSM_RELAX_TO_REST));
     CHECK_OK(g, dpsm_set_max_substeps(g, 10));
     CHECK_OK(g, dpsm_step(g, 1.0));
@@ -220,6 +222,7 @@ static void test_after_time_accurate_steps(void **state) {
     for (int j = 0; j < N; ++j)
         for (int i = 0; i < N; ++i) h[i + N * j] = fmax(0.0, 8.0 - 1.5 * hypot(i - 20.0, j - 20.0));
     dpsm_grid *g = grid_of(h, NULL, 4, 0);
+    CHECK_OK(g, dpsm_set_relaxation(g, DPSM_RELAX_TIME_ACCURATE));
     CHECK_OK(g, dpsm_step(g, 1e6));
     REQUIRE(step_info_of(g, DPSM_INFO_AT_REST) == 1.0, "the first pile did not rest");
     CHECK_OK(g, dpsm_step(g, 1.0)); /* at rest: the active set forgets the pile */
@@ -239,6 +242,7 @@ static void test_after_time_accurate_steps(void **state) {
     /* Knocked out of rest on both piles (dpsm_add_heights_region clears the
      * residuals of its block only), both grids must step alike. */
     dpsm_grid *fresh = grid_of(a, NULL, 4, 0);
+    CHECK_OK(fresh, dpsm_set_relaxation(fresh, DPSM_RELAX_TIME_ACCURATE));
     double knock[5 * 5];
     for (int c = 0; c < 5 * 5; ++c) knock[c] = 6.0;
     for (int pile = 0; pile < 2; ++pile) {
@@ -306,6 +310,50 @@ static void test_pile_in_a_large_grid_costs_its_cells(void **state) {
     }
 }
 
+/* Lone tall spikes on cells ten times longer in y than in x: the stages and
+ * momentum undershoot the floor of open sides there. The relaxation must not
+ * leave that: it steps the scene in time instead, from the same start, and
+ * ends exactly where time-accurate steps to rest end. */
+static void test_falls_back_where_it_would_leave_new_extremes(void **state) {
+    (void)state;
+    enum { SX = 48, SY = 43 };
+    double h[SX * SY], a[SX * SY], b[SX * SY];
+    unsigned r = 1u;
+    for (int c = 0; c < SX * SY; ++c) {
+        r = r * 1664525u + 1013904223u;
+        const double u = (double)(r >> 8) / 16777216.0;
+        r = r * 1664525u + 1013904223u;
+        h[c] = u < 0.05 ? 60.0 * (double)(r >> 8) / 16777216.0 : 0.0;
+    }
+    dpsm_grid *g[2];
+    const int relaxation[2] = {DPSM_RELAX_TO_REST, DPSM_RELAX_TIME_ACCURATE};
+    for (int k = 0; k < 2; ++k) {
+        CHECK_OK(NULL, dpsm_create_2d(SX, SY, 0.5, 5.0, &g[k]));
+        for (int side = DPSM_XMIN; side <= DPSM_YMAX; ++side) CHECK_OK(g[k], dpsm_set_boundary(g[k], side, DPSM_OPEN));
+        CHECK_OK(g[k], dpsm_set_heights(g[k], h));
+        CHECK_OK(g[k], dpsm_set_relaxation(g[k], relaxation[k]));
+        CHECK_OK(g[k], dpsm_step(g[k], k == 0 ? 1.0 : 1e300));
+        REQUIRE(step_info_of(g[k], DPSM_INFO_AT_REST) == 1.0, "relaxation %d: not at rest", relaxation[k]);
+    }
+    REQUIRE(step_info_of(g[0], DPSM_INFO_TIME_INTEGRATED) > 0.0 &&
+                step_info_of(g[0], DPSM_INFO_TIME_INTEGRATED) == step_info_of(g[1], DPSM_INFO_TIME_INTEGRATED) &&
+                step_info_of(g[0], DPSM_INFO_SUBSTEPS) == step_info_of(g[1], DPSM_INFO_SUBSTEPS),
+            "not stepped in time: %g in %g sub-steps, time-accurate %g in %g",
+            step_info_of(g[0], DPSM_INFO_TIME_INTEGRATED), step_info_of(g[0], DPSM_INFO_SUBSTEPS),
+            step_info_of(g[1], DPSM_INFO_TIME_INTEGRATED), step_info_of(g[1], DPSM_INFO_SUBSTEPS));
+    REQUIRE(step_info_of(g[0], DPSM_INFO_CELL_UPDATES) > step_info_of(g[1], DPSM_INFO_CELL_UPDATES),
+            "the relaxation's own work is not counted");
+    CHECK_OK(g[0], dpsm_get_heights(g[0], a));
+    CHECK_OK(g[1], dpsm_get_heights(g[1], b));
+    REQUIRE(memcmp(a, b, sizeof a) == 0, "the fallback ends elsewhere than time-accurate steps");
+    for (int c = 0; c < SX * SY; ++c) REQUIRE(a[c] >= 0.0, "h[%d] = %g below the floor", c, a[c]);
+    REQUIRE(ledger_residual(g[0]) <= 1e-13, "ledger residual %g", ledger_residual(g[0]));
+    REQUIRE(memcmp(&(double){mass_of(g[0], DPSM_MASS_OUTFLOW)}, &(double){mass_of(g[1], DPSM_MASS_OUTFLOW)},
+                   sizeof(double)) == 0,
+            "outflow %.17g against %.17g", mass_of(g[0], DPSM_MASS_OUTFLOW), mass_of(g[1], DPSM_MASS_OUTFLOW));
+    for (int k = 0; k < 2; ++k) dpsm_destroy(g[k]);
+}
+
 /* A restart file keeps the setting, and the loaded grid continues bit for bit. */
 static void test_restart_keeps_it(void **state) {
     (void)state;
@@ -356,50 +404,169 @@ static void require_refused(dpsm_grid *g, int64_t cells, const char *phrase) {
     free(after);
 }
 
-static void test_unsupported_scenes_refused(void **state) {
-    (void)state;
-    enum { M = 12 };
-    double h[M * M], q[M * M], zb[M * M];
+/* A small steep scene with one thing the relaxation does not support, by
+ * number (0 .. kUnsupported - 1); names it in *phrase. */
+enum { M = 12, kUnsupported = 9 };
+static dpsm_grid *unsupported_scene(int feature, const char **phrase) {
+    double h[M * M], q[M * M], zb[M * M], theta[M * M];
     uint8_t kinds[M * M];
     for (int c = 0; c < M * M; ++c) {
         h[c] = (double)(c % 7);
         q[c] = 0.01;
         zb[c] = -1.0;
+        theta[c] = 0.5 + 0.01 * (c % 3);
         kinds[c] = DPSM_CELL_SAND;
     }
     dpsm_grid *g = NULL;
-    CHECK_OK(NULL, dpsm_create_1d(M, 1.0, &g));
-    CHECK_OK(g, dpsm_set_heights(g, h));
-    require_refused(g, M, "1D or axisymmetric");
-    dpsm_destroy(g);
-    CHECK_OK(NULL, dpsm_create_axisymmetric(M, 1.0, &g));
-    CHECK_OK(g, dpsm_set_heights(g, h));
-    require_refused(g, M, "1D or axisymmetric");
-    dpsm_destroy(g);
-    double theta[M * M];
-    for (int c = 0; c < M * M; ++c) theta[c] = 0.5 + 0.01 * (c % 3);
-    for (int feature = 0; feature < 7; ++feature) {
+    if (feature == 0) {
+        CHECK_OK(NULL, dpsm_create_1d(M, 1.0, &g));
+    } else if (feature == 1) {
+        CHECK_OK(NULL, dpsm_create_axisymmetric(M, 1.0, &g));
+    } else {
         CHECK_OK(NULL, dpsm_create_2d(M, M, 1.0, 1.0, &g));
-        CHECK_OK(g, dpsm_set_heights(g, h));
+    }
+    CHECK_OK(g, dpsm_set_heights(g, h));
+    switch (feature) {
+        case 0:
+        case 1: *phrase = "1D or axisymmetric"; break;
+        case 2: CHECK_OK(g, dpsm_set_bedrock(g, zb)); *phrase = "a bed"; break;
+        case 3: CHECK_OK(g, dpsm_set_static_angle(g, 0.7)); *phrase = "a static angle"; break;
+        case 4: CHECK_OK(g, dpsm_set_source(g, q)); *phrase = "an active source"; break;
+        case 5: CHECK_OK(g, dpsm_set_repose_angle_field(g, theta)); *phrase = "an angle field"; break;
+        case 6: CHECK_OK(g, dpsm_set_flux_exponent(g, 1.5)); *phrase = "a flux exponent other than 1"; break;
+        case 7: CHECK_OK(g, dpsm_set_scheme(g, DPSM_SCHEME_PAIRWISE)); *phrase = "the pairwise scheme"; break;
+        default:
+            kinds[0] = kinds[M * M - 1] = DPSM_CELL_OPEN;
+            CHECK_OK(g, dpsm_set_cell_kinds(g, kinds));
+            double low = 0.0, high = 3.0;
+            CHECK_OK(g, dpsm_set_heights_region(g, 0, 0, 1, 1, &low));
+            CHECK_OK(g, dpsm_set_heights_region(g, M - 1, M - 1, 1, 1, &high));
+            *phrase = "open cells held at different levels";
+    }
+    return g;
+}
+
+static void test_unsupported_scenes_refused(void **state) {
+    (void)state;
+    for (int feature = 0; feature < kUnsupported; ++feature) {
         const char *phrase = NULL;
-        switch (feature) {
-            case 0: CHECK_OK(g, dpsm_set_bedrock(g, zb)); phrase = "a bed"; break;
-            case 1: CHECK_OK(g, dpsm_set_static_angle(g, 0.7)); phrase = "a static angle"; break;
-            case 2: CHECK_OK(g, dpsm_set_source(g, q)); phrase = "an active source"; break;
-            case 3: CHECK_OK(g, dpsm_set_repose_angle_field(g, theta)); phrase = "an angle field"; break;
-            case 4: CHECK_OK(g, dpsm_set_flux_exponent(g, 1.5)); phrase = "a flux exponent other than 1"; break;
-            case 5: CHECK_OK(g, dpsm_set_scheme(g, DPSM_SCHEME_PAIRWISE)); phrase = "the pairwise scheme"; break;
-            default:
-                kinds[0] = kinds[M * M - 1] = DPSM_CELL_OPEN;
-                CHECK_OK(g, dpsm_set_cell_kinds(g, kinds));
-                double low = 0.0, high = 3.0;
-                CHECK_OK(g, dpsm_set_heights_region(g, 0, 0, 1, 1, &low));
-                CHECK_OK(g, dpsm_set_heights_region(g, M - 1, M - 1, 1, 1, &high));
-                phrase = "open cells held at different levels";
-        }
-        require_refused(g, M * M, phrase);
+        dpsm_grid *g = unsupported_scene(feature, &phrase);
+        require_refused(g, feature < 2 ? M : M * M, phrase);
         dpsm_destroy(g);
     }
+}
+
+/* The default, DPSM_RELAX_AUTO, steps every scene the relaxation does not
+ * support exactly as DPSM_RELAX_TIME_ACCURATE does, in time. */
+static void test_auto_steps_the_others_in_time(void **state) {
+    (void)state;
+    double a[M * M], b[M * M];
+    for (int feature = 0; feature < kUnsupported; ++feature) {
+        const char *phrase = NULL;
+        dpsm_grid *automatic = unsupported_scene(feature, &phrase), *timed = unsupported_scene(feature, &phrase);
+        CHECK_OK(timed, dpsm_set_relaxation(timed, DPSM_RELAX_TIME_ACCURATE));
+        for (int k = 0; k < 3; ++k) {
+            CHECK_OK(automatic, dpsm_step(automatic, 0.05));
+            CHECK_OK(timed, dpsm_step(timed, 0.05));
+            REQUIRE(step_info_of(automatic, DPSM_INFO_TIME_INTEGRATED) == step_info_of(timed, DPSM_INFO_TIME_INTEGRATED) &&
+                        step_info_of(automatic, DPSM_INFO_SUBSTEPS) == step_info_of(timed, DPSM_INFO_SUBSTEPS),
+                    "%s: time %g in %g sub-steps, time-accurate %g in %g", phrase,
+                    step_info_of(automatic, DPSM_INFO_TIME_INTEGRATED), step_info_of(automatic, DPSM_INFO_SUBSTEPS),
+                    step_info_of(timed, DPSM_INFO_TIME_INTEGRATED), step_info_of(timed, DPSM_INFO_SUBSTEPS));
+        }
+        REQUIRE(step_info_of(timed, DPSM_INFO_SUBSTEPS) > 0.0, "%s: the scene did not move", phrase);
+        CHECK_OK(automatic, dpsm_get_heights(automatic, a));
+        CHECK_OK(timed, dpsm_get_heights(timed, b));
+        REQUIRE(memcmp(a, b, sizeof(double) * (feature < 2 ? M : M * M)) == 0, "%s: heights differ", phrase);
+        dpsm_destroy(automatic);
+        dpsm_destroy(timed);
+    }
+}
+
+/* Requires two grids' heights and step information to agree bit for bit,
+ * the cell updates only `with_cost` (a loaded grid looks at every tile once
+ * more, which costs work but changes no result). */
+static void require_same_state(dpsm_grid *g, dpsm_grid *other, int with_cost, const char *what) {
+    double *a = malloc(sizeof(double) * N * N), *b = malloc(sizeof(double) * N * N);
+    CHECK_OK(g, dpsm_get_heights(g, a));
+    CHECK_OK(other, dpsm_get_heights(other, b));
+    REQUIRE(memcmp(a, b, sizeof(double) * N * N) == 0, "%s: heights differ", what);
+    for (int item = DPSM_INFO_SUBSTEPS; item <= (with_cost ? DPSM_INFO_CELL_UPDATES : DPSM_INFO_MAX_EXCESS_SLOPE); ++item)
+        REQUIRE(step_info_of(g, item) == step_info_of(other, item), "%s: step info %d is %g and %g", what, item,
+                step_info_of(g, item), step_info_of(other, item));
+    free(a);
+    free(b);
+}
+
+/* A grid left at the default relaxes the cone to rest as DPSM_RELAX_TO_REST
+ * does; while a source acts it steps in time as DPSM_RELAX_TIME_ACCURATE
+ * does, and once the source is off it relaxes again. A restart file (of
+ * version 3) keeps the default. */
+static void test_auto_relaxes_where_it_can(void **state) {
+    (void)state;
+    double *h = malloc(sizeof(double) * N * N), *q = calloc(N * N, sizeof(double));
+    cone(h);
+    for (int j = 40; j < 50; ++j)
+        for (int i = 20; i < 30; ++i) q[i + N * j] = 0.5;
+    dpsm_grid *automatic = grid_of(h, NULL, 4, 0), *to_rest = grid_of(h, NULL, 4, 0), *timed = grid_of(h, NULL, 4, 0);
+    CHECK_OK(to_rest, dpsm_set_relaxation(to_rest, DPSM_RELAX_TO_REST));
+    CHECK_OK(timed, dpsm_set_relaxation(timed, DPSM_RELAX_TIME_ACCURATE));
+    CHECK_OK(automatic, dpsm_step(automatic, 1.0));
+    CHECK_OK(to_rest, dpsm_step(to_rest, 1.0));
+    REQUIRE(step_info_of(automatic, DPSM_INFO_TIME_INTEGRATED) == 0.0 &&
+                step_info_of(automatic, DPSM_INFO_AT_REST) == 1.0,
+            "the default did not relax the cone to rest");
+    require_same_state(automatic, to_rest, 1, "the default against DPSM_RELAX_TO_REST");
+
+    /* The same rested heights on the time-accurate grid, then a source on both. */
+    double *rested = malloc(sizeof(double) * N * N);
+    CHECK_OK(automatic, dpsm_get_heights(automatic, rested));
+    CHECK_OK(timed, dpsm_set_heights(timed, rested));
+    dpsm_grid *reloaded = NULL;
+    const char *path = "test_relax_auto.dpsm";
+    for (int k = 0; k < 3; ++k) {
+        if (k == 0) {
+            CHECK_OK(automatic, dpsm_set_heights(automatic, rested)); /* the same history as timed's */
+            CHECK_OK(automatic, dpsm_set_source(automatic, q));
+            CHECK_OK(timed, dpsm_set_source(timed, q));
+        }
+        CHECK_OK(automatic, dpsm_step(automatic, 2.0));
+        CHECK_OK(timed, dpsm_step(timed, 2.0));
+        REQUIRE(step_info_of(automatic, DPSM_INFO_TIME_INTEGRATED) == 2.0, "with a source, the default integrated %g",
+                step_info_of(automatic, DPSM_INFO_TIME_INTEGRATED));
+        require_same_state(automatic, timed, 1, "with a source, the default against DPSM_RELAX_TIME_ACCURATE");
+    }
+    CHECK_OK(automatic, dpsm_set_source(automatic, NULL));
+    CHECK_OK(automatic, dpsm_save(automatic, path));
+    unsigned char header[12];
+    FILE *file = fopen(path, "rb");
+    REQUIRE(file && fread(header, 1, sizeof header, file) == sizeof header, "cannot read %s back", path);
+    fclose(file);
+    REQUIRE(header[8] == 3 && header[9] == 0 && header[10] == 0 && header[11] == 0,
+            "a grid at the default is saved as version %u, not 3", (unsigned)header[8]);
+    CHECK_OK(NULL, dpsm_load(path, &reloaded));
+    dpsm_grid *reloaded_to_rest = NULL;
+    CHECK_OK(NULL, dpsm_load(path, &reloaded_to_rest));
+    remove(path);
+    CHECK_OK(reloaded_to_rest, dpsm_set_relaxation(reloaded_to_rest, DPSM_RELAX_TO_REST));
+    CHECK_OK(automatic, dpsm_step(automatic, 1.0));
+    CHECK_OK(reloaded, dpsm_step(reloaded, 1.0));
+    CHECK_OK(reloaded_to_rest, dpsm_step(reloaded_to_rest, 1.0));
+    REQUIRE(step_info_of(automatic, DPSM_INFO_TIME_INTEGRATED) == 0.0 && step_info_of(automatic, DPSM_INFO_SUBSTEPS) > 0.0,
+            "with the source off, the default did not relax to rest");
+    require_same_state(automatic, reloaded_to_rest, 0, "source off: the default against DPSM_RELAX_TO_REST");
+    require_same_state(automatic, reloaded, 0, "source off: the default against its restart");
+    REQUIRE(ledger_residual(automatic) <= 1e-13, "ledger residual %g", ledger_residual(automatic));
+    /* Set explicitly, the default is the default. */
+    CHECK_OK(to_rest, dpsm_set_relaxation(to_rest, DPSM_RELAX_AUTO));
+    dpsm_destroy(automatic);
+    dpsm_destroy(to_rest);
+    dpsm_destroy(timed);
+    dpsm_destroy(reloaded);
+    dpsm_destroy(reloaded_to_rest);
+    free(h);
+    free(q);
+    free(rested);
 }
 
 int main(void) {
@@ -410,8 +577,11 @@ int main(void) {
         cmocka_unit_test(test_limit_and_switching_back),
         cmocka_unit_test(test_after_time_accurate_steps),
         cmocka_unit_test(test_pile_in_a_large_grid_costs_its_cells),
+        cmocka_unit_test(test_falls_back_where_it_would_leave_new_extremes),
         cmocka_unit_test(test_restart_keeps_it),
         cmocka_unit_test(test_unsupported_scenes_refused),
+        cmocka_unit_test(test_auto_steps_the_others_in_time),
+        cmocka_unit_test(test_auto_relaxes_where_it_can),
     };
     return cmocka_run_group_tests_name("relax to rest", tests, NULL, NULL);
 }

@@ -325,10 +325,12 @@ static void test_axisymmetric_continues_bit_for_bit(void **state) {
 
 /* ---- damaged files ------------------------------------------------------------ */
 
-/* A small file with every optional array: source, bed, angle field, moving cells. */
+/* A small file with every optional array: source, bed, angle field, moving
+ * cells; time-accurate, so that it is a file of version 1. */
 static unsigned char *small_file(const char *path, size_t *size) {
     dpsm_grid *g = NULL;
     CHECK_OK(NULL, dpsm_create_2d(5, 4, 0.1, 0.1, &g));
+    CHECK_OK(g, dpsm_set_relaxation(g, DPSM_RELAX_TIME_ACCURATE));
     double h[20], zb[20], q[20], theta[20];
     for (int c = 0; c < 20; ++c) {
         h[c] = 0.1 * c;
@@ -436,11 +438,27 @@ static void test_values_are_checked_behind_the_checksum(void **state) {
     REQUIRE(get_u32(good + kHeaderChecksum) == crc32_of(good, kHeaderChecksum), "the header's checksum is not its CRC-32");
     unsigned char *bytes = malloc(size);
 
+    REQUIRE(get_u32(good + kOffsetVersion) == 1, "the small file is of version %u, not 1",
+            get_u32(good + kOffsetVersion));
     memcpy(bytes, good, size);
-    put_u32(bytes + kOffsetVersion, 3);
+    put_u32(bytes + kOffsetVersion, 4);
     reseal(bytes, size);
     write_file(bad, bytes, size);
-    require_refused(bad, "written by a newer dpsm, version 3", "version 3");
+    require_refused(bad, "written by a newer dpsm, version 4", "version 4");
+
+    /* The relaxations' flags: DPSM_RELAX_AUTO's needs version 3, and a file
+     * cannot ask for both. */
+    memcpy(bytes, good, size);
+    put_u32(bytes + kOffsetVersion, 2);
+    put_u32(bytes + kOffsetFlags, get_u32(bytes + kOffsetFlags) | 64u);
+    reseal(bytes, size);
+    write_file(bad, bytes, size);
+    require_refused(bad, "need version 3", "the flag of DPSM_RELAX_AUTO in version 2");
+    put_u32(bytes + kOffsetVersion, 3);
+    put_u32(bytes + kOffsetFlags, get_u32(bytes + kOffsetFlags) | 32u);
+    reseal(bytes, size);
+    write_file(bad, bytes, size);
+    require_refused(bad, "both relaxation flags", "both relaxations");
 
     memcpy(bytes, good, size);
     put_f64(bytes + kOffsetRepose, 2.0);

@@ -347,6 +347,7 @@ static int cmd_table_2d(int argc, char **argv) {
         uint8_t *kind = xcalloc(cells, sizeof *kind);
         dpsm_grid *g = NULL;
         CHECK(NULL, dpsm_create_2d(m, m, dx, dx, &g));
+        CHECK(g, dpsm_set_relaxation(g, DPSM_RELAX_TIME_ACCURATE)); /* the paper's experiments, in time */
         CHECK(g, dpsm_set_repose_angle(g, theta));
         CHECK(g, dpsm_set_mobility(g, 1.0));
         CHECK(g, dpsm_set_scheme(g, sc->scheme));

@@ -59,6 +59,7 @@ module dpsm
   ! Relaxations (dpsm_set_relaxation).
   integer(c_int), parameter, public :: DPSM_RELAX_TIME_ACCURATE = 0
   integer(c_int), parameter, public :: DPSM_RELAX_TO_REST = 1
+  integer(c_int), parameter, public :: DPSM_RELAX_AUTO = 2
   ! Cell kinds (the values of an integer(c_int8_t) kinds array).
   integer(c_int8_t), parameter, public :: DPSM_CELL_SAND = 0_c_int8_t
   integer(c_int8_t), parameter, public :: DPSM_CELL_WALL = 1_c_int8_t
@@ -643,8 +644,10 @@ contains
     call finish(c_dpsm_set_scheme(g%ptr, scheme), ierr, 'dpsm_set_scheme', g)
   end subroutine dpsm_set_scheme
 
-  !> dpsm_set_relaxation(g, relaxation[, ierr]): DPSM_RELAX_TIME_ACCURATE (the
-  !> default) or DPSM_RELAX_TO_REST (each dpsm_step relaxes to rest, fast).
+  !> dpsm_set_relaxation(g, relaxation[, ierr]): DPSM_RELAX_AUTO (the default:
+  !> DPSM_RELAX_TO_REST where the scene allows it, else time-accurate),
+  !> DPSM_RELAX_TO_REST (each dpsm_step relaxes to rest, fast) or
+  !> DPSM_RELAX_TIME_ACCURATE (sub-steps over dt).
   subroutine dpsm_set_relaxation(g, relaxation, ierr)
     type(dpsm_grid), intent(in) :: g
     integer(c_int), intent(in) :: relaxation

@@ -118,10 +118,14 @@ typedef struct dpsm_grid dpsm_grid;
 /** @name Relaxations
  *  For dpsm_set_relaxation(): how dpsm_step() moves the surface. @{ */
 /** Explicit sub-steps, each stable and time accurate, to the end of `dt` or
- *  to rest (the default). */
+ *  to rest: for a host that needs the flow's timing. */
 #define DPSM_RELAX_TIME_ACCURATE 0
-/** To rest in each dpsm_step(), in few flux evaluations, without a time scale. */
+/** To rest in each dpsm_step(), in few flux evaluations, without a time
+ *  scale; refused on scenes it does not support. */
 #define DPSM_RELAX_TO_REST 1
+/** The default: ::DPSM_RELAX_TO_REST where the scene allows it, else
+ *  ::DPSM_RELAX_TIME_ACCURATE, decided anew at every dpsm_step(). */
+#define DPSM_RELAX_AUTO 2
 /** @} */
 
 /** @name Cell kinds
@@ -278,22 +282,26 @@ DPSM_API int dpsm_set_mobility(dpsm_grid *g, double nu);
 DPSM_API int dpsm_set_scheme(dpsm_grid *g, int scheme);
 
 /**
- * @brief Chooses how dpsm_step() moves the surface: ::DPSM_RELAX_TIME_ACCURATE
- *        (the default) or ::DPSM_RELAX_TO_REST.
+ * @brief Chooses how dpsm_step() moves the surface: ::DPSM_RELAX_AUTO (the
+ *        default), ::DPSM_RELAX_TO_REST or ::DPSM_RELAX_TIME_ACCURATE.
  *
  * ::DPSM_RELAX_TO_REST makes every dpsm_step() bring the surface to rest in
  * far fewer evaluations of the slide fluxes than the time-accurate explicit
- * sub-steps take, whatever its `dt` (which must still be finite and
- * positive): for a host that needs the deposit after each change, not the
- * flow's timing. It follows the flow's own path by Runge-Kutta-Chebyshev steps
- * while much sand moves and lets momentum finish the last small motions; the
- * deposit stays within about 0.2 % (L1) of the time-accurate one on the
- * scenes of the performance page, at rest tolerances up to 1e-3 (at 1e-2 it
- * strays further). Mass is kept: what leaves through open sides and cells is
- * booked as outflow, with the rounding of the combined stages (about 1e-16 of
- * the mass per evaluation). Then ::DPSM_INFO_SUBSTEPS counts flux evaluations,
- * ::DPSM_INFO_TIME_INTEGRATED is 0, and ::DPSM_INFO_AT_REST is 1 unless the
- * sub-step limit (dpsm_set_max_substeps()) ran out first.
+ * sub-steps take (on the cone of the performance page about a tenth of the
+ * time), whatever its `dt` (which must still be finite and positive): for a
+ * host that needs the deposit after each change, not the flow's timing. It
+ * follows the flow's own path by Runge-Kutta-Chebyshev steps while much sand
+ * moves and lets momentum finish the last small motions; the deposit stays
+ * within about 0.2 % (L1) of the time-accurate one on the scenes of the
+ * performance page, at rest tolerances up to 1e-3 (at 1e-2 it strays
+ * further). Mass is kept: what leaves through open sides and cells is booked
+ * as outflow, with the rounding of the combined stages (about 1e-16 of the
+ * mass per evaluation); in a scene without open sides or cells nothing is
+ * booked, and that rounding is the balance's only residual. Then
+ * ::DPSM_INFO_SUBSTEPS counts the flux evaluations that moved sand (the one
+ * that finds rest is not counted, as a time-accurate sub-step that finds
+ * rest is not), ::DPSM_INFO_TIME_INTEGRATED is 0, and ::DPSM_INFO_AT_REST is
+ * 1 unless the sub-step limit (dpsm_set_max_substeps()) ran out first.
  *
  * Like the time-accurate steps it costs what the scene needs: each evaluation
  * visits only the tiles near moving sand (::DPSM_INFO_CELL_UPDATES counts
@@ -308,8 +316,18 @@ DPSM_API int dpsm_set_scheme(dpsm_grid *g, int scheme);
  * open cells at different levels. A host adds its deposit with
  * dpsm_add_heights_region() instead of a source.
  *
+ * ::DPSM_RELAX_AUTO, the default, relaxes to rest wherever
+ * ::DPSM_RELAX_TO_REST would be accepted, and takes time-accurate sub-steps
+ * over `dt` wherever it would be refused; it decides at every dpsm_step(), so
+ * a grid switches to time-accurate steps while a source is active and back
+ * once it is switched off. ::DPSM_INFO_TIME_INTEGRATED tells which it took (0
+ * after a relaxation to rest). A host that needs the flow's timing (a
+ * transient, a coupling through the avalanche's duration) asks for
+ * ::DPSM_RELAX_TIME_ACCURATE; \ref guide_time_steps compares the three.
+ *
  * @param g           the grid.
- * @param relaxation  ::DPSM_RELAX_TIME_ACCURATE or ::DPSM_RELAX_TO_REST.
+ * @param relaxation  ::DPSM_RELAX_AUTO, ::DPSM_RELAX_TO_REST or
+ *                    ::DPSM_RELAX_TIME_ACCURATE.
  * @return ::DPSM_OK, ::DPSM_ERR_NULL_POINTER or ::DPSM_ERR_UNKNOWN_ENUM.
  */
 DPSM_API int dpsm_set_relaxation(dpsm_grid *g, int relaxation);
@@ -441,7 +459,14 @@ DPSM_API int dpsm_set_source(dpsm_grid *g, const double *q);
 DPSM_API int dpsm_stable_dt(const dpsm_grid *g, double *dt);
 
 /**
- * @brief Advances the surface by exactly `dt`.
+ * @brief Advances the surface by `dt`, or (by default, where the scene
+ *        allows it) straight to rest.
+ *
+ * By default (::DPSM_RELAX_AUTO) a step on a 2D grid whose scene the fast
+ * relaxation supports brings the surface to rest whatever `dt`, in far fewer
+ * flux evaluations than sub-steps would take; dpsm_set_relaxation() tells
+ * which scenes those are and how to ask for time-accurate steps instead.
+ * What follows describes the time-accurate steps.
  *
  * Sub-steps of at most dpsm_stable_dt() are taken. When the surface is at rest
  * (no face steeper than `tan(theta) * (1 + tol)`, see
@@ -460,8 +485,9 @@ DPSM_API int dpsm_stable_dt(const dpsm_grid *g, double *dt);
  *
  * @param g   the grid.
  * @param dt  finite and positive.
- * @return ::DPSM_OK, ::DPSM_ERR_NULL_POINTER, ::DPSM_ERR_INVALID_VALUE or
- *         ::DPSM_ERR_WORK_LIMIT.
+ * @return ::DPSM_OK, ::DPSM_ERR_NULL_POINTER, ::DPSM_ERR_INVALID_VALUE,
+ *         ::DPSM_ERR_WORK_LIMIT or ::DPSM_ERR_NOT_APPLICABLE
+ *         (::DPSM_RELAX_TO_REST on a scene it does not support).
  */
 DPSM_API int dpsm_step(dpsm_grid *g, double dt);
 

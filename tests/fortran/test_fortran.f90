@@ -139,6 +139,8 @@ contains
     call expect(ierr == DPSM_ERR_UNKNOWN_ENUM, 'dpsm_set_relaxation(7) fails')
     call dpsm_set_relaxation(g, DPSM_RELAX_TO_REST, ierr)
     call expect(ierr == DPSM_OK, 'dpsm_set_relaxation(TO_REST)')
+    call dpsm_set_relaxation(g, DPSM_RELAX_AUTO, ierr)
+    call expect(ierr == DPSM_OK, 'dpsm_set_relaxation(AUTO)')
     call dpsm_set_relaxation(g, DPSM_RELAX_TIME_ACCURATE, ierr)
     call expect(ierr == DPSM_OK, 'dpsm_set_relaxation(TIME_ACCURATE)')
     call dpsm_set_boundary(g, 9_c_int, DPSM_OPEN, ierr)

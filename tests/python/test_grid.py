@@ -212,6 +212,7 @@ class Test2D(LedgerMixin, unittest.TestCase):
                 grid.set_repose_angle(0.6)
                 grid.set_heights(self.cone)
             g.set_relaxation(dpsm.RELAX_TO_REST)
+            accurate.set_relaxation(dpsm.RELAX_TIME_ACCURATE)
             total = g.get_mass(dpsm.MASS_TOTAL)
             g.step(1.0)
             accurate.step(1e6)
@@ -227,6 +228,34 @@ class Test2D(LedgerMixin, unittest.TestCase):
             self.assertEqual(g.get_step_info(dpsm.INFO_SUBSTEPS), 0.0)  # truly at rest
         finally:
             accurate.close()
+
+    def test_relax_auto_is_the_default(self):
+        """DPSM_RELAX_AUTO: the default relaxes the cone to rest, and steps in time while a source acts."""
+        g, to_rest = self.g, dpsm.Grid.create_2d(self.nx, self.ny, self.dx, self.dy)
+        try:
+            for grid in (g, to_rest):
+                grid.set_repose_angle(0.6)
+                grid.set_heights(self.cone)
+            to_rest.set_relaxation(dpsm.RELAX_TO_REST)
+            g.step(1.0)
+            to_rest.step(1.0)
+            self.assertEqual(g.get_step_info(dpsm.INFO_TIME_INTEGRATED), 0.0)
+            self.assertEqual(g.get_step_info(dpsm.INFO_SUBSTEPS), to_rest.get_step_info(dpsm.INFO_SUBSTEPS))
+            self.assertEqual(flat(g.get_heights()), flat(to_rest.get_heights()))
+            g.set_source([[0.01] * self.nx for _ in range(self.ny)])
+            g.step(0.5)
+            self.assertEqual(g.get_step_info(dpsm.INFO_TIME_INTEGRATED), 0.5)
+            g.set_source(None)
+            g.set_relaxation(dpsm.RELAX_AUTO)
+            g.step(1.0)
+            self.assertEqual(g.get_step_info(dpsm.INFO_TIME_INTEGRATED), 0.0)
+            self.assertEqual(g.get_step_info(dpsm.INFO_AT_REST), 1.0)
+            self.assertLedger(g)
+            with self.assertRaises(dpsm.Error) as caught:
+                g.set_relaxation(3)
+            self.assertEqual(caught.exception.status, dpsm.ERR_UNKNOWN_ENUM)
+        finally:
+            to_rest.close()
 
     def test_step_to_rest(self):
         g = self.g
@@ -497,6 +526,10 @@ class TestRestart(LedgerMixin, unittest.TestCase):
 
     def test_the_format(self):
         with dpsm.Grid.create_2d(5, 4, 0.1, 0.1) as g:
+            g.save(self.path)
+            with open(self.path, "rb") as f:
+                self.assertEqual(int.from_bytes(f.read()[8:12], "little"), 3)  # the default relaxation needs 3
+            g.set_relaxation(dpsm.RELAX_TIME_ACCURATE)
             g.save(self.path)
         with open(self.path, "rb") as f:
             data = f.read()

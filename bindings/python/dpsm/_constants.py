@@ -35,6 +35,7 @@ DPSM_SCHEME_ISOTROPIC = 1
 # Relaxations (dpsm_set_relaxation).
 DPSM_RELAX_TIME_ACCURATE = 0
 DPSM_RELAX_TO_REST = 1
+DPSM_RELAX_AUTO = 2
 
 # Cell kinds.
 DPSM_CELL_SAND = 0

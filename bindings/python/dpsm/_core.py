@@ -286,8 +286,9 @@ class Grid:
         self._call(f, _c_int(scheme, "scheme", f, C.DPSM_ERR_UNKNOWN_ENUM))
 
     def set_relaxation(self, relaxation):
-        """``dpsm_set_relaxation``: ``RELAX_TIME_ACCURATE`` (the default) or ``RELAX_TO_REST`` (each ``step``
-        brings the surface to rest in few flux evaluations, without a time scale)."""
+        """``dpsm_set_relaxation``: ``RELAX_AUTO`` (the default: ``RELAX_TO_REST`` where the scene allows it,
+        else ``RELAX_TIME_ACCURATE``), ``RELAX_TO_REST`` (each ``step`` brings the surface to rest in few flux
+        evaluations, without a time scale) or ``RELAX_TIME_ACCURATE`` (sub-steps over ``dt``)."""
         f = "dpsm_set_relaxation"
         self._call(f, _c_int(relaxation, "relaxation", f, C.DPSM_ERR_UNKNOWN_ENUM))
 
