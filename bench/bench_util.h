@@ -75,6 +75,7 @@ int cmd_throughput(int argc, char **argv);
 int cmd_sparse(int argc, char **argv);
 int cmd_idle(int argc, char **argv);
 int cmd_cone(int argc, char **argv);
+int cmd_deposits(int argc, char **argv);
 int cmd_steps(int argc, char **argv); /* relax_study.c */
 
 #endif

@@ -31,7 +31,7 @@ mkdir -p "$data" "$figures"
   echo "compiler: $(${CXX:-c++} --version 2>/dev/null | head -1)"
 } > "$data/speed_provenance.txt"
 
-for what in throughput sparse idle cone steps; do
+for what in throughput sparse idle cone deposits steps; do
   echo ">> dpsm-bench $what"
   "$bench" "$what" > "$data/speed_$what.csv" 2> "$data/speed_$what.log"
   cat "$data/speed_$what.csv"

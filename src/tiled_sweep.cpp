@@ -261,12 +261,21 @@ void refresh_scratch(const Grid &grid, TiledWorkspace &ws, const CellBox &box, b
 
 void tiled_workspace_changed(TiledWorkspace &ws, const ActiveSet &active, const CellBox &box) {
     if (ws.all_stale || box.empty()) return;
-    for (std::int64_t t = 0; t < active.tiles(); ++t) {
-        const CellBox part = box.grown_within(0, active.tile_cells(t));
-        if (part.empty()) continue;
-        if (ws.stale[static_cast<std::size_t>(t)].empty()) ws.stale_tiles.push_back(t);
-        ws.stale[static_cast<std::size_t>(t)].add(part);
-    }
+    // Only the tiles the box overlaps: a host's or the relaxation's small
+    // edit on a large grid costs its own tiles.
+    const std::int64_t side = ActiveSet::kTile;
+    const std::int64_t ti0 = std::max<std::int64_t>(0, box.i0 / side);
+    const std::int64_t ti1 = std::min(active.tiles_x() - 1, (box.i1 - 1) / side);
+    const std::int64_t tj0 = std::max<std::int64_t>(0, box.j0 / side);
+    const std::int64_t tj1 = std::min(active.tiles_y() - 1, (box.j1 - 1) / side);
+    for (std::int64_t tj = tj0; tj <= tj1; ++tj)
+        for (std::int64_t ti = ti0; ti <= ti1; ++ti) {
+            const std::int64_t t = ti + active.tiles_x() * tj;
+            const CellBox part = box.grown_within(0, active.tile_cells(t));
+            if (part.empty()) continue;
+            if (ws.stale[static_cast<std::size_t>(t)].empty()) ws.stale_tiles.push_back(t);
+            ws.stale[static_cast<std::size_t>(t)].add(part);
+        }
 }
 
 void prepare_tiled_sweep(Grid &grid, int threads) {
