@@ -14,7 +14,7 @@
  *   dpsm-bench sparse [n [fraction [threads]]]   a dune field with ~1 % of cells on slip faces
  *   dpsm-bench idle [n]                a surface at rest
  *   dpsm-bench cone [tolerance [runs]] a cone relaxed to rest (the dune models' scene)
- *   dpsm-bench deposits [n [count]]    a host's small deposits, each stepped to rest
+ *   dpsm-bench deposits [n [count [rounds]]]  a host's small deposits, each stepped to rest
  *   dpsm-bench steps                   the study of larger steps (relax_study.c)
  * Each of these also times the plain reference loop of reference.c, so every
  * figure is also a ratio (speed.c).
@@ -208,8 +208,8 @@ static const command kCommands[] = {
      "[tolerance [runs]]  cone 40 high, slope 1.5, 101^2, to rest at 33 deg; seconds and top vs 22.89 (relaxed to rest:"
      " the best of runs, 10)"},
     {"deposits", cmd_deposits,
-     "[n [count]]  count (40) heaps of 10^2 cells dropped one by one on n^2 (4096^2) at rest, each stepped to rest:"
-     " time-accurate and by the default"},
+     "[n [count [rounds]]]  count (40) heaps of 10^2 cells dropped one by one on n^2 (4096^2) at rest, each stepped"
+     " to rest, rounds (1) times over: time-accurate and by the default"},
     {"steps", cmd_steps, "explicit sub-steps against the bounded exchange at dt -> infinity: time and error to rest"},
     {"work-precision", cmd_work_precision,
      "[max_n [threads]]  column collapse (a = 0.5, 30 deg) to rest: 2D n^2 up to max_n^2 (default 512), both schemes,"

@@ -49,11 +49,25 @@ def speed_table(data):
         rs = ref.get(r["tolerance"])
         met = "yes" if s <= 0.02 and abs(err) <= 0.5 else f"no: {s / 0.02:.1f} x too slow" if abs(err) <= 0.5 else "no"
         fast = r["method"] == "dpsm-to-rest"
-        how = "relaxed to rest (DPSM_RELAX_TO_REST)" if fast else "to rest"
+        how = "relaxed to rest (the default here, as DPSM_RELAX_TO_REST)" if fast else \
+            "to rest by time-accurate sub-steps (DPSM_RELAX_TIME_ACCURATE)"
         work = "flux evaluations" if fast else "sub-steps"
         out.append(f"| cone 101^2 {how} at 33 deg, tolerance {r['tolerance']}: seconds, top ({float(r['top']):.3f}, "
                    f"exact 22.89) | {s:.3f} s, {err:+.2f} % ({r['substeps']} {work}) | "
                    f"{float(rs['seconds']):.3f} s | | 0.02 s, 0.5 % | {met} |" if rs else "")
+    if os.path.exists(os.path.join(data, "speed_deposits.csv")):
+        dep = rows(data, "deposits")
+        for rounds in sorted({r.get("rounds", "1") for r in dep}, key=int):
+            by = {r["method"]: r for r in dep if r.get("rounds", "1") == rounds}
+            timed, auto = by.get("dpsm-time-accurate"), by.get("dpsm-auto")
+            if not (timed and auto):
+                continue
+            what = (f"{auto['deposits']} heaps of 10^2 cells dropped one by one on {auto['n']}^2"
+                    if rounds == "1" else
+                    f"{int(auto['deposits']) * int(rounds)} such heaps on {auto['deposits']} growing piles")
+            out.append(f"| {what}, each stepped to rest: seconds by the default (relaxed to rest) / "
+                       f"time-accurate | {float(auto['seconds']):.3f} s ({auto['substeps']} flux evaluations) / "
+                       f"{float(timed['seconds']):.3f} s ({timed['substeps']} sub-steps) | | | | |")
     return out
 
 

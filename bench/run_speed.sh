@@ -37,6 +37,7 @@ for what in throughput sparse idle cone deposits steps; do
   cat "$data/speed_$what.csv"
 done
 "$bench" cone 1e-3 | tail -n +2 >> "$data/speed_cone.csv"
+"$bench" deposits 4096 40 10 2>> "$data/speed_deposits.log" | tail -n +2 >> "$data/speed_deposits.csv"
 echo ">> dpsm-bench-kernel"
 "$build/bench/dpsm-bench-kernel" > "$data/speed_kernel.csv"
 cat "$data/speed_kernel.csv"

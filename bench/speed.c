@@ -199,15 +199,16 @@ int cmd_idle(int argc, char **argv) {
 
 /* A host's deposits: `count` heaps of 10 x 10 cells, 4 high, dropped one
  * after another along a line of an n x n surface at rest, each stepped to
- * rest (dt = 50 until DPSM_INFO_AT_REST), time-accurate and by the default
+ * rest (dt = 50 until DPSM_INFO_AT_REST), `rounds` times over (the piles
+ * grow), time-accurate and by the default
  * (DPSM_RELAX_AUTO, which relaxes this scene to rest). Prints the seconds
  * (best of three), the sub-steps or flux evaluations and the cells computed,
  * and how far the two deposits end apart (L1, of the deposited volume). */
 int cmd_deposits(int argc, char **argv) {
     const int64_t n = argc > 0 ? atoll(argv[0]) : 4096;
-    const int count = argc > 1 ? atoi(argv[1]) : 40;
-    if (n < 256 || count < 1 || 100 + 50 * (int64_t)count > n - 20) {
-        fprintf(stderr, "dpsm-bench deposits: n >= 256 and 1 <= count <= (n - 120) / 50\n");
+    const int count = argc > 1 ? atoi(argv[1]) : 40, rounds = argc > 2 ? atoi(argv[2]) : 1;
+    if (n < 256 || count < 1 || 100 + 50 * (int64_t)count > n - 20 || rounds < 1) {
+        fprintf(stderr, "dpsm-bench deposits: n >= 256, 1 <= count <= (n - 120) / 50, rounds >= 1\n");
         return 1;
     }
     double *h = xcalloc((size_t)(n * n), sizeof(double)), *out[2];
@@ -216,7 +217,7 @@ int cmd_deposits(int argc, char **argv) {
     double heap[100];
     for (int c = 0; c < 100; ++c) heap[c] = 4.0;
     const int relaxations[2] = {DPSM_RELAX_TIME_ACCURATE, DPSM_RELAX_AUTO};
-    printf("method,n,deposits,seconds,substeps,cell_updates\n");
+    printf("method,n,deposits,rounds,seconds,substeps,cell_updates\n");
     for (int k = 0; k < 2; ++k) {
         double seconds = INFINITY, substeps = 0.0, updates = 0.0;
         out[k] = xcalloc((size_t)(n * n), sizeof(double));
@@ -225,8 +226,8 @@ int cmd_deposits(int argc, char **argv) {
             CHECK(g, dpsm_set_relaxation(g, relaxations[k]));
             CHECK(g, dpsm_step(g, 1.0)); /* looks at every tile once and finds rest */
             double t = 0.0, s = 0.0, u = 0.0;
-            for (int d = 0; d < count; ++d) {
-                CHECK(g, dpsm_add_heights_region(g, 100 + 50 * d, n / 2, 10, 10, heap));
+            for (int d = 0; d < count * rounds; ++d) {
+                CHECK(g, dpsm_add_heights_region(g, 100 + 50 * (d % count), n / 2, 10, 10, heap));
                 const double t0 = now_seconds();
                 double rest = 0.0;
                 for (int guard = 0; rest == 0.0 && guard < 100000; ++guard) {
@@ -248,13 +249,13 @@ int cmd_deposits(int argc, char **argv) {
             CHECK(g, dpsm_get_heights(g, out[k]));
             dpsm_destroy(g);
         }
-        printf("%s,%lld,%d,%.4f,%.0f,%.4g\n", k ? "dpsm-auto" : "dpsm-time-accurate", (long long)n, count, seconds,
-               substeps, updates);
+        printf("%s,%lld,%d,%d,%.4f,%.0f,%.4g\n", k ? "dpsm-auto" : "dpsm-time-accurate", (long long)n, count, rounds,
+               seconds, substeps, updates);
     }
     double apart = 0.0;
     for (int64_t c = 0; c < n * n; ++c) apart += fabs(out[0][c] - out[1][c]);
     fprintf(stderr, "dpsm-bench deposits: the two deposits end %.3f %% apart (L1, of the deposited volume)\n",
-            100.0 * apart / (100.0 * 4.0 * count));
+            100.0 * apart / (100.0 * 4.0 * count * rounds));
     free(out[0]);
     free(out[1]);
     free(h);
