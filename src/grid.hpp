@@ -149,6 +149,7 @@ public:
     void set_relaxation(Relaxation relaxation) { relaxation_ = relaxation; }
 
     bool side_open(int side) const { return side_open_[side]; }
+    bool any_side_open() const { return side_open_[0] || side_open_[1] || side_open_[2] || side_open_[3]; }
     void set_side_open(int side, bool open) {
         side_open_[side] = open;
         touched_everywhere();

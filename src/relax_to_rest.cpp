@@ -284,8 +284,7 @@ public:
             take(grid_.open_level_min());
             take(grid_.open_level_max());
         }
-        if (grid_.side_open(kXMin) || grid_.side_open(kXMax) || grid_.side_open(kYMin) || grid_.side_open(kYMax))
-            take(0.0);
+        if (grid_.any_side_open()) take(0.0);
         const double slack = kBoundsSlack * std::max(std::fabs(lo), std::fabs(hi));
         bool within = true;
         for (const std::int64_t t : ws_.live_tiles)
@@ -365,10 +364,8 @@ const char *relaxation_unsupported(const Grid &grid) {
     if (grid.flux_exponent() != 1.0) return "a flux exponent other than 1 (dpsm_set_flux_exponent)";
     if (grid.hysteresis()) return "a static angle (dpsm_set_static_angle)";
     if (grid.source_active()) return "an active source (dpsm_set_source); add the deposit with dpsm_add_heights_region";
-    const bool side_open =
-        grid.side_open(kXMin) || grid.side_open(kXMax) || grid.side_open(kYMin) || grid.side_open(kYMax);
     if (grid.has_open_cells() && (grid.open_level_min() != grid.open_level_max() ||
-                                  (side_open && grid.open_level_min() != 0.0)))
+                                  (grid.any_side_open() && grid.open_level_min() != 0.0)))
         return "open cells held at different levels, or at another than the open sides' 0 (sand would flow for ever)";
     return nullptr;
 }
@@ -486,8 +483,7 @@ bool relax_to_rest(Grid &grid, double &cells_visited) {
     // of the combined stages; where it cannot, that rounding is all the
     // change and is not outflow.
     const double left = rates.mass_left(x);
-    const bool sinks = grid.has_open_cells() || grid.side_open(kXMin) || grid.side_open(kXMax) ||
-                       grid.side_open(kYMin) || grid.side_open(kYMax);
+    const bool sinks = grid.has_open_cells() || grid.any_side_open();
     cells_visited = rates.cells_visited();
     // The stages and momentum are not monotone and their sums round: on rough
     // scenes they can leave a hole below the lowest start height, or lose

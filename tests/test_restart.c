@@ -101,6 +101,17 @@ static void reseal(unsigned char *bytes, size_t size) {
     put_u32(bytes + size - 4, crc32_of(bytes, size - 4));
 }
 
+/* Writes to `path` the file `good` with another format version and more
+ * flags, its checksums made right again (bytes: scratch of `size`). */
+static void write_with_header(const char *path, unsigned char *bytes, const unsigned char *good, size_t size,
+                              uint32_t version, uint32_t more_flags) {
+    memcpy(bytes, good, size);
+    put_u32(bytes + kOffsetVersion, version);
+    put_u32(bytes + kOffsetFlags, get_u32(bytes + kOffsetFlags) | more_flags);
+    reseal(bytes, size);
+    write_file(path, bytes, size);
+}
+
 /* Everything a host can read back, bit for bit: heights, the five ledger
  * figures, the stable step, and the step information (the cell updates only
  * when `with_cost`: a loaded grid looks at every tile once more, which costs
@@ -448,16 +459,9 @@ static void test_values_are_checked_behind_the_checksum(void **state) {
 
     /* The relaxations' flags: DPSM_RELAX_AUTO's needs version 3, and a file
      * cannot ask for both. */
-    memcpy(bytes, good, size);
-    put_u32(bytes + kOffsetVersion, 2);
-    put_u32(bytes + kOffsetFlags, get_u32(bytes + kOffsetFlags) | 64u);
-    reseal(bytes, size);
-    write_file(bad, bytes, size);
+    write_with_header(bad, bytes, good, size, 2, 64u);
     require_refused(bad, "need version 3", "the flag of DPSM_RELAX_AUTO in version 2");
-    put_u32(bytes + kOffsetVersion, 3);
-    put_u32(bytes + kOffsetFlags, get_u32(bytes + kOffsetFlags) | 32u);
-    reseal(bytes, size);
-    write_file(bad, bytes, size);
+    write_with_header(bad, bytes, good, size, 3, 64u | 32u);
     require_refused(bad, "both relaxation flags", "both relaxations");
 
     memcpy(bytes, good, size);
@@ -581,17 +585,10 @@ static void test_block_files_need_dpsm_load_mpi(void **state) {
     }
     /* The flag without the record: the file is 48 bytes short. */
     unsigned char *bytes = malloc(size);
-    memcpy(bytes, good, size);
-    put_u32(bytes + kOffsetVersion, 2);
-    put_u32(bytes + kOffsetFlags, get_u32(bytes + kOffsetFlags) | 16u);
-    reseal(bytes, size);
-    write_file(bad, bytes, size);
+    write_with_header(bad, bytes, good, size, 2, 16u);
     require_refused(bad, "truncated", "the block flag without its record");
     /* Version 2 without the flag is a grid of its own. */
-    memcpy(bytes, good, size);
-    put_u32(bytes + kOffsetVersion, 2);
-    reseal(bytes, size);
-    write_file(bad, bytes, size);
+    write_with_header(bad, bytes, good, size, 2, 0u);
     out = NULL;
     CHECK_OK(NULL, dpsm_load(bad, &out));
     dpsm_destroy(out);
