@@ -171,9 +171,31 @@ void Grid::copy_heights_between_sweeps(const double *y, const CellBox &within) {
         }
 }
 
-void Grid::drop_residuals() {
+Grid::SavedResiduals Grid::drop_residuals() {
+    SavedResiduals saved;
+    const CellBox box = residual_bounds_.grown_within(0, CellBox{0, geometry_.nx, 0, geometry_.ny});
+    saved.box = box;
+    if (!box.empty()) {
+        saved.values.reserve(static_cast<std::size_t>((box.i1 - box.i0) * (box.j1 - box.j0)));
+        for (std::int64_t j = box.j0; j < box.j1; ++j)
+            saved.values.insert(saved.values.end(), residuals_.begin() + (box.i0 + geometry_.nx * j),
+                                residuals_.begin() + (box.i1 + geometry_.nx * j));
+    }
     set_heights_between_sweeps(heights_.data(), residual_bounds_);
     residual_bounds_ = CellBox{};
+    return saved;
+}
+
+void Grid::restore_residuals(const SavedResiduals &saved) {
+    const CellBox &box = saved.box;
+    if (box.empty()) return;
+    const std::int64_t width = box.i1 - box.i0;
+    for (std::int64_t j = box.j0; j < box.j1; ++j)
+        std::copy_n(saved.values.begin() + width * (j - box.j0), width,
+                    residuals_.begin() + (box.i0 + geometry_.nx * j));
+    residual_bounds_.add(box);
+    if (active_) active_->mark_block(box.i0, box.j0, width, box.j1 - box.j0);
+    if (tiled_ && active_) tiled_workspace_changed(*tiled_, *active_, box);
 }
 
 void Grid::read_heights(const Block &block, double *values) const {

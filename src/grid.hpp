@@ -167,8 +167,14 @@ public:
     void residuals_written(const CellBox &box) { residual_bounds_.add(box); }
     // Every residual becomes 0, waking the cells whose residual was not (the
     // relaxation to rest has no use for them); costs what the residuals that
-    // steps left behind cover, not the grid.
-    void drop_residuals();
+    // steps left behind cover, not the grid. Returns what they were, for
+    // restore_residuals.
+    struct SavedResiduals {
+        CellBox box;
+        std::vector<float> values;  // the box's, row by row
+    };
+    SavedResiduals drop_residuals();
+    void restore_residuals(const SavedResiduals &saved);
     void swap_heights(std::vector<double> &heights, std::vector<float> &residuals) {
         heights_.swap(heights);
         residuals_.swap(residuals);

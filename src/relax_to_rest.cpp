@@ -185,7 +185,7 @@ class Evaluator {
 public:
     Evaluator(Grid &grid, double dt)
         : grid_(grid), dt_(dt), nx_(grid.geometry().nx), ws_(grid.relax_workspace()) {
-        grid.drop_residuals();  // the sweeps without residuals need them 0
+        residuals_ = grid.drop_residuals();  // the sweeps without residuals need them 0
     }
     // Every box empty again, for the next step.
     ~Evaluator() {
@@ -297,10 +297,11 @@ public:
     void finish(const double *y) {
         for (const std::int64_t t : ws_.live_tiles) grid_.set_heights_between_sweeps(y, ws_.live[t]);
     }
-    // The grid's heights become the start's again, and every cell a sweep
-    // read may move: the active set as it was, or wider.
+    // The grid becomes the start again, residuals included, and every cell a
+    // sweep read may move: the active set as it was, or wider.
     void restore_start() {
         finish(ws_.start.get());
+        grid_.restore_residuals(residuals_);
         for (const std::int64_t t : ws_.filled_tiles) {
             const CellBox &box = ws_.filled[t];
             grid_.active_set().mark_block(box.i0, box.j0, box.i1 - box.i0, box.j1 - box.j0);
@@ -346,6 +347,7 @@ private:
     double dt_;
     std::int64_t nx_;
     RelaxWorkspace &ws_;
+    Grid::SavedResiduals residuals_;  // as they were before the relaxation
     std::vector<LevelSummary> levels_;
     std::int64_t evaluations_ = 0;
     double visited_ = 0.0, last_visited_ = 0.0;
@@ -380,7 +382,7 @@ void require_supported(const Grid &grid) {
 
 }  // namespace
 
-bool relax_to_rest(Grid &grid, double &cells_visited) {
+bool relax_to_rest(Grid &grid, std::int64_t budget, bool rest_or_nothing, double &cells_visited) {
     cells_visited = 0.0;
     require_supported(grid);
     prepare_tiled_sweep(grid, grid.threads());  // allocates before anything changes
@@ -399,7 +401,6 @@ bool relax_to_rest(Grid &grid, double &cells_visited) {
     double *y0 = rates.state(0), *yjm1 = rates.state(1), *yjm2 = rates.state(2), *yj = rates.state(3);
     double *f0 = rates.rates();
     const double switch_excess = kSwitchExcessShare * std::tan(grid.min_repose_angle());
-    const std::int64_t budget = grid.max_substeps();
     const CellLoops &loops = cell_loops();
 
     // The flow's path by RKC steps, while much sand moves.
@@ -493,7 +494,8 @@ bool relax_to_rest(Grid &grid, double &cells_visited) {
     const MassLedger &ledger = grid.ledger();
     const double mass = std::fabs(ledger.external.value() + ledger.sourced.value() - ledger.outflow.value() -
                                   ledger.unmet.value());
-    if (!rates.within_start_extremes(x) || (!sinks && std::fabs(left) > kMassSlack * mass)) {
+    if (!rates.within_start_extremes(x) || (!sinks && std::fabs(left) > kMassSlack * mass) ||
+        (rest_or_nothing && !rested)) {
         rates.restore_start();
         return false;
     }

@@ -62,10 +62,24 @@ StepAgreement agree_before_step(Grid &grid, double dt) {
 }  // namespace
 
 void step(Grid &grid, double dt) {
-    // The default relaxes to rest where it can; a distributed grid cannot, on
-    // every rank alike, so its ranks all take the time-accurate path.
-    const bool relax = grid.relaxation() == kToRest ||
-                       (grid.relaxation() == kAutoRelaxation && relaxation_unsupported(grid) == nullptr);
+    // The default relaxes to rest where the relaxation supports the scene and
+    // gets there in no more flux evaluations than the time-accurate step would
+    // take sub-steps over dt: then the sand would (nearly) have come to rest
+    // within dt anyway, and the relaxation is the shorter way there. A flow
+    // that lasts longer than that is stepped in time, and a dt of fewer than
+    // kAutoLeastSubsteps sub-steps is stepped in time at once (the relaxation
+    // rarely rests so soon, and trying would double the step's cost). A
+    // distributed grid is not supported, on every rank alike, so its ranks
+    // all step in time.
+    constexpr double kAutoLeastSubsteps = 16.0;
+    const Relaxation relaxation = grid.relaxation();
+    bool relax = relaxation == kToRest;
+    std::int64_t budget = grid.max_substeps();
+    if (relaxation == kAutoRelaxation && relaxation_unsupported(grid) == nullptr) {
+        const double substeps = std::ceil(dt / stable_dt(grid));
+        relax = substeps >= kAutoLeastSubsteps;
+        if (substeps < static_cast<double>(budget)) budget = static_cast<std::int64_t>(substeps);
+    }
     if (!relax) {
         step_in_time(grid, dt);
         return;
@@ -81,15 +95,20 @@ void step(Grid &grid, double dt) {
     }
     // No time scale: dt only says that time passed.
     double tried = 0.0;
-    if (relax_to_rest(grid, tried)) return;
-    // Where the relaxation could not reach a rest of the model's own, the
-    // time-accurate sub-steps do, from the same start, for as long as it takes
-    // (the scene comes to rest by itself: the relaxation refuses the others).
-    step_in_time(grid, std::numeric_limits<double>::max());
+    const bool automatic = relaxation == kAutoRelaxation;
+    if (relax_to_rest(grid, budget, automatic, tried)) return;
+    // Where the relaxation could not reach a rest of the model's own (or, by
+    // default, not within its budget), the time-accurate sub-steps take over
+    // from the same start: by default over dt; asked to rest, to rest, within
+    // as many sub-steps as the relaxation had evaluations (dpsm_set_max_substeps).
+    if (automatic)
+        step_in_time(grid, dt);
+    else
+        step_in_time(grid, std::numeric_limits<double>::infinity(), budget);
     grid.last_step().cell_updates += tried;
 }
 
-void step_in_time(Grid &grid, double dt) {
+void step_in_time(Grid &grid, double dt, std::int64_t most) {
     const StepAgreement state = agree_before_step(grid, dt);  // first: it may set the smallest angle
     const double dt_max = stable_dt(grid);
     const double needed = std::ceil(dt / dt_max);
@@ -109,7 +128,7 @@ void step_in_time(Grid &grid, double dt) {
 
     // Without a bound, step at dt_max until the surface rests (it must, or the
     // check above would have refused).
-    const std::int64_t substeps = bounded ? std::max<std::int64_t>(1, static_cast<std::int64_t>(needed)) : INT64_MAX;
+    const std::int64_t substeps = bounded ? std::max<std::int64_t>(1, static_cast<std::int64_t>(needed)) : most;
     const double sub_dt = bounded ? dt / static_cast<double>(substeps) : dt_max;
     const bool source_active = state.source_active;
     MassLedger &ledger = grid.ledger();
@@ -165,7 +184,7 @@ void step_in_time(Grid &grid, double dt) {
         }
     }
     if (grid.decomposition()) info.cell_updates = grid.global_sum(info.cell_updates);
-    info.time_integrated = info.at_rest ? static_cast<double>(info.substeps) * sub_dt : dt;
+    info.time_integrated = info.at_rest || !bounded ? static_cast<double>(info.substeps) * sub_dt : dt;
     grid.last_step() = info;
 }
 

@@ -14,9 +14,11 @@ double stable_dt(const Grid &grid);
 // asks (grid.hpp).
 void step(Grid &grid, double dt);
 
-// Advances exactly dt (or until rest) by time-accurate sub-steps. Throws
+// Advances exactly dt (or until rest) by time-accurate sub-steps; a dt of
+// more than 2^53 stable sub-steps (infinity included) steps at the stable
+// sub-step until rest, at most `most` of them. Throws
 // Error(DPSM_ERR_WORK_LIMIT) before changing anything if a scene that can
 // flow forever needs more sub-steps than the grid's limit.
-void step_in_time(Grid &grid, double dt);
+void step_in_time(Grid &grid, double dt, std::int64_t most = INT64_MAX);
 
 }  // namespace dpsm
