@@ -510,7 +510,6 @@ std::int64_t tiled_sweep(Grid &grid, int levels, double dt, std::vector<LevelSum
         ws.last_written.add(ws.boxes[k]);
         ws.stale_tiles.push_back(ws.visit[k]);
     }
-    if (residuals) grid.residuals_written(ws.last_written);
 
     // New hot boxes: the cells touching moving faces in any level, grown by the
     // one cell a last move can make steep. Sums in tile order, whatever the threads.
@@ -530,6 +529,9 @@ std::int64_t tiled_sweep(Grid &grid, int levels, double dt, std::vector<LevelSum
                           ws.origin[2 * k + 1] + st.hot_r0 - 1, ws.origin[2 * k + 1] + st.hot_r1 + 1);
         }
         active.hot(ws.visit[k]) = moved;
+        // A residual changes only with its cell's height, which only a moving
+        // face changes: within the new hot box.
+        if (residuals) grid.residuals_written(moved);
     }
     if (decomposition) decomposition->after_sweep(summaries);  // every rank takes the same sub-steps
     return visited_cells;
