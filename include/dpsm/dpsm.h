@@ -123,8 +123,9 @@ typedef struct dpsm_grid dpsm_grid;
 /** To rest in each dpsm_step(), in few flux evaluations, without a time
  *  scale; refused on scenes it does not support. */
 #define DPSM_RELAX_TO_REST 1
-/** The default: ::DPSM_RELAX_TO_REST where the scene allows it, else
- *  ::DPSM_RELAX_TIME_ACCURATE, decided anew at every dpsm_step(). */
+/** The default: ::DPSM_RELAX_TO_REST where the scene allows it and the
+ *  relaxation rests within as many flux evaluations as `dt` holds stable
+ *  sub-steps, else ::DPSM_RELAX_TIME_ACCURATE; decided at every dpsm_step(). */
 #define DPSM_RELAX_AUTO 2
 /** @} */
 
@@ -303,6 +304,13 @@ DPSM_API int dpsm_set_scheme(dpsm_grid *g, int scheme);
  * rest is not), ::DPSM_INFO_TIME_INTEGRATED is 0, and ::DPSM_INFO_AT_REST is
  * 1 unless the sub-step limit (dpsm_set_max_substeps()) ran out first.
  *
+ * Where the state it reaches would lie beyond the extremes of the start's
+ * sand (and of the levels open sides and cells hold), or a closed scene's
+ * mass would be off by more than 1e-14, the step goes back to its start and
+ * takes time-accurate sub-steps to rest instead, at most as many as
+ * dpsm_set_max_substeps() allows; then ::DPSM_INFO_TIME_INTEGRATED is the
+ * time that took.
+ *
  * Like the time-accurate steps it costs what the scene needs: each evaluation
  * visits only the tiles near moving sand (::DPSM_INFO_CELL_UPDATES counts
  * their cells), its work arrays are touched only where sand moved, and a step
@@ -316,13 +324,20 @@ DPSM_API int dpsm_set_scheme(dpsm_grid *g, int scheme);
  * open cells at different levels. A host adds its deposit with
  * dpsm_add_heights_region() instead of a source.
  *
- * ::DPSM_RELAX_AUTO, the default, relaxes to rest wherever
- * ::DPSM_RELAX_TO_REST would be accepted, and takes time-accurate sub-steps
- * over `dt` wherever it would be refused; it decides at every dpsm_step(), so
- * a grid switches to time-accurate steps while a source is active and back
- * once it is switched off. ::DPSM_INFO_TIME_INTEGRATED tells which it took (0
- * after a relaxation to rest). A host that needs the flow's timing (a
- * transient, a coupling through the avalanche's duration) asks for
+ * ::DPSM_RELAX_AUTO, the default, relaxes to rest where that is the shorter
+ * way to where the time-accurate steps would go: where ::DPSM_RELAX_TO_REST
+ * would be accepted, `dt` holds at least 16 stable sub-steps
+ * (dpsm_stable_dt()), and the relaxation rests within as many flux
+ * evaluations as `dt` holds sub-steps (the sand would then have come to rest
+ * within about `dt` anyway). Otherwise it takes the time-accurate sub-steps
+ * over `dt`: where the relaxation is refused (a source that pours, a bed, a
+ * distributed grid, ...), where `dt` is short, and, from the same start
+ * (residuals included), where the flow outlasts the relaxation's budget. So
+ * a step by default never costs much more than the time-accurate one plus
+ * what the relaxation tried, and a flow that lasts longer than `dt` is
+ * advanced in time. ::DPSM_INFO_TIME_INTEGRATED tells which it took (0 after
+ * a relaxation to rest). A host that needs the flow's timing in every step
+ * (a transient, a coupling through the avalanche's duration) asks for
  * ::DPSM_RELAX_TIME_ACCURATE; \ref guide_time_steps compares the three.
  *
  * @param g           the grid.
@@ -463,10 +478,11 @@ DPSM_API int dpsm_stable_dt(const dpsm_grid *g, double *dt);
  *        allows it) straight to rest.
  *
  * By default (::DPSM_RELAX_AUTO) a step on a 2D grid whose scene the fast
- * relaxation supports brings the surface to rest whatever `dt`, in far fewer
- * flux evaluations than sub-steps would take; dpsm_set_relaxation() tells
- * which scenes those are and how to ask for time-accurate steps instead.
- * What follows describes the time-accurate steps.
+ * relaxation supports brings the surface to rest, in far fewer flux
+ * evaluations than sub-steps would take, when it gets there within as many
+ * evaluations as `dt` holds sub-steps; dpsm_set_relaxation() tells which
+ * scenes those are and how to ask for time-accurate steps always. What
+ * follows describes the time-accurate steps.
  *
  * Sub-steps of at most dpsm_stable_dt() are taken. When the surface is at rest
  * (no face steeper than `tan(theta) * (1 + tol)`, see
