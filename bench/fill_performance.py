@@ -66,7 +66,7 @@ def speed_table(data):
                     if rounds == "1" else
                     f"{int(auto['deposits']) * int(rounds)} such heaps on {auto['deposits']} growing piles")
             out.append(f"| {what}, each stepped to rest: seconds by the default (relaxed to rest) / "
-                       f"time-accurate | {float(auto['seconds']):.3f} s ({auto['substeps']} flux evaluations) / "
+                       f"time-accurate | {float(auto['seconds']):.3f} s ({auto['substeps']} flux evaluations and sub-steps) / "
                        f"{float(timed['seconds']):.3f} s ({timed['substeps']} sub-steps) | | | | |")
     return out
 
