@@ -49,19 +49,7 @@ TiledWorkspace &Grid::tiled_workspace() {
 }
 
 RelaxWorkspace &Grid::relax_workspace() {
-    if (!relax_) {
-        auto ws = std::make_unique<RelaxWorkspace>();
-        const std::size_t cells = heights_.size(), tiles = static_cast<std::size_t>(active_->tiles());
-        // Not value-initialised: a page is touched only where a step needs it.
-        for (auto &state : ws->states) state.reset(new double[cells]);
-        ws->start.reset(new double[cells]);
-        ws->rates.reset(new double[cells]);
-        ws->filled.resize(tiles);
-        ws->live.resize(tiles);
-        ws->filled_tiles.reserve(tiles);
-        ws->live_tiles.reserve(tiles);
-        relax_ = std::move(ws);
-    }
+    if (!relax_) relax_ = std::make_unique<RelaxWorkspace>(heights_.size(), static_cast<std::size_t>(active_->tiles()));
     return *relax_;
 }
 

@@ -167,6 +167,18 @@ const CellLoops &cell_loops() {
     return plain;
 }
 
+}  // namespace
+
+RelaxWorkspace::RelaxWorkspace(std::size_t cells, std::size_t tiles)
+    // Not value-initialised: a page is touched only where a step needs it.
+    : start(new double[cells]), rates(new double[cells]), filled(tiles), live(tiles) {
+    for (auto &state : states) state.reset(new double[cells]);
+    filled_tiles.reserve(tiles);
+    live_tiles.reserve(tiles);
+}
+
+namespace {
+
 // The states of the relaxation (the RKC stages, momentum's points) and the
 // rates at a step's start, each an array over the whole grid of which only
 // the tiles near moving sand are ever touched: piles here and there on a

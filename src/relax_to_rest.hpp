@@ -5,6 +5,7 @@
 // momentum finish the small tail (docs/performance.md, "Larger steps").
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <memory>
 #include <vector>
@@ -17,6 +18,7 @@ namespace dpsm {
 // touches only the pages of the tiles where sand moves, not fresh ones
 // (relax_to_rest.cpp). Outside a step every box is empty.
 struct RelaxWorkspace {
+    RelaxWorkspace(std::size_t cells, std::size_t tiles);
     static constexpr int kStates = 4;
     std::unique_ptr<double[]> states[kStates], start, rates;  // over the grid, not initialised
     std::vector<CellBox> filled, live;                       // per tile of the active set
