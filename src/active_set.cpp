@@ -35,6 +35,7 @@ ActiveSet::ActiveSet(std::int64_t nx, std::int64_t ny)
       tiles_x_((nx + kTile - 1) / kTile),
       tiles_y_((ny + kTile - 1) / kTile),
       hot_(static_cast<std::size_t>(tiles_x_ * tiles_y_)),
+      driven_(hot_.size()),
       source_(hot_.size()),
       masked_(hot_.size(), 0),
       has_source_(hot_.size(), 0) {
@@ -81,13 +82,31 @@ void ActiveSet::refresh_source(const Grid &grid) {
     const std::vector<double> &q = grid.source();
     if (q.empty()) return;
     const std::vector<std::uint8_t> &kind = grid.kinds();
-    for (std::int64_t j = 0; j < ny_; ++j)
-        for (std::int64_t i = 0; i < nx_; ++i) {
-            const std::int64_t c = i + nx_ * j;
-            if (q[c] == 0.0 || kind[c] != kSand) continue;
-            source_[(i / kTile) + tiles_x_ * (j / kTile)].add(i, i + 1, j, j + 1);
-            for_tiles_reaching(i, j, [&](std::int64_t t) { has_source_[t] = 1; });
+    auto acts = [&](std::int64_t c) { return q[c] != 0.0 && kind[c] == kSand; };
+    // Per tile and row, the first and the last cell with a source: a host
+    // sets a source every step, often on every cell, so each row's scan stops
+    // at its first cell from either end.
+    for (std::int64_t t = 0; t < tiles(); ++t) {
+        const CellBox cells = tile_cells(t);
+        for (std::int64_t j = cells.j0; j < cells.j1; ++j) {
+            std::int64_t first = cells.i0;
+            while (first < cells.i1 && !acts(first + nx_ * j)) ++first;
+            if (first == cells.i1) continue;
+            std::int64_t last = cells.i1 - 1;
+            while (!acts(last + nx_ * j)) --last;
+            source_[t].add(first, last + 1, j, j + 1);
         }
+    }
+    // A tile sees a source when its sweep reads a cell with one.
+    for (std::int64_t t = 0; t < tiles(); ++t) {
+        if (source_[t].empty()) continue;
+        const std::int64_t ti = t % tiles_x_, tj = t / tiles_x_;
+        for (std::int64_t uj = std::max<std::int64_t>(0, tj - 1); uj <= std::min(tiles_y_ - 1, tj + 1); ++uj)
+            for (std::int64_t ui = std::max<std::int64_t>(0, ti - 1); ui <= std::min(tiles_x_ - 1, ti + 1); ++ui) {
+                const std::int64_t u = ui + tiles_x_ * uj;
+                if (source_[t].reaches(tile_cells(u), kReach)) has_source_[u] = 1;
+            }
+    }
 }
 
 void ActiveSet::set_remote_activity(const std::vector<CellBox> &hot, const std::vector<CellBox> &sources) {
@@ -105,12 +124,15 @@ void ActiveSet::set_remote_activity(const std::vector<CellBox> &hot, const std::
             for (std::int64_t ti = t0; ti <= t1; ++ti) {
                 const std::int64_t t = ti + tiles_x_ * tj;
                 if (!box.reaches(tile_cells(t), kReach)) continue;
-                remote_[t].add(box);
-                if (source) remote_source_[t] = 1;
+                if (source)
+                    remote_source_[t] = 1;
+                else
+                    remote_[t].add(box);
             }
     };
     for (const CellBox &box : hot) spread(box, false);
-    // A source changes its cells every sub-step, steepening the faces within one.
+    // The neighbours' sources only say which tiles must see them: their
+    // driven cells come with the hot boxes.
     for (const CellBox &box : sources) spread(box.grown(1), true);
 }
 
@@ -125,8 +147,26 @@ CellBox ActiveSet::sources_near(std::int64_t t) const {
 
 bool ActiveSet::may_move() const {
     for (std::int64_t t = 0; t < tiles(); ++t)
-        if (!hot_[t].empty() || !source_[t].empty()) return true;
+        if (!hot_[t].empty() || !driven_[t].empty()) return true;
     return false;
+}
+
+bool ActiveSet::any_driven() const {
+    for (const CellBox &box : driven_)
+        if (!box.empty()) return true;
+    return false;
+}
+
+void ActiveSet::drive_every_source() { driven_ = source_; }
+
+void ActiveSet::forget_driven() { std::fill(driven_.begin(), driven_.end(), CellBox{}); }
+
+void ActiveSet::end_of_step() {
+    for (std::size_t t = 0; t < driven_.size(); ++t) {
+        if (driven_[t].empty()) continue;
+        hot_[t].add(driven_[t].grown(1));
+        driven_[t] = CellBox{};
+    }
 }
 
 void ActiveSet::tiles_to_visit(int levels, std::vector<std::int64_t> &tiles, std::vector<CellBox> &boxes,
@@ -135,9 +175,9 @@ void ActiveSet::tiles_to_visit(int levels, std::vector<std::int64_t> &tiles, std
     // cell within one of it changed: the cells touching moving faces spread by
     // at most one cell a sub-step. A hot box holds the cells that may touch a
     // moving face in a sweep's first sub-step, so in its sub-step s such cells
-    // lie within s - 1 of it: a hot box reaches levels - 1 cells. A source
-    // changes its cells every sub-step, steepening the faces within one of
-    // them: grown by one it is a hot box.
+    // lie within s - 1 of it: a hot box reaches levels - 1 cells. A driven
+    // box holds cells whose faces a source may make steep in any sub-step:
+    // grown by one it is a hot box.
     const std::int64_t reach = levels - 1;
     tiles.clear();
     boxes.clear();
@@ -151,7 +191,7 @@ void ActiveSet::tiles_to_visit(int levels, std::vector<std::int64_t> &tiles, std
         for (std::int64_t ti = 0; ti < tiles_x_; ++ti) {
             const std::int64_t t = ti + tiles_x_ * tj;
             if (!remote_.empty() && !remote_[t].empty()) near_activity_[t] = 1;
-            if (hot_[t].empty() && source_[t].empty()) continue;
+            if (hot_[t].empty() && driven_[t].empty()) continue;
             for (std::int64_t uj = std::max<std::int64_t>(0, tj - 1); uj <= std::min(tiles_y_ - 1, tj + 1); ++uj)
                 for (std::int64_t ui = std::max<std::int64_t>(0, ti - 1); ui <= std::min(tiles_x_ - 1, ti + 1); ++ui)
                     near_activity_[ui + tiles_x_ * uj] = 1;
@@ -169,7 +209,7 @@ void ActiveSet::tiles_to_visit(int levels, std::vector<std::int64_t> &tiles, std
                     const std::int64_t ui = ti + di, uj = tj + dj;
                     if (ui < 0 || uj < 0 || ui >= tiles_x_ || uj >= tiles_y_) continue;
                     const std::int64_t u = ui + tiles_x_ * uj;
-                    for (const CellBox &from : {hot_[u], source_[u].grown(1)}) {
+                    for (const CellBox &from : {hot_[u], driven_[u].grown(1)}) {
                         const CellBox part = from.grown_within(reach, cells);
                         if (part.empty()) continue;
                         reached.add(part);

@@ -1,8 +1,11 @@
 // The active set of a 2D grid: which tiles of 64 x 64 cells can move. A
 // tile's hot box holds the cells that carried sand in its last sweep (or that
-// the host changed since); a sweep visits a tile when a hot box, or a source,
-// lies near enough to reach it within the sweep. Everything else is exactly at
-// rest under the dead-zone flux law, so skipping it changes no result.
+// the host changed since); its driven box, during a step, the cells whose
+// faces a source may make steep within the step (tiled_sweep.hpp: a source
+// elsewhere is applied in closed form). A sweep visits a tile when a hot or
+// driven box lies near enough to reach it within the sweep. Everything else
+// is exactly at rest under the dead-zone flux law, so skipping it changes no
+// result.
 #pragma once
 
 #include <climits>
@@ -68,7 +71,7 @@ public:
     void refresh_masks(const Grid &grid);
     void refresh_source(const Grid &grid);
 
-    bool may_move() const;  // some tile is hot or has a source
+    bool may_move() const;  // some tile is hot or driven
     // The tiles a sweep of `levels` sub-steps must visit, in order, and in each
     // the box of its cells that can change (the rest of the tile stays as it is)
     // and the box of the hot boxes and sources (grown by one) that reach it,
@@ -77,6 +80,20 @@ public:
                         std::vector<CellBox> &seeds) const;
 
     CellBox &hot(std::int64_t t) { return hot_[t]; }
+    const CellBox &hot(std::int64_t t) const { return hot_[t]; }
+    // The driven boxes of a step (set by the stepper at its start); at its
+    // end they join the hot boxes, since their last changes may have made
+    // faces steep that no later sub-step looked at.
+    CellBox &driven(std::int64_t t) { return driven_[t]; }
+    const CellBox &driven(std::int64_t t) const { return driven_[t]; }
+    bool any_driven() const;
+    void drive_every_source();  // every source's cells are driven (sources applied at each sub-step)
+    void end_of_step();         // the driven boxes join the hot ones and are cleared
+    void forget_driven();       // a refused step: the driven boxes are cleared
+    // This tile's cells with a source in it; and whether a source of a
+    // distributed grid's neighbour lies within its reach.
+    const CellBox &sources(std::int64_t t) const { return source_[t]; }
+    bool has_remote_source(std::int64_t t) const { return !remote_source_.empty() && remote_source_[t] != 0; }
     // The box of this grid's cells with a source in tile t and the tiles
     // around it: all a sweep of t reads (the sources of a distributed grid's
     // neighbours come with its halo).
@@ -88,9 +105,10 @@ public:
 
     // A distributed grid's view of its neighbours (decomposition.hpp): boxes of
     // cells beyond this block, in its coordinates, that may move in the coming
-    // sweep (their hot boxes) or hold a source. Tiles they reach are visited
-    // and see those sources, as if the neighbours' tiles were this grid's.
-    // Replaces the previous view; a serial grid never sets one.
+    // sweep (their hot and driven boxes) or hold a source. Tiles the first
+    // reach are visited, and tiles the second reach see those sources, as if
+    // the neighbours' tiles were this grid's. Replaces the previous view; a
+    // serial grid never sets one.
     void set_remote_activity(const std::vector<CellBox> &hot, const std::vector<CellBox> &sources);
 
 private:
@@ -100,6 +118,7 @@ private:
 
     std::int64_t nx_, ny_, tiles_x_, tiles_y_;
     std::vector<CellBox> hot_;
+    std::vector<CellBox> driven_;          // per tile, during a step: see driven()
     std::vector<CellBox> source_;          // cells with a source, per tile
     std::vector<std::uint8_t> masked_;     // walls or sinks within a tile's reach (the sweep adds the edge)
     std::vector<std::uint8_t> has_source_; // a source within a tile's reach

@@ -205,6 +205,23 @@ void save_block(const dpsm::Grid &grid, const dpsm::Decomposition &d, const char
              "of files; this rank's block went to ", path);
 }
 
+const char *side_name(int side) {
+    static const char *const names[4] = {"DPSM_XMIN", "DPSM_XMAX", "DPSM_YMIN", "DPSM_YMAX"};
+    return names[side];
+}
+
+// A side this grid has: the four of a 2D grid, the two of a line, the outer
+// one of an axisymmetric grid.
+void require_side(const dpsm_grid *g, int side, const char *function) {
+    if (side < DPSM_XMIN || side > DPSM_YMAX)
+        fail(DPSM_ERR_UNKNOWN_ENUM, function, "side = ", side, " is not DPSM_XMIN, DPSM_XMAX, DPSM_YMIN or DPSM_YMAX");
+    const dpsm::Geometry &geo = g->core.geometry();
+    if (geo.dim == 1 && side >= DPSM_YMIN)
+        fail(DPSM_ERR_NOT_APPLICABLE, function, "a 1D grid has no y sides (side = ", side_name(side), ")");
+    if (geo.axisymmetric && side == DPSM_XMIN)
+        fail(DPSM_ERR_NOT_APPLICABLE, function, "side = DPSM_XMIN of an axisymmetric grid is the axis, not a boundary");
+}
+
 void require_angle(double theta, const char *function, const char *name) {
     require_finite(theta, function, name);
     if (!(theta > 0.0 && theta < 0.5 * M_PI))
@@ -295,14 +312,9 @@ int dpsm_set_boundary(dpsm_grid *g, int side, int kind) {
     const char *fn = "dpsm_set_boundary";
     return guarded(g, fn, [&] {
         require_grid(g, fn);
-        if (side < DPSM_XMIN || side > DPSM_YMAX)
-            fail(DPSM_ERR_UNKNOWN_ENUM, fn, "side = ", side, " is not DPSM_XMIN, DPSM_XMAX, DPSM_YMIN or DPSM_YMAX");
         if (kind != DPSM_OPEN && kind != DPSM_WALL)
             fail(DPSM_ERR_UNKNOWN_ENUM, fn, "kind = ", kind, " is not DPSM_OPEN or DPSM_WALL");
-        if (g->core.geometry().dim == 1 && side >= DPSM_YMIN)
-            fail(DPSM_ERR_NOT_APPLICABLE, fn, "a 1D grid has no y sides (side = ", side, ")");
-        if (g->core.geometry().axisymmetric && side == DPSM_XMIN)
-            fail(DPSM_ERR_NOT_APPLICABLE, fn, "side = DPSM_XMIN of an axisymmetric grid is the axis, not a boundary");
+        require_side(g, side, fn);
         g->core.set_side_open(side, kind == DPSM_OPEN);
     });
 }
@@ -515,15 +527,7 @@ int dpsm_set_bedrock(dpsm_grid *g, const double *zb) {
     const char *fn = "dpsm_set_bedrock";
     return guarded(g, fn, [&] {
         require_grid(g, fn);
-        if (zb) {
-            require_finite_array(g, zb, fn, "zb");
-            const dpsm::Geometry &geo = g->core.geometry();
-            const std::vector<double> &h = g->core.heights();
-            for (std::int64_t c = 0; c < geo.cells(); ++c)
-                if (zb[c] > h[c])
-                    fail(DPSM_ERR_INVALID_VALUE, fn, "zb[", c, "] (cell i = ", c % geo.nx, ", j = ", c / geo.nx,
-                         ") = ", zb[c], " lies above the cell's height ", h[c]);
-        }
+        if (zb) require_finite_array(g, zb, fn, "zb");
         g->core.set_bed(zb);
     });
 }
@@ -561,6 +565,80 @@ int dpsm_set_static_angle(dpsm_grid *g, double radians) {
         require_grid(g, fn);
         require_angle(radians, fn, "radians");
         g->core.set_static_angle(radians);
+    });
+}
+
+int dpsm_set_side_levels(dpsm_grid *g, int side, const double *levels) {
+    const char *fn = "dpsm_set_side_levels";
+    return guarded(g, fn, [&] {
+        require_grid(g, fn);
+        require_side(g, side, fn);
+        if (levels) {
+            const dpsm::Geometry &geo = g->core.geometry();
+            const bool x_side = side <= DPSM_XMAX;
+            const std::int64_t n = x_side ? geo.ny : geo.nx;
+            for (std::int64_t k = 0; k < n; ++k) {
+                if (std::isfinite(levels[k]) && std::fabs(levels[k]) <= kMaxMagnitude) continue;
+                if (!std::isfinite(levels[k]))
+                    fail(DPSM_ERR_INVALID_VALUE, fn, "levels[", k, "] (the face of cell ", x_side ? "j = " : "i = ", k,
+                         " on side ", side_name(side), ") is ", describe(levels[k]));
+                fail(DPSM_ERR_INVALID_VALUE, fn, "levels[", k, "] (the face of cell ", x_side ? "j = " : "i = ", k,
+                     " on side ", side_name(side), ") = ", levels[k], " is outside the supported range [-1e50, 1e50]");
+            }
+        }
+        g->core.set_side_levels(side, levels);
+    });
+}
+
+int dpsm_get_side_outflow(const dpsm_grid *g, int side, double *value) {
+    const char *fn = "dpsm_get_side_outflow";
+    return guarded(g, fn, [&] {
+        require_grid(g, fn);
+        const bool known = side >= DPSM_XMIN && side <= DPSM_YMAX;
+        const double local = known ? g->core.ledger().side_outflow[side].value() : 0.0;
+        double total = local;
+        // A distributed grid's figure is global; every rank takes part in the
+        // sum, a refusing one too, so that none waits for ever.
+        bool all_agreed = true;
+        if (dpsm::Decomposition *decomposition = g->core.decomposition())
+            all_agreed = decomposition->sum_unless_refused(local, !value || !known, total);
+        require_pointer(value, fn, "value");
+        require_side(g, side, fn);
+        if (!all_agreed)
+            fail(DPSM_ERR_INVALID_VALUE, fn,
+                 "another rank of the distributed grid refused its arguments (a NULL value or an unknown side), so no "
+                 "rank has the global figure");
+        *value = total;
+    });
+}
+
+int dpsm_set_face_flux_recording(dpsm_grid *g, int on) {
+    const char *fn = "dpsm_set_face_flux_recording";
+    return guarded(g, fn, [&] {
+        require_grid(g, fn);
+        if (on != 0 && on != 1) fail(DPSM_ERR_INVALID_VALUE, fn, "on = ", on, " is not 0 or 1");
+        g->core.set_face_flux_recording(on == 1);
+    });
+}
+
+int dpsm_get_face_fluxes(const dpsm_grid *g, double *fx, double *fy) {
+    const char *fn = "dpsm_get_face_fluxes";
+    return guarded(g, fn, [&] {
+        require_grid(g, fn);
+        require_pointer(fx, fn, "fx");
+        const dpsm::Geometry &geo = g->core.geometry();
+        if (geo.dim == 2) require_pointer(fy, fn, "fy");
+        if (geo.dim == 1 && fy)
+            fail(DPSM_ERR_INVALID_VALUE, fn, "fy must be NULL on a ", geo.axisymmetric ? "axisymmetric" : "1D",
+                 " grid: it has no y faces");
+        const dpsm::FaceFluxes *fluxes = g->core.face_fluxes_if_any();
+        if (!fluxes)
+            fail(DPSM_ERR_NOT_APPLICABLE, fn, "face fluxes are not recorded on this grid: call "
+                 "dpsm_set_face_flux_recording(g, 1) before the steps whose fluxes you need");
+        if (!fluxes->available)
+            fail(DPSM_ERR_NOT_APPLICABLE, fn, "the last step relaxed to rest (DPSM_RELAX_TO_REST), which has no face "
+                 "fluxes; step with DPSM_RELAX_TIME_ACCURATE or the default for them");
+        g->core.read_face_fluxes(fx, fy);
     });
 }
 

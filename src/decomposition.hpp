@@ -20,8 +20,11 @@
 // (i0, j0) of the global grid of global_nx x global_ny cells.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <vector>
+
+#include "side_levels.hpp"
 
 namespace dpsm {
 
@@ -38,12 +41,17 @@ struct HaloStore {
     std::int64_t i0 = 0, j0 = 0;                   // its first cell in the global grid
     std::int64_t global_nx = 0, global_ny = 0;
     std::vector<double> heights, sources;          // sources: 0 where none
+    std::vector<double> since;                     // lazy sources: as TileBuffers::since
     std::vector<float> residuals;
     std::vector<std::uint8_t> kinds;
     // The physics of real scenes: bed and tan(theta) (0 where none) as the
     // host last set them, and which cells were moving at the start of the sweep.
     std::vector<double> bed, tan_theta;
     std::vector<std::uint8_t> moving;
+    // The levels beyond the global domain's sides, each side whole (global_ny
+    // values for the x sides, global_nx for the y sides; empty: 0), as the
+    // blocks along it hold them (Decomposition::agree_before_step assembles them).
+    SideLevels side_levels;
 
     void resize(int halo_depth, std::int64_t block_nx, std::int64_t block_ny) {
         depth = halo_depth;
@@ -52,11 +60,16 @@ struct HaloStore {
         const std::size_t n = static_cast<std::size_t>(2 * depth * (nx + 2 * depth) + 2 * depth * ny);
         heights.assign(n, 0.0);
         sources.assign(n, 0.0);
+        since.assign(n, 0.0);
         residuals.assign(n, 0.0f);
         kinds.assign(n, 0);
         bed.assign(n, 0.0);
         tan_theta.assign(n, 0.0);
         moving.assign(n, 0);
+    }
+    // The level of the global ghost cell (i, j) (global coordinates).
+    double outside_level(std::int64_t i, std::int64_t j) const {
+        return level_beyond(side_levels, global_nx, global_ny, i, j);
     }
     // Whether block cell (i, j) (outside the block, within depth) is a cell of the global grid.
     bool in_domain(std::int64_t i, std::int64_t j) const {
@@ -80,6 +93,7 @@ struct StepAgreement {
     bool has_open_cells = false;  // open cells somewhere
     bool may_move = false;        // some tile anywhere is hot or has a source
     double open_level_min = 0.0, open_level_max = 0.0;  // over all open cells (when there are any)
+    double side_level_min = 0.0, side_level_max = 0.0;  // over the levels beyond the open sides (0 where none)
 };
 
 class Decomposition {
@@ -89,7 +103,8 @@ public:
     const HaloStore &halo() const { return halo_; }
 
     // Collective, at the start of dpsm_step: refreshes the halo's kinds,
-    // sources, bed and angles if the host changed them on any rank, checks
+    // sources, bed and angles, and the side levels along the global domain,
+    // if the host changed them on any rank, checks
     // that every rank steps the same dt with the same parameters (throws Error
     // otherwise, on every rank alike), gives the grid the smallest angle of
     // repose of all blocks (it sets the sub-step), and returns the global flags.

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <utility>
 
 #include "decomposition.hpp"
@@ -228,12 +229,17 @@ void Grid::restore(GridState &&s) {
     scheme_ = s.scheme;
     relaxation_ = s.relaxation;
     side_open_ = s.side_open;
+    side_levels_ = std::move(s.side_levels);
+    update_held_levels();
+    set_face_flux_recording(s.record_fluxes);
     heights_ = std::move(s.heights);
     residuals_ = std::move(s.residuals);
     residual_bounds_ = CellBox{};
     residual_bounds_.add(0, geometry_.nx, 0, geometry_.ny);
     kinds_ = std::move(s.kinds);
     source_ = std::move(s.source);
+    clock_.assign(geometry_.dim == 2 && !source_.empty() ? heights_.size() : 0, 0.0);
+    clock_base_ = 0.0;
     bed_ = std::move(s.bed);
     // The tangents and the smallest angle exactly as the setter computes them.
     set_angle_field(s.angle_field.empty() ? nullptr : s.angle_field.data());
@@ -266,17 +272,124 @@ void Grid::set_source(const double *q) {
         source_.assign(q, q + heights_.size());
     else
         source_.clear();
+    if (q && geometry_.dim == 2 && clock_.size() != heights_.size()) {
+        clock_.assign(heights_.size(), 0.0);
+        if (tiled_) tiled_->all_stale = true;
+    }
     ++masks_version_;
     update_source_summary();
 }
 
 void Grid::set_bed(const double *zb) {
-    if (zb)
+    if (zb) {
         bed_.assign(zb, zb + heights_.size());
-    else
+        lift_to_bed();
+    } else {
         bed_.clear();
+    }
     ++masks_version_;
     touched_everywhere();
+}
+
+void Grid::lift_to_bed() {
+    // A bed set before the sand (or above it) lifts the surface to it; the
+    // sand this adds comes from the host, as dpsm_set_heights' would.
+    CompensatedSum change;
+    bool lifted = false;
+    for (std::size_t c = 0; c < heights_.size(); ++c) {
+        if (!(heights_[c] < bed_[c])) continue;
+        if (kinds_[c] == kSand)
+            change.add((bed_[c] - heights_[c]) * geometry_.cell_area(static_cast<std::int64_t>(c)));
+        heights_[c] = bed_[c];
+        residuals_[c] = 0.0f;
+        lifted = true;
+    }
+    if (!lifted) return;
+    ledger_.external.add(change.value());
+    if (open_cells_ > 0) update_open_levels();
+    if (tiled_) tiled_->all_stale = true;
+}
+
+void Grid::set_side_levels(int side, const double *levels) {
+    const std::int64_t n = side < kYMin ? geometry_.ny : geometry_.nx;
+    if (levels)
+        side_levels_[side].assign(levels, levels + n);
+    else
+        side_levels_[side].clear();
+    update_held_levels();
+    ++side_levels_version_;
+    touched_everywhere();
+}
+
+double Grid::outside_level(std::int64_t i, std::int64_t j) const {
+    return level_beyond(side_levels_, geometry_.nx, geometry_.ny, i, j);
+}
+
+void Grid::read_face_fluxes(double *fx, double *fy) const {
+    const FaceFluxes &fluxes = *fluxes_;
+    if (geometry_.dim == 1) {
+        std::copy(fluxes.x.begin(), fluxes.x.end(), fx);
+        return;
+    }
+    // A tile's faces hold the last step's fluxes only if that step visited it.
+    const std::int64_t nx = geometry_.nx, ny = geometry_.ny;
+    for (std::int64_t t = 0; t < active_->tiles(); ++t) {
+        const CellBox tile = active_->tile_cells(t);
+        const bool current = fluxes.tile_step[static_cast<std::size_t>(t)] == fluxes.step;
+        const std::int64_t x1 = tile.i1 + (tile.i1 == nx ? 1 : 0), y1 = tile.j1 + (tile.j1 == ny ? 1 : 0);
+        for (std::int64_t j = tile.j0; j < tile.j1; ++j) {
+            const std::size_t at = static_cast<std::size_t>(tile.i0 + (nx + 1) * j);
+            if (current)
+                std::copy_n(fluxes.x.begin() + at, x1 - tile.i0, fx + at);
+            else
+                std::fill_n(fx + at, x1 - tile.i0, 0.0);
+        }
+        for (std::int64_t j = tile.j0; j < y1; ++j) {
+            const std::size_t at = static_cast<std::size_t>(tile.i0 + nx * j);
+            if (current)
+                std::copy_n(fluxes.y.begin() + at, tile.i1 - tile.i0, fy + at);
+            else
+                std::fill_n(fy + at, tile.i1 - tile.i0, 0.0);
+        }
+    }
+}
+
+SideLevelRange side_level_range(const std::array<bool, 4> &open, const std::array<std::vector<double>, 4> &levels) {
+    SideLevelRange range{std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity()};
+    auto take = [&](double level) {
+        range.lowest = std::min(range.lowest, level);
+        range.highest = std::max(range.highest, level);
+    };
+    for (int side = 0; side < 4; ++side) {
+        if (!open[side]) continue;
+        if (levels[side].empty()) take(0.0);  // a side without levels holds 0
+        for (const double level : levels[side]) take(level);
+    }
+    if (range.lowest > range.highest) range = SideLevelRange{};  // no side open
+    return range;
+}
+
+void Grid::update_held_levels() {
+    const SideLevelRange range = side_level_range(side_open_, side_levels_);
+    side_level_min_ = range.lowest;
+    side_level_max_ = range.highest;
+}
+
+void Grid::set_face_flux_recording(bool on) {
+    record_fluxes_ = on;
+    if (!on) {
+        fluxes_.reset();
+        return;
+    }
+    if (fluxes_) return;
+    auto fluxes = std::make_unique<FaceFluxes>();
+    const std::size_t nx = static_cast<std::size_t>(geometry_.nx), ny = static_cast<std::size_t>(geometry_.ny);
+    fluxes->x.assign((nx + 1) * ny, 0.0);
+    if (geometry_.dim == 2) {
+        fluxes->y.assign(nx * (ny + 1), 0.0);
+        fluxes->tile_step.assign(static_cast<std::size_t>(active_->tiles()), 0);
+    }
+    fluxes_ = std::move(fluxes);
 }
 
 void Grid::set_angle_field(const double *theta) {

@@ -9,12 +9,24 @@
 #include <vector>
 
 #include "active_set.hpp"
+#include "face_fluxes.hpp"
 #include "ledger.hpp"
+#include "side_levels.hpp"
 
 namespace dpsm {
 
 enum Side { kXMin = 0, kXMax = 1, kYMin = 2, kYMax = 3 };
-enum CellKind : std::uint8_t { kSand = 0, kWall = 1, kOpen = 2 };
+// kOutside never lies on a grid: a sweep gives it to the cells beyond an
+// open side, which hold the side's level as open cells hold theirs, so that
+// what leaves through each side is told from what leaves through open cells.
+enum CellKind : std::uint8_t { kSand = 0, kWall = 1, kOpen = 2, kOutside = 3 };
+
+// The lowest and highest level held beyond the open sides: each open side's
+// levels, 0 for an open side without levels; (0, 0) when no side is open.
+struct SideLevelRange {
+    double lowest = 0.0, highest = 0.0;
+};
+SideLevelRange side_level_range(const std::array<bool, 4> &open, const std::array<std::vector<double>, 4> &levels);
 
 enum Scheme { kPairwise = 0, kIsotropic = 1 };
 // How dpsm_step moves the surface (the values of DPSM_RELAX_*).
@@ -62,6 +74,8 @@ struct GridState {
     int threads = 0;
     Scheme scheme = kPairwise;
     std::array<bool, 4> side_open{};
+    SideLevels side_levels;
+    bool record_fluxes = false;
     std::vector<double> heights;
     std::vector<float> residuals;
     std::vector<std::uint8_t> kinds;
@@ -113,7 +127,8 @@ public:
     // or at its default when a scene does not use it, and a scene that uses
     // none of them is stepped by the vectorised kernels.
     const std::vector<double> &bed() const { return bed_; }  // empty: none
-    void set_bed(const double *zb);                           // NULL: none
+    // NULL: none. A bed above a cell lifts the cell to it (booked as external mass).
+    void set_bed(const double *zb);
     const std::vector<double> &angle_field() const { return angle_field_; }  // radians; empty: uniform
     const std::vector<double> &tan_field() const { return tan_field_; }      // tan of angle_field
     void set_angle_field(const double *theta);                               // NULL: uniform
@@ -152,8 +167,22 @@ public:
     bool any_side_open() const { return side_open_[0] || side_open_[1] || side_open_[2] || side_open_[3]; }
     void set_side_open(int side, bool open) {
         side_open_[side] = open;
+        update_held_levels();
         touched_everywhere();
     }
+    // The surface level outside an open side, per boundary face (k counts
+    // along the side: j for the x sides, i for the y sides); 0 unless the
+    // host set levels (dpsm_set_side_levels).
+    double side_level(int side, std::int64_t k) const { return side_level_of(side_levels_, side, k); }
+    const std::vector<double> &side_levels(int side) const { return side_levels_[side]; }  // empty: all 0
+    void set_side_levels(int side, const double *levels);                                     // NULL: all 0
+    // The level of the cell (i, j) beyond the domain that a sweep reads as
+    // the outside of the sides (side_levels.hpp).
+    double outside_level(std::int64_t i, std::int64_t j) const;
+    // The lowest and highest level held beyond the open sides (0 and 0 when
+    // no side is open or none has levels).
+    double side_level_min() const { return side_level_min_; }
+    double side_level_max() const { return side_level_max_; }
 
     // Cell data, x fastest.
     const std::vector<double> &heights() const { return heights_; }
@@ -188,6 +217,16 @@ public:
     double open_level_min() const { return open_level_min_; }
     double open_level_max() const { return open_level_max_; }
     bool source_active() const { return source_rate_nonzero_; }
+    // Sources applied lazily (tiled_sweep.hpp), as on 2D grids without the
+    // physics of real scenes: per cell, the sub-steps counted since the grid
+    // began after which a source cell's stored height is current, where that
+    // is later than clock_base(), the count at the start of the present step
+    // (at the end of a step every source cell is current).
+    bool lazy_sources() const { return geometry_.dim == 2 && !uses_physics(); }
+    const std::vector<double> &source_clock() const { return clock_; }
+    std::vector<double> &source_clock_for_stepping() { return clock_; }
+    double clock_base() const { return clock_base_; }
+    void set_clock_base(double count) { clock_base_ = count; }
     double source_mass_rate() const { return source_mass_rate_; }
 
     // A block of cells [i0, i0+ni) x [j0, j0+nj), values x fastest: sets the
@@ -213,6 +252,16 @@ public:
     // look at which cells differ, and wakes all of it.
     void copy_heights_between_sweeps(const double *y, const CellBox &within);
     void set_source(const double *q);                 // NULL: none
+
+    // The volume each face carried in the last step, recorded only when the
+    // host asked for it (dpsm_set_face_flux_recording). x faces: (nx + 1) * ny,
+    // face i on the low side of cell i; y faces: nx * (ny + 1) (2D only).
+    bool records_face_fluxes() const { return record_fluxes_; }
+    void set_face_flux_recording(bool on);
+    FaceFluxes &face_fluxes() { return *fluxes_; }
+    const FaceFluxes *face_fluxes_if_any() const { return fluxes_.get(); }
+    // The last step's face fluxes, in the layout of dpsm_get_face_fluxes (fy: 2D only).
+    void read_face_fluxes(double *fx, double *fy) const;
 
     // Mass on sand cells now, a compensated sum.
     double total_mass() const;
@@ -243,12 +292,17 @@ public:
     // Changes whenever the host sets cell kinds or sources: a distributed grid
     // refreshes its halo's copies of them when it does.
     std::uint64_t masks_version() const { return masks_version_; }
+    // Changes whenever the host sets side levels: a distributed grid then
+    // assembles the levels along the global domain's sides again.
+    std::uint64_t side_levels_version() const { return side_levels_version_; }
     // The sum over all blocks of a distributed grid; `local` on a serial grid.
     double global_sum(double local) const;
 
 private:
     void update_source_summary();
     void update_open_levels();
+    void update_held_levels();
+    void lift_to_bed();
     // Something that may make any face steep changed: every tile is looked at again.
     void touched_everywhere() {
         if (active_) active_->mark_all();
@@ -261,12 +315,16 @@ private:
     double rest_tolerance_;
     std::int64_t max_substeps_;
     std::array<bool, 4> side_open_{};
+    SideLevels side_levels_;
+    double side_level_min_ = 0.0, side_level_max_ = 0.0;
 
     std::vector<double> heights_;
     std::vector<float> residuals_;
     CellBox residual_bounds_;  // outside it every residual is 0
     std::vector<std::uint8_t> kinds_;
     std::vector<double> source_;
+    std::vector<double> clock_;  // empty until a 2D grid has a source
+    double clock_base_ = 0.0;
     std::vector<double> bed_;
     std::vector<double> angle_field_, tan_field_;
     double min_angle_field_ = 0.0;
@@ -278,6 +336,8 @@ private:
     std::unique_ptr<ActiveSet> active_;
     std::unique_ptr<TiledWorkspace> tiled_;
     std::unique_ptr<RelaxWorkspace> relax_;
+    bool record_fluxes_ = false;
+    std::unique_ptr<FaceFluxes> fluxes_;
     Scheme scheme_;
     Relaxation relaxation_ = kAutoRelaxation;
     int threads_ = 0;
@@ -291,6 +351,7 @@ private:
     StepInfo last_step_;
     std::unique_ptr<Decomposition> decomposition_;
     std::uint64_t masks_version_ = 0;
+    std::uint64_t side_levels_version_ = 0;
 };
 
 }  // namespace dpsm

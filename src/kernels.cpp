@@ -3,8 +3,11 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 
 #include "closure.hpp"
+#include "ledger.hpp"
+#include "tiled_sweep.hpp"
 
 namespace dpsm {
 
@@ -21,8 +24,9 @@ namespace {
 // a face takes from its upstream cell at a share of the sand that cell holds.
 class FaceSweep {
 public:
-    FaceSweep(Grid &grid, std::vector<double> &rate, double dt)
+    FaceSweep(Grid &grid, std::vector<double> &rate, double dt, bool record)
         : grid_(grid),
+          faces_(record ? grid.face_fluxes().x.data() : nullptr),
           h_(grid.heights().data()),
           kind_(grid.kinds().data()),
           rate_(rate.data()),
@@ -37,6 +41,7 @@ public:
         if (!grid.bed().empty()) prepare_bed(grid, n);
     }
 
+    // The face between cells a and b = a + 1, face index b.
     void interior_face(std::int64_t a, std::int64_t b, double d, double weight_a, double weight_b, double len) {
         const std::uint8_t ka = kind_[a], kb = kind_[b];
         if (ka == kWall || kb == kWall || (ka != kSand && kb != kSand)) return;
@@ -45,6 +50,7 @@ public:
         if (!available_.empty()) flux = capped(flux, flux > 0.0 ? a : b, flux > 0.0 ? weight_a : weight_b);
         if (flux == 0.0) return;
         carried(a, b);
+        if (faces_) faces_[b] += flux * len * dt_;
         if (ka == kSand)
             rate_[a] -= flux * weight_a;
         else
@@ -55,15 +61,19 @@ public:
             result.outflow_rate += flux * len;  // b is an open cell: a sink
     }
 
-    void open_side_face(std::int64_t a, double d, double weight_a, double len) {
+    // The face between cell a and the outside of an open side, held at `level`.
+    void open_side_face(int side, std::int64_t a, double level, double d, double weight_a, double len) {
         if (kind_[a] != kSand) return;
-        double flux = flux_from_to(a, -1, h_[a], 0.0, d);
+        double flux = flux_from_to(a, -1, h_[a], level, d);
         if (flux == 0.0) return;
         if (!available_.empty() && flux > 0.0) flux = capped(flux, a, weight_a);
         if (flux == 0.0) return;
         carried(a, -1);
         rate_[a] -= flux * weight_a;
         result.outflow_rate += flux * len;
+        result.side_outflow_rate[side] += flux * len;
+        // Face 0 lies on the low side of cell 0, face nx on the high side of the last.
+        if (faces_) faces_[side == kXMin ? 0 : a + 1] += (side == kXMin ? -flux : flux) * len * dt_;
     }
 
     // Hands the new moving cells to the grid (hysteresis) once every face is done.
@@ -150,6 +160,7 @@ private:
     static constexpr double kFaces = 2.0;  // faces of a cell on a line or a radius
 
     Grid &grid_;
+    double *faces_;  // the face fluxes to add to; null when not recorded
     const double *h_;
     const std::uint8_t *kind_;
     double *rate_;
@@ -163,21 +174,56 @@ private:
 
 }  // namespace
 
-SweepResult slide_rates_1d(Grid &grid, double dt) {
+bool source_may_steepen_1d(const Grid &grid, double T) {
+    const Geometry &geo = grid.geometry();
+    const std::int64_t nx = geo.nx;
+    const std::vector<double> &h = grid.heights(), &q = grid.source();
+    const std::vector<std::uint8_t> &kind = grid.kinds();
+    auto later = [&](std::int64_t c) { return kind[c] == kSand ? h[c] + q[c] * T : h[c]; };
+    double largest = 0.0;
+    for (std::int64_t c = 0; c < nx; ++c) largest = std::max({largest, std::fabs(h[c]), std::fabs(later(c))});
+    if (!std::isfinite(largest)) return true;
+    // A face in the band of rounding below the threshold counts as steep.
+    const double threshold = grid.tan_repose() * (1.0 + grid.rest_tolerance()) * geo.dx -
+                             64.0 * std::numeric_limits<double>::epsilon() * largest;
+    // Only faces with a source on a side move; the others are as they are now.
+    auto sourced = [&](std::int64_t c) { return kind[c] == kSand && q[c] != 0.0; };
+    auto steep = [&](double ha, double hb) { return std::fabs(ha - hb) > threshold; };
+    for (std::int64_t i = 0; i + 1 < nx; ++i) {
+        const std::uint8_t ka = kind[i], kb = kind[i + 1];
+        if (ka == kWall || kb == kWall || (ka != kSand && kb != kSand) || !(sourced(i) || sourced(i + 1))) continue;
+        if (steep(later(i), later(i + 1))) return true;
+    }
+    if (grid.side_open(kXMin) && !geo.axisymmetric && sourced(0) && steep(later(0), grid.side_level(kXMin, 0)))
+        return true;
+    return grid.side_open(kXMax) && sourced(nx - 1) && steep(later(nx - 1), grid.side_level(kXMax, 0));
+}
+
+void apply_source_1d(Grid &grid, double substeps, double dt) {
+    std::vector<double> &h = grid.heights_for_stepping();
+    std::vector<float> &residual = grid.residuals_for_stepping();
+    const std::vector<double> &q = grid.source();
+    const std::vector<std::uint8_t> &kind = grid.kinds();
+    for (std::size_t c = 0; c < h.size(); ++c)
+        if (kind[c] == kSand && q[c] != 0.0) add_with_residual(h[c], residual[c], source_lag(q[c], dt, substeps));
+}
+
+SweepResult slide_rates_1d(Grid &grid, double dt, bool record) {
     const Geometry &geo = grid.geometry();
     const std::int64_t nx = geo.nx;
     std::vector<double> &rate = grid.rate_workspace();
     std::fill(rate.begin(), rate.end(), 0.0);
-    FaceSweep sweep(grid, rate, dt);
+    FaceSweep sweep(grid, rate, dt, record);
     // Along a line or a radius: weights are face length over cell area.
     for (std::int64_t i = 0; i + 1 < nx; ++i) {
         const double len = geo.x_face_length(i);
         sweep.interior_face(i, i + 1, geo.dx, len / geo.cell_area(i), len / geo.cell_area(i + 1), len);
     }
-    if (grid.side_open(kXMin) && !geo.axisymmetric) sweep.open_side_face(0, geo.dx, 1.0 / geo.dx, 1.0);
+    if (grid.side_open(kXMin) && !geo.axisymmetric)
+        sweep.open_side_face(kXMin, 0, grid.side_level(kXMin, 0), geo.dx, 1.0 / geo.dx, 1.0);
     if (grid.side_open(kXMax)) {
         const double len = geo.x_face_length(nx - 1);
-        sweep.open_side_face(nx - 1, geo.dx, len / geo.cell_area(nx - 1), len);
+        sweep.open_side_face(kXMax, nx - 1, grid.side_level(kXMax, 0), geo.dx, len / geo.cell_area(nx - 1), len);
     }
     sweep.finish();
     return sweep.result;
@@ -194,15 +240,9 @@ void apply_rates(Grid &grid, double dt) {
     const std::vector<double> &q = grid.source();
     const std::vector<double> &zb = grid.bed();
     const std::size_t n = h.size();
-    // h += increment as a TwoSum: what rounding drops is kept in residual and
-    // added back next time, so mass is not lost one half-ulp at a time.
     auto add = [&](std::size_t c, double increment) {
         if (increment == 0.0) return;  // as the 2D kernel: still cells stay bit for bit
-        const double b = increment + static_cast<double>(residual[c]);
-        const double s = h[c] + b;
-        const double b_virtual = s - h[c];
-        residual[c] = static_cast<float>((h[c] - (s - b_virtual)) + (b - b_virtual));
-        h[c] = s;
+        add_with_residual(h[c], residual[c], increment);
     };
     if (!zb.empty()) {
         // The rate holds the applied source already. Rounding may leave a

@@ -17,6 +17,7 @@ struct SweepResult {
     bool moved = false;             // some face carried sand
     double max_excess_slope = 0.0;  // max over faces that carried sand of |slope| - tan(theta)
     double outflow_rate = 0.0;      // mass per unit time leaving through open sides and cells
+    double side_outflow_rate[4] = {};  // the part of it that left through each side
     double unmet_mass = 0.0;        // erosion asked for in this sub-step where no sand lay above the bed
     double sourced_mass = 0.0;      // with a bed: what the source put on (or took from) the sand
 };
@@ -25,9 +26,21 @@ struct SweepResult {
 // sand cell, 0 for wall and open cells, for a sub-step of dt. Sources are not
 // included, except on a grid with a bed, where the rate holds the part of the
 // source that finds sand. Updates which cells are moving (hysteresis).
-SweepResult slide_rates_1d(Grid &grid, double dt);
+// With record, adds the volume each face carries in the sub-step to the
+// grid's face fluxes.
+SweepResult slide_rates_1d(Grid &grid, double dt, bool record = false);
 
 // h += dt * (rate + q) on sand cells.
 void apply_rates(Grid &grid, double dt);
+
+// Sources on a line without the physics of real scenes: whether a face with
+// a source on a side is steeper than the rest threshold (less a margin for
+// rounding) at the end of T under the sources alone. A face's slope moves
+// linearly, so where it is not steep now, nor then, it is not in between:
+// once a sub-step has moved nothing and this says no, the rest of the step
+// is the source in closed form, apply_source_1d over `substeps` sub-steps of
+// dt (source_lag, tiled_sweep.hpp).
+bool source_may_steepen_1d(const Grid &grid, double T);
+void apply_source_1d(Grid &grid, double substeps, double dt);
 
 }  // namespace dpsm

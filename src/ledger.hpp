@@ -32,11 +32,26 @@ private:
     double correction_ = 0.0;
 };
 
+// A cell's height plus an increment as a TwoSum: what rounding drops is kept
+// in the cell's residual and added back with its next increment, so that a
+// surface does not lose mass one half-ulp at a time (the tile kernel does the
+// same in its lanes).
+inline void add_with_residual(double &h, float &residual, double increment) noexcept {
+    const double b = increment + static_cast<double>(residual);
+    const double s = h + b;
+    const double b_virtual = s - h;
+    residual = static_cast<float>((h - (s - b_virtual)) + (b - b_virtual));
+    h = s;
+}
+
 struct MassLedger {
     CompensatedSum sourced;   // mass added by sources
     CompensatedSum external;  // mass added by the host's own calls
     CompensatedSum outflow;   // mass that left through open sides and cells
     CompensatedSum unmet;     // erosion asked for where no sand lay above the bed
+    // The part of `outflow` that left through each side (DPSM_XMIN ..
+    // DPSM_YMAX); the rest left through open cells.
+    CompensatedSum side_outflow[4];
 };
 
 }  // namespace dpsm

@@ -296,7 +296,10 @@ public:
             take(grid_.open_level_min());
             take(grid_.open_level_max());
         }
-        if (grid_.any_side_open()) take(0.0);
+        if (grid_.any_side_open()) {
+            take(grid_.side_level_min());
+            take(grid_.side_level_max());
+        }
         const double slack = kBoundsSlack * std::max(std::fabs(lo), std::fabs(hi));
         bool within = true;
         for (const std::int64_t t : ws_.live_tiles)
@@ -378,9 +381,17 @@ const char *relaxation_unsupported(const Grid &grid) {
     if (grid.flux_exponent() != 1.0) return "a flux exponent other than 1 (dpsm_set_flux_exponent)";
     if (grid.hysteresis()) return "a static angle (dpsm_set_static_angle)";
     if (grid.source_active()) return "an active source (dpsm_set_source); add the deposit with dpsm_add_heights_region";
-    if (grid.has_open_cells() && (grid.open_level_min() != grid.open_level_max() ||
-                                  (grid.any_side_open() && grid.open_level_min() != 0.0)))
-        return "open cells held at different levels, or at another than the open sides' 0 (sand would flow for ever)";
+    double lowest = std::numeric_limits<double>::infinity(), highest = -lowest;
+    if (grid.has_open_cells()) {
+        lowest = grid.open_level_min();
+        highest = grid.open_level_max();
+    }
+    if (grid.any_side_open()) {
+        lowest = std::min(lowest, grid.side_level_min());
+        highest = std::max(highest, grid.side_level_max());
+    }
+    if (lowest < highest)
+        return "open cells and open sides held at different levels (sand would flow for ever)";
     return nullptr;
 }
 
@@ -392,9 +403,27 @@ void require_supported(const Grid &grid) {
              " in this version; use DPSM_RELAX_TIME_ACCURATE (dpsm_set_relaxation)");
 }
 
+// What left through each side, carried along with a state: every state is a
+// combination of the start and of evaluations' changes, and what an
+// evaluation sends through a side is the same combination of theirs.
+struct SideMass {
+    double side[4] = {};
+    SideMass plus(double weight, const SideMass &o) const {
+        SideMass r;
+        for (int k = 0; k < 4; ++k) r.side[k] = side[k] + weight * o.side[k];
+        return r;
+    }
+    SideMass minus(const SideMass &o) const { return plus(-1.0, o); }
+};
+SideMass side_mass_of(const LevelSummary &evaluation, double dt) {
+    SideMass m;
+    for (int k = 0; k < 4; ++k) m.side[k] = evaluation.side_outflow_rate[k] * dt;
+    return m;
+}
+
 }  // namespace
 
-bool relax_to_rest(Grid &grid, std::int64_t budget, bool rest_or_nothing, double &cells_visited) {
+bool relax_to_rest(Grid &grid, std::int64_t budget, double &cells_visited) {
     cells_visited = 0.0;
     require_supported(grid);
     prepare_tiled_sweep(grid, grid.threads());  // allocates before anything changes
@@ -407,11 +436,13 @@ bool relax_to_rest(Grid &grid, std::int64_t budget, bool rest_or_nothing, double
         return true;
     }
     // All the memory first: an allocation that fails leaves the grid as it was.
-    Evaluator rates(grid, stable_dt(grid));
+    const double dt = stable_dt(grid);
+    Evaluator rates(grid, dt);
     // The states change roles by swapping these pointers; the evaluator only
     // needs to know which arrays they are, not which is which.
     double *y0 = rates.state(0), *yjm1 = rates.state(1), *yjm2 = rates.state(2), *yj = rates.state(3);
     double *f0 = rates.rates();
+    SideMass out_y0, out_yjm1, out_yjm2, out_yj, out_f0;  // the states' side outflows since the start
     const double switch_excess = kSwitchExcessShare * std::tan(grid.min_repose_angle());
     const CellLoops &loops = cell_loops();
 
@@ -420,6 +451,7 @@ bool relax_to_rest(Grid &grid, std::int64_t budget, bool rest_or_nothing, double
     double last_excess = 0.0;
     for (int k = 0; rates.evaluations() < budget; ++k) {
         const LevelSummary start = rates.evaluate(y0);
+        out_f0 = side_mass_of(start, dt);
         last_excess = start.max_excess;
         if (!start.moved) {
             rested = true;
@@ -445,8 +477,10 @@ bool relax_to_rest(Grid &grid, std::int64_t budget, bool rest_or_nothing, double
                 yjm1[c] = y0[c] + first * f0[c];
             }
         });
+        out_yjm2 = out_y0;
+        out_yjm1 = out_y0.plus(first, out_f0);
         for (int j = 2; j <= rkc.s; ++j) {
-            rates.evaluate(yjm1);
+            const SideMass out_next = side_mass_of(rates.evaluate(yjm1), dt);
             const double *next = rates.next();
             const double mu = 2.0 * rkc.b[j] * rkc.w0 / rkc.b[j - 1], nu = -rkc.b[j] / rkc.b[j - 2];
             const double mut = 2.0 * rkc.b[j] * rkc.w1 / rkc.b[j - 1];
@@ -455,37 +489,51 @@ bool relax_to_rest(Grid &grid, std::int64_t budget, bool rest_or_nothing, double
             rates.for_rows([&](std::size_t c0, std::size_t c1) {
                 loops.rkc_stage(c0, c1, y0, yjm1, yjm2, next, f0, weights, yj);
             });
+            out_yj = out_y0.plus(mu, out_yjm1.minus(out_y0))
+                         .plus(nu, out_yjm2.minus(out_y0))
+                         .plus(weights.mut_tau, out_next)
+                         .plus(weights.gamt_tau, out_f0);
             std::swap(yjm2, yjm1);
             std::swap(yjm1, yj);
+            std::swap(out_yjm2, out_yjm1);
+            std::swap(out_yjm1, out_yj);
         }
         std::swap(y0, yjm1);
+        std::swap(out_y0, out_yjm1);
     }
 
     // Momentum for the tail, where little sand is left to move.
     double *&x = y0, *&x_prev = yjm1, *&y = yjm2;
+    SideMass &out_x = out_y0, &out_x_prev = out_yjm1, &out_y = out_yjm2;
     const auto copy = [&](double *to, const double *from) {
         rates.for_rows([&](std::size_t c0, std::size_t c1) { std::copy(from + c0, from + c1, to + c0); });
     };
     copy(x_prev, x);
+    out_x_prev = out_x;
     for (std::int64_t k = 0; switched && !rested && rates.evaluations() < budget;) {
         const double beta = static_cast<double>(k) / static_cast<double>(k + 3);
         rates.for_rows([&](std::size_t c0, std::size_t c1) { loops.extrapolate(c0, c1, x, x_prev, beta, y); });
+        out_y = out_x.plus(beta, out_x.minus(out_x_prev));
         const LevelSummary at = rates.evaluate(y);
         const double *next = rates.next();
         last_excess = at.max_excess;
         if (!at.moved) {
             copy(x, y);
             copy(x_prev, y);
+            out_x = out_x_prev = out_y;
             rested = k == 0;
             k = 0;
             continue;
         }
         MomentumStep step;
         rates.for_rows([&](std::size_t c0, std::size_t c1) { loops.momentum(c0, c1, next, y, x, x_prev, step); });
+        out_x_prev = out_y.plus(1.0, side_mass_of(at, dt));
         std::swap(x, x_prev);  // x_prev: the x before this step
+        std::swap(out_x, out_x_prev);
         const auto total = [](const double *parts) { return (parts[0] + parts[1]) + (parts[2] + parts[3]); };
         if (total(step.along) < 0.0 || total(step.coasting) > kCoastingShare * total(step.motion)) {
             copy(x_prev, x);
+            out_x_prev = out_x;
             k = 0;
         } else {
             ++k;
@@ -506,14 +554,15 @@ bool relax_to_rest(Grid &grid, std::int64_t budget, bool rest_or_nothing, double
     const MassLedger &ledger = grid.ledger();
     const double mass = std::fabs(ledger.external.value() + ledger.sourced.value() - ledger.outflow.value() -
                                   ledger.unmet.value());
-    if (!rates.within_start_extremes(x) || (!sinks && std::fabs(left) > kMassSlack * mass) ||
-        (rest_or_nothing && !rested)) {
+    if (!rates.within_start_extremes(x) || (!sinks && std::fabs(left) > kMassSlack * mass)) {
         rates.restore_start();
         return false;
     }
     // The state reached becomes the grid's (at rest, it already is).
     rates.finish(x);
     if (sinks) grid.ledger().outflow.add(left);
+    for (int side = 0; side < 4; ++side)
+        if (out_x.side[side] != 0.0) grid.ledger().side_outflow[side].add(out_x.side[side]);
     // The evaluation that found rest moved nothing and is not counted, as a
     // time-accurate sub-step that finds rest is not: a step on a surface at
     // rest reads 0, however it was found so.

@@ -27,14 +27,13 @@ struct RelaxWorkspace {
 
 // Relaxes the grid to rest (or until `budget` flux evaluations are spent),
 // booking what leaves through open sides and cells as outflow, and returns
-// true. Returns false with the grid as it was, residuals included,
-// where the state it reached is not one the model's own steps could reach
-// (new extremes, or a closed scene's mass off by more than rounding), and,
-// with rest_or_nothing, where the budget ran out before rest; the caller
+// true. Returns false with the grid as it was, residuals included, where the
+// state it reached is not one the model's own steps could reach (new
+// extremes, or a closed scene's mass off by more than rounding); the caller
 // then steps in time. cells_visited: the work done either way. Throws
 // Error(DPSM_ERR_NOT_APPLICABLE) before changing anything for a scene this
 // relaxation does not support.
-bool relax_to_rest(Grid &grid, std::int64_t budget, bool rest_or_nothing, double &cells_visited);
+bool relax_to_rest(Grid &grid, std::int64_t budget, double &cells_visited);
 
 // What of the grid's scene the relaxation does not support, as a phrase for
 // a message; null when it supports all of it.

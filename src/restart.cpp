@@ -15,6 +15,7 @@
 #include <limits>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #if defined(__unix__) || defined(__APPLE__)
@@ -50,11 +51,32 @@ constexpr std::uint32_t kRelaxToRest = 1u << 5;
 // Version 3: dpsm_step relaxes to rest where the scene allows it (DPSM_RELAX_AUTO,
 // the default since that version). Without either flag: time-accurate.
 constexpr std::uint32_t kRelaxAuto = 1u << 6;
-constexpr std::uint32_t kKnownFlags =
-    kHasSource | kHasBed | kHasAngleField | kHasMoving | kIsBlock | kRelaxToRest | kRelaxAuto;
-// The flags a file of version 1 cannot hold, and those version 2 cannot.
+// Version 4, what a host couples: the accounts of what left through each
+// side (after the arrays), the levels beyond a side (one flag per side,
+// DPSM_XMIN first; its levels follow the accounts), and whether the face
+// fluxes are recorded (no data: a loaded grid reads 0 until its next step).
+constexpr std::uint32_t kHasSideOutflows = 1u << 7;
+constexpr std::uint32_t kHasSideLevelsOfXMin = 1u << 8;  // .. 1u << 11 for DPSM_YMAX
+constexpr std::uint32_t kHasSideLevels = 0xfu << 8;
+constexpr std::uint32_t kRecordsFluxes = 1u << 12;
+constexpr std::uint32_t kKnownFlags = kHasSource | kHasBed | kHasAngleField | kHasMoving | kIsBlock | kRelaxToRest |
+                                      kRelaxAuto | kHasSideOutflows | kHasSideLevels | kRecordsFluxes;
+// The flags a file of version 1 cannot hold, those version 2 cannot, and so on.
 constexpr std::uint32_t kVersion2Flags = kIsBlock | kRelaxToRest;
 constexpr std::uint32_t kVersion3Flags = kRelaxAuto;
+constexpr std::uint32_t kVersion4Flags = kHasSideOutflows | kHasSideLevels | kRecordsFluxes;
+
+constexpr std::uint32_t side_levels_flag(int side) { return kHasSideLevelsOfXMin << side; }
+
+// The oldest version that holds a file with these flags.
+std::uint32_t version_for(std::uint32_t flags) {
+    if (flags & kVersion4Flags) return 4;
+    if (flags & kVersion3Flags) return 3;
+    return (flags & kVersion2Flags) ? 2 : 1;
+}
+
+// The faces along a side: ny for the x sides, nx for the y sides.
+std::int64_t faces_along(int side, std::int64_t nx, std::int64_t ny) { return side < kYMin ? ny : nx; }
 
 
 // ---- CRC-32 (ISO-HDLC, as zlib, PNG and gzip: reflected 0xEDB88320) -------
@@ -150,6 +172,11 @@ std::uint32_t flags_of(const Grid &g) {
     if (!g.moving().empty()) flags |= kHasMoving;
     if (g.relaxation() == kToRest) flags |= kRelaxToRest;
     if (g.relaxation() == kAutoRelaxation) flags |= kRelaxAuto;
+    for (const CompensatedSum &account : g.ledger().side_outflow)
+        if (account.sum() != 0.0 || account.correction() != 0.0) flags |= kHasSideOutflows;
+    for (int side = 0; side < 4; ++side)
+        if (!g.side_levels(side).empty()) flags |= side_levels_flag(side);
+    if (g.records_face_fluxes()) flags |= kRecordsFluxes;
     return flags;
 }
 
@@ -158,7 +185,7 @@ void write_header(Writer &w, const Grid &g, const RestartBlock &block) {
     for (const std::uint8_t b : kMagic) w.u8(b);
     // The oldest version that holds the grid, so that older libraries read what they can.
     const std::uint32_t flags = flags_of(g) | (block.present ? kIsBlock : 0u);
-    w.u32((flags & kVersion3Flags) ? 3u : (flags & kVersion2Flags) ? 2u : 1u);
+    w.u32(version_for(flags));
     w.u32(static_cast<std::uint32_t>(geo.dim));
     w.u32(geo.axisymmetric ? 1u : 0u);
     w.i64(geo.nx);
@@ -208,6 +235,12 @@ void write_body(Writer &w, const Grid &g) {
     w.array(g.bed(), &Writer::f64);
     w.array(g.angle_field(), &Writer::f64);
     w.array(g.moving(), &Writer::u8);
+    if (flags_of(g) & kHasSideOutflows)
+        for (const CompensatedSum &account : g.ledger().side_outflow) {
+            w.f64(account.sum());
+            w.f64(account.correction());
+        }
+    for (int side = 0; side < 4; ++side) w.array(g.side_levels(side), &Writer::f64);  // nothing when empty
     w.checksum();
     w.flush();
 }
@@ -344,6 +377,23 @@ void read_body(Reader &r, const Header &h, std::size_t n, GridState &s) {
     if (h.flags & kHasBed) r.array(s.bed, n, &Reader::f64);
     if (h.flags & kHasAngleField) r.array(s.angle_field, n, &Reader::f64);
     if (h.flags & kHasMoving) r.array(s.moving, n, &Reader::u8);
+    if (h.flags & kHasSideOutflows)
+        for (CompensatedSum &account : s.ledger.side_outflow) {
+            const double sum = r.f64();
+            const double correction = r.f64();
+            account = CompensatedSum(sum, correction);
+        }
+    for (int side = 0; side < 4; ++side)
+        if (h.flags & side_levels_flag(side))
+            r.array(s.side_levels[side], static_cast<std::size_t>(faces_along(side, h.nx, h.ny)), &Reader::f64);
+}
+
+// The bytes of version 4's parts after the arrays, by the flags.
+std::size_t coupling_bytes(std::uint32_t flags, std::int64_t nx, std::int64_t ny) {
+    std::size_t bytes = (flags & kHasSideOutflows) ? 4 * 16 : 0;
+    for (int side = 0; side < 4; ++side)
+        if (flags & side_levels_flag(side)) bytes += 8 * static_cast<std::size_t>(faces_along(side, nx, ny));
+    return bytes;
 }
 
 // The bytes each cell takes in the body, by the arrays the flags announce.
@@ -379,17 +429,21 @@ void check_layout(const Header &h, const std::string &path, const char *fn) {
     if (h.nx > kMaxCells / h.ny)
         bad("nx * ny = ", h.nx, " * ", h.ny, " cells is more than this library can address (", kMaxCells, ")");
     if (h.flags & ~kKnownFlags) bad("unknown array flags ", hex32(h.flags & ~kKnownFlags));
-    if ((h.flags & kVersion2Flags) && h.version < 2)
-        bad("the flags ", hex32(h.flags & kVersion2Flags), " are set in a file of version ", h.version,
-            " (they need version 2)");
-    if ((h.flags & kVersion3Flags) && h.version < 3)
-        bad("the flags ", hex32(h.flags & kVersion3Flags), " are set in a file of version ", h.version,
-            " (they need version 3)");
+    const std::pair<std::uint32_t, std::uint32_t> needs[] = {{kVersion2Flags, 2}, {kVersion3Flags, 3}, {kVersion4Flags, 4}};
+    for (const auto &[flags, version] : needs)
+        if ((h.flags & flags) && h.version < version)
+            bad("the flags ", hex32(h.flags & flags), " are set in a file of version ", h.version, " (they need version ",
+                version, ")");
     if ((h.flags & kRelaxToRest) && (h.flags & kRelaxAuto)) bad("both relaxation flags are set");
     if ((h.flags & kRelaxToRest) && h.dim != 2) bad("a grid of dim = ", h.dim, " cannot relax to rest");
     if ((h.flags & kIsBlock) && h.dim != 2) bad("a block of a distributed grid must have dim = 2, not ", h.dim);
+    for (int side = 0; side < 4; ++side)
+        if ((h.flags & side_levels_flag(side)) && ((h.dim == 1 && side >= kYMin) || (h.axisymmetric && side == kXMin)))
+            bad("levels beyond side ", side, ", which a grid of dim = ", h.dim,
+                h.axisymmetric ? " (axisymmetric)" : "", " does not have");
     const std::uint64_t cells = static_cast<std::uint64_t>(h.nx) * static_cast<std::uint64_t>(h.ny);
-    if (cells > (std::numeric_limits<std::size_t>::max() - kHeaderBytes - kBlockBytes - kChecksumBytes) /
+    if (cells > (std::numeric_limits<std::size_t>::max() - kHeaderBytes - kBlockBytes - kChecksumBytes -
+                 coupling_bytes(h.flags, h.nx, h.ny)) /
                     bytes_per_cell(h.flags))
         bad(cells, " cells do not fit in this machine's memory");
 }
@@ -420,9 +474,15 @@ void check_values(const Header &h, const GridState &s, std::size_t n, const std:
         bad("the moving cells are ", (h.flags & kHasMoving) ? "present" : "missing", " but the static angle is ",
             s.static_angle);
     const MassLedger &l = s.ledger;
-    for (const CompensatedSum *account : {&l.sourced, &l.external, &l.outflow, &l.unmet})
+    for (const CompensatedSum *account : {&l.sourced, &l.external, &l.outflow, &l.unmet, &l.side_outflow[0],
+                                          &l.side_outflow[1], &l.side_outflow[2], &l.side_outflow[3]})
         if (!std::isfinite(account->sum()) || !std::isfinite(account->correction()))
             bad("a ledger account is not finite (", account->sum(), " + ", account->correction(), ")");
+    for (int side = 0; side < 4; ++side)
+        for (std::size_t k = 0; k < s.side_levels[side].size(); ++k)
+            if (!in_range(s.side_levels[side][k]))
+                bad("the level beyond face ", k, " of side ", side, " = ", s.side_levels[side][k],
+                    " is not finite within [-1e50, 1e50]");
     const StepInfo &info = s.last_step;
     if (info.substeps < 0) bad("the last step's sub-steps ", info.substeps, " are negative");
     if (!(std::isfinite(info.time_integrated) && info.time_integrated >= 0.0))
@@ -578,7 +638,8 @@ void load_restart(const char *path, Geometry &geometry, GridState &state, Restar
     // short file allocates no more than it holds).
     const std::size_t n = static_cast<std::size_t>(header.nx) * static_cast<std::size_t>(header.ny);
     const std::size_t block_bytes = (header.flags & kIsBlock) ? kBlockBytes : 0;
-    const std::size_t expected = kHeaderBytes + block_bytes + n * bytes_per_cell(header.flags) + kChecksumBytes;
+    const std::size_t expected = kHeaderBytes + block_bytes + n * bytes_per_cell(header.flags) +
+                                 coupling_bytes(header.flags, header.nx, header.ny) + kChecksumBytes;
     constexpr std::size_t kChunk = std::size_t{1} << 22;
     while (bytes.size() <= expected) {
         const std::size_t want = expected + 1 - bytes.size();
@@ -614,6 +675,7 @@ void load_restart(const char *path, Geometry &geometry, GridState &state, Restar
                        : (header.flags & kRelaxAuto) ? kAutoRelaxation
                                                      : kTimeAccurate;
     state.last_step.at_rest = header.at_rest != 0;
+    state.record_fluxes = (header.flags & kRecordsFluxes) != 0;
     for (int side = 0; side < 4; ++side) state.side_open[side] = header.side_open[side] != 0;
     geometry = Geometry{static_cast<int>(header.dim), header.axisymmetric != 0, header.nx, header.ny, header.dx, header.dy};
 }

@@ -14,9 +14,10 @@ namespace dpsm {
 // holds the grid: version 1 for a grid of its own, version 2 (version 1 and a
 // block record) for one rank's block of a distributed grid or a grid set to
 // DPSM_RELAX_TO_REST, version 3 for a grid left at the default relaxation
-// (DPSM_RELAX_AUTO), so that older libraries still read every file they
-// could hold.
-constexpr std::uint32_t kRestartVersion = 3;
+// (DPSM_RELAX_AUTO), version 4 for a grid with side levels, sand that left
+// through a side, or face fluxes recorded, so that older libraries still
+// read every file they could hold.
+constexpr std::uint32_t kRestartVersion = 4;
 
 // Where a block file's grid lies in its distributed grid (version 2): its
 // place, which of how many ranks saved it, and the mark that all the files

@@ -4,8 +4,8 @@
 
 namespace dpsm {
 
-TileKernel tile_kernel_avx2(bool masked, bool isotropic, bool source, bool grid_in, bool grid_out) {
-    return tile_kernel_for<simd::Lanes4>(masked, isotropic, source, grid_in, grid_out);
+TileKernel tile_kernel_avx2(bool masked, bool isotropic, bool source, bool grid_in, bool grid_out, PhysicsKind physics) {
+    return tile_kernel_for<simd::Lanes4>(masked, isotropic, source, grid_in, grid_out, physics);
 }
 
 }  // namespace dpsm

@@ -7,7 +7,6 @@
 // (2) every face once, (3) every cell's update.
 #include <algorithm>
 #include <cmath>
-#include <limits>
 
 #include "closure.hpp"
 #include "grid.hpp"
@@ -29,9 +28,6 @@ void TileBuffers::resize_physics() {
 }
 
 namespace {
-
-constexpr double kFacesPerCell = 4.0;  // a face takes at most this share of its upstream cell's sand
-constexpr double kLevelWithinRounding = 4.0 * std::numeric_limits<double>::epsilon();
 
 template <bool Isotropic, bool Source>
 void advance_tile_level_physics(TileBuffers &b, int in, const TileRect &reg, const TileRect &tile,
@@ -123,6 +119,14 @@ void advance_tile_level_physics(TileBuffers &b, int in, const TileRect &reg, con
             fy[c] = face(c - W, c, (h[c - W] - h[c]) * p.inv_dy, gt, p.inv_dy);
         }
 
+    if (p.record) {
+        // Every face the region touches, as a height per sub-step of its cells.
+        for (int r = reg.r0; r < reg.r1; ++r)
+            for (int c = r * W + reg.c0; c <= r * W + reg.c1; ++c) b.face_x[c] += fx[c] * p.inv_dx * p.dt;
+        for (int r = reg.r0; r <= reg.r1; ++r)
+            for (int c = r * W + reg.c0; c < r * W + reg.c1; ++c) b.face_y[c] += fy[c] * p.inv_dy * p.dt;
+    }
+
     // (3) Cells.
     bool moved = false;
     for (int r = reg.r0; r < reg.r1; ++r) {
@@ -162,13 +166,18 @@ void advance_tile_level_physics(TileBuffers &b, int in, const TileRect &reg, con
                 st.hot_c1 = std::max(st.hot_c1, col + 1);
             }
             if (!sand) continue;
-            // Sand sent into sinks; what sinks feed counts negative.
-            double rate = 0.0;
-            if (kind[c + 1] == kOpen) rate += east * p.x_face_length;
-            if (kind[c - 1] == kOpen) rate -= west * p.x_face_length;
-            if (kind[c + W] == kOpen) rate += north * p.y_face_length;
-            if (kind[c - W] == kOpen) rate -= south * p.y_face_length;
-            st.outflow_rate += rate;
+            // Sand sent into sinks (open cells, and the outside of open sides,
+            // side by side); what sinks feed counts negative.
+            const double out[4] = {-west * p.x_face_length, east * p.x_face_length, -south * p.y_face_length,
+                                   north * p.y_face_length};
+            const int beyond[4] = {c - 1, c + 1, c - W, c + W};
+            for (int side = 0; side < 4; ++side) {
+                if (kind[beyond[side]] == kOpen) st.outflow_rate += out[side];
+                if (kind[beyond[side]] == kOutside) {
+                    st.outflow_rate += out[side];
+                    st.side_outflow_rate[side] += out[side];
+                }
+            }
             if (Source && p.bed) {
                 st.sourced_mass += applied[c] * p.cell_area;
                 if (q[c] < 0.0) st.unmet_mass += (applied[c] - q[c] * p.dt) * p.cell_area;

@@ -3,6 +3,21 @@
 // tile reads the heights at the start of the sweep and writes its own cells
 // to a separate output, so results do not depend on the order of tiles or the
 // number of threads; sums over tiles are taken in tile order.
+//
+// Lazy sources (2D grids without the physics of real scenes). A source that
+// cannot make a face steep within a step needs no sub-steps: the height of a
+// cell none of whose faces carries sand grows as h + q t, which one addition
+// gives at the end of the step as well as many. So a step starts by finding
+// the cells whose faces a source may make steep within it (drive_sources:
+// each face's slope moves linearly in time under sources alone, so its
+// magnitude is largest at one end of the step, and both ends are looked at);
+// only those drive the active set. The kernel updates a cell only in a
+// sub-step in which one of its faces carries sand (then it adds the source
+// since the cell was last current); everywhere else what the source adds
+// waits, and catch_up_sources applies it at the end of the step in closed
+// form. A cell's stored height thus depends on when sand moved across its
+// faces, not on which sweeps visited it, and results stay independent of
+// the active set and the threads.
 #pragma once
 
 #include <cstdint>
@@ -18,6 +33,7 @@ class Grid;
 struct LevelSummary {
     bool moved = false;         // some face carried sand in this sub-step
     double outflow_rate = 0.0;  // mass per unit time into sinks
+    double side_outflow_rate[4] = {};  // the part of it that left through each side
     double max_excess = 0.0;    // largest |grad h| - tan(theta) over faces that carried sand (if found: tiled_sweep)
     double unmet_mass = 0.0;    // erosion asked for where no sand lay above the bed
     double sourced_mass = 0.0;  // with a bed: what the source put on (or took from) the sand
@@ -37,6 +53,8 @@ struct TiledWorkspace {
     std::vector<double> heights;     // the grid's heights but in the stale boxes
     std::vector<float> residuals;
     std::vector<std::uint8_t> moving;  // the moving cells (hysteresis)
+    std::vector<double> clock;         // the source cells' clocks (lazy sources)
+    std::vector<std::uint8_t> visited_in_step;  // per tile: a sweep of this step wrote some of its cells
     bool all_stale = true;             // nothing of the scratch can be trusted
     std::vector<CellBox> stale;        // per tile: where the scratch may differ from the grid
     std::vector<std::int64_t> stale_tiles;  // the tiles whose stale box is not empty
@@ -58,14 +76,33 @@ void prepare_tiled_sweep(Grid &grid, int threads);
 // longer holds them.
 void tiled_workspace_changed(TiledWorkspace &ws, const ActiveSet &active, const CellBox &box);
 
+// What a source q adds to a cell in `substeps` sub-steps of dt, the same
+// bits wherever it is applied.
+inline double source_lag(double q, double dt, double substeps) { return (q * dt) * substeps; }
+
+// Lazy sources, at the start of a step of duration T: sets the active set's
+// driven boxes to the cells whose faces are steeper than the rest threshold
+// (less a margin for rounding) now or at T under the sources alone, and
+// returns whether any face is steep at T: a source that keeps sand moving
+// (a face steep only now comes to rest by itself). Changes no height. On a
+// distributed grid it exchanges the halo first (collective); the result is
+// this block's.
+bool drive_sources(Grid &grid, double T, double dt);
+
+// Lazy sources, at the end of a step: every source cell not current after
+// sub-step `substeps` of dt gets its source since in closed form (a TwoSum
+// with its residual). Returns the number of cells it changed.
+double catch_up_sources(Grid &grid, double substeps, double dt);
+
 // Advances a 2D grid `levels` (1 .. ActiveSet::kMaxLevels) sub-steps of dt and
 // fills one summary per level; returns the number of cells it visited.
 // Without residuals (the relaxation to rest, which has no use for them) every
 // residual must be 0 and stays 0, and the heights are those the sweep with
 // them would give; the physics kernel always carries them. The largest
 // excess slope costs a little on every face, so it is found on the last
-// level only, and only with find_excess (elsewhere it is 0).
+// level only, and only with find_excess (elsewhere it is 0). first_substep:
+// the index in the step of the sweep's first sub-step (lazy sources).
 std::int64_t tiled_sweep(Grid &grid, int levels, double dt, std::vector<LevelSummary> &summaries,
-                         bool find_excess, bool residuals = true);
+                         bool find_excess, bool residuals = true, double first_substep = 0.0);
 
 }  // namespace dpsm

@@ -4,8 +4,9 @@
  * Every failed call on a valid grid is checked the same way (EXPECT_FAIL): the
  * documented status, a message from dpsm_last_error() that names the function
  * and the bad argument, and a grid exactly as it was. "Exactly" means a
- * snapshot of everything the API shows (heights, the four ledger figures, the
- * stable step, the last step's information, the shape) compared bit for bit,
+ * snapshot of everything the API shows (heights, the four ledger figures, what
+ * left through each side, the last step's face fluxes where they are recorded,
+ * the stable step, the last step's information, the shape) compared bit for bit,
  * and, for the grids of the group fixtures, the same behaviour afterwards: each
  * fixture keeps a twin built by the same calls that never sees a bad call, and
  * after every failed call both are driven through the same probe sequence
@@ -86,13 +87,39 @@ typedef struct {
     double mass[4];  /* DPSM_MASS_TOTAL .. DPSM_MASS_OUTFLOW */
     double info[5];  /* DPSM_INFO_SUBSTEPS .. DPSM_INFO_CELL_UPDATES */
     double stable_dt;
+    int has_side[4];          /* the grid has this side (dpsm_get_side_outflow applies) */
+    double side_outflow[4];   /* what left through it */
+    int fluxes_status;        /* dpsm_get_face_fluxes: DPSM_OK where recorded */
+    size_t nfx, nfy;          /* face counts (nfy = 0 on 1D and axisymmetric grids) */
+    double fx[2 * MAX_CELLS], fy[2 * MAX_CELLS];
 } snapshot_t;
+
+/* The part of a snapshot that issue 17 added: what left through each side
+ * the grid has (dpsm_get_side_outflow refuses the others) and the face
+ * fluxes when they are recorded (their status otherwise). Called first: the
+ * refused calls set the message, the snapshot's later calls clear it. */
+static void snapshot_sides_and_faces(const dpsm_grid *g, snapshot_t *s, const char *file, int line) {
+    for (int side = DPSM_XMIN; side <= DPSM_YMAX; ++side) {
+        const int st = dpsm_get_side_outflow(g, side, &s->side_outflow[side]);
+        require_at(st == DPSM_OK || st == DPSM_ERR_NOT_APPLICABLE, file, line, "dpsm_get_side_outflow(%d): %s: %s",
+                   side, dpsm_status_string(st), dpsm_last_error(g));
+        s->has_side[side] = st == DPSM_OK;
+    }
+    const int two_d = s->has_side[DPSM_YMIN];
+    s->nfx = (size_t)((s->nx + 1) * s->ny);
+    s->nfy = two_d ? (size_t)(s->nx * (s->ny + 1)) : 0;
+    require_at(s->nfx <= 2 * MAX_CELLS && s->nfy <= 2 * MAX_CELLS, file, line, "too many faces for a snapshot");
+    s->fluxes_status = dpsm_get_face_fluxes(g, s->fx, two_d ? s->fy : NULL);
+    require_at(s->fluxes_status == DPSM_OK || s->fluxes_status == DPSM_ERR_NOT_APPLICABLE, file, line,
+               "dpsm_get_face_fluxes: %s: %s", dpsm_status_string(s->fluxes_status), dpsm_last_error(g));
+}
 
 static void snapshot_at(const dpsm_grid *g, snapshot_t *s, const char *file, int line) {
     memset(s, 0, sizeof *s);
     check_ok_(g, dpsm_get_shape(g, &s->nx, &s->ny), "dpsm_get_shape", file, line);
     s->n = (size_t)(s->nx * s->ny);
     require_at(s->n <= MAX_CELLS, file, line, "snapshot of a grid of %zu cells, at most %d", s->n, MAX_CELLS);
+    snapshot_sides_and_faces(g, s, file, line);
     check_ok_(g, dpsm_get_heights(g, s->h), "dpsm_get_heights", file, line);
     for (int q = 0; q < 4; ++q) check_ok_(g, dpsm_get_mass(g, q, &s->mass[q]), "dpsm_get_mass", file, line);
     for (int i = 0; i < 5; ++i) check_ok_(g, dpsm_get_step_info(g, i, &s->info[i]), "dpsm_get_step_info", file, line);
@@ -120,6 +147,19 @@ static void compare_snapshots_at(const snapshot_t *a, const snapshot_t *b, const
                    what, info_names[i], a->info[i], b->info[i]);
     require_at(memcmp(&a->stable_dt, &b->stable_dt, sizeof(double)) == 0, file, line,
                "%s: stable_dt %.17g vs %.17g", what, a->stable_dt, b->stable_dt);
+    for (int side = DPSM_XMIN; side <= DPSM_YMAX; ++side)
+        require_at(a->has_side[side] == b->has_side[side] &&
+                       memcmp(&a->side_outflow[side], &b->side_outflow[side], sizeof(double)) == 0,
+                   file, line, "%s: side %d outflow %.17g vs %.17g", what, side, a->side_outflow[side],
+                   b->side_outflow[side]);
+    require_at(a->fluxes_status == b->fluxes_status, file, line, "%s: dpsm_get_face_fluxes %s vs %s", what,
+               dpsm_status_string(a->fluxes_status), dpsm_status_string(b->fluxes_status));
+    for (size_t f = 0; f < a->nfx; ++f)
+        require_at(memcmp(&a->fx[f], &b->fx[f], sizeof(double)) == 0, file, line, "%s: x face %zu carried %.17g vs %.17g",
+                   what, f, a->fx[f], b->fx[f]);
+    for (size_t f = 0; f < a->nfy; ++f)
+        require_at(memcmp(&a->fy[f], &b->fy[f], sizeof(double)) == 0, file, line, "%s: y face %zu carried %.17g vs %.17g",
+                   what, f, a->fy[f], b->fy[f]);
 }
 #define COMPARE_SNAPSHOTS(a, b, what) compare_snapshots_at((a), (b), (what), __FILE__, __LINE__)
 
@@ -148,12 +188,29 @@ typedef struct {
     double q[MAX_CELLS]; /* the source both carry */
 } fixture_t;
 
+/* Every scene holds the same level beyond each of its sides, open or wall
+ * (so that opening a wall side keeps the held levels equal and the scene
+ * comes to rest), and records its face fluxes: both are part of what a bad
+ * call must leave as it was. The level is the open cell's, if any. */
+static int set_levels_and_recording(dpsm_grid *g, int64_t nx, int64_t ny, int two_d, int axi, double level) {
+    double levels[MAX_CELLS];
+    for (int k = 0; k < MAX_CELLS; ++k) levels[k] = level;
+    assert_true(nx <= MAX_CELLS && ny <= MAX_CELLS);
+    for (int side = axi ? DPSM_XMAX : DPSM_XMIN; side <= (two_d ? DPSM_YMAX : DPSM_XMAX); ++side) {
+        const int st = dpsm_set_side_levels(g, side, levels);
+        if (st != DPSM_OK) return st;
+    }
+    return dpsm_set_face_flux_recording(g, 1);
+}
+
 /* The 2D scene: 7x5 cells of 0.5 x 0.4, a sloping surface with a bump, a wall
  * cell and an open cell (both with a source the library must ignore), the
- * XMAX side open, every parameter off its default. */
+ * XMAX side open, every side held at the open cell's level, every parameter
+ * off its default. */
 enum { NX2 = 7, NY2 = 5 };
 #define DX2 0.5
 #define DY2 0.4
+#define LEVEL2 0.2
 enum { WALL2 = 1 + NX2 * 1, OPEN2 = 5 + NX2 * 3 };
 
 static int build_scene_2d(dpsm_grid **out, double *q) {
@@ -171,7 +228,7 @@ static int build_scene_2d(dpsm_grid **out, double *q) {
         }
     h[3 + NX2 * 2] = 2.5;
     h[WALL2] = 1.5;
-    h[OPEN2] = 0.0;
+    h[OPEN2] = LEVEL2;
     kinds[WALL2] = DPSM_CELL_WALL;
     kinds[OPEN2] = DPSM_CELL_OPEN;
     q[WALL2] = 7.0;
@@ -180,7 +237,8 @@ static int build_scene_2d(dpsm_grid **out, double *q) {
         (st = dpsm_set_rest_tolerance(g, 1e-3)) != DPSM_OK ||
         (st = dpsm_set_max_substeps(g, PROBE_MAX_SUBSTEPS)) != DPSM_OK ||
         (st = dpsm_set_boundary(g, DPSM_XMAX, DPSM_OPEN)) != DPSM_OK || (st = dpsm_set_heights(g, h)) != DPSM_OK ||
-        (st = dpsm_set_cell_kinds(g, kinds)) != DPSM_OK || (st = dpsm_set_source(g, q)) != DPSM_OK) {
+        (st = dpsm_set_cell_kinds(g, kinds)) != DPSM_OK || (st = dpsm_set_source(g, q)) != DPSM_OK ||
+        (st = set_levels_and_recording(g, NX2, NY2, 1, 0, LEVEL2)) != DPSM_OK) {
         dpsm_destroy(g);
         return st;
     }
@@ -188,7 +246,8 @@ static int build_scene_2d(dpsm_grid **out, double *q) {
     return DPSM_OK;
 }
 
-/* The 1D scene: 9 cells of 0.3, a pile, a wall cell, the XMIN side open. */
+/* The 1D scene: 9 cells of 0.3, a pile, a wall cell, the XMIN side open and
+ * both sides held at 0.05 (above the first cell: sand comes in). */
 enum { NX1 = 9, WALL1 = 6 };
 #define DX1 0.3
 
@@ -211,7 +270,8 @@ static int build_scene_1d(dpsm_grid **out, double *q) {
         (st = dpsm_set_rest_tolerance(g, 1e-3)) != DPSM_OK ||
         (st = dpsm_set_max_substeps(g, PROBE_MAX_SUBSTEPS)) != DPSM_OK ||
         (st = dpsm_set_boundary(g, DPSM_XMIN, DPSM_OPEN)) != DPSM_OK || (st = dpsm_set_heights(g, h)) != DPSM_OK ||
-        (st = dpsm_set_cell_kinds(g, kinds)) != DPSM_OK || (st = dpsm_set_source(g, q)) != DPSM_OK) {
+        (st = dpsm_set_cell_kinds(g, kinds)) != DPSM_OK || (st = dpsm_set_source(g, q)) != DPSM_OK ||
+        (st = set_levels_and_recording(g, NX1, 1, 0, 0, 0.05)) != DPSM_OK) {
         dpsm_destroy(g);
         return st;
     }
@@ -220,7 +280,7 @@ static int build_scene_1d(dpsm_grid **out, double *q) {
 }
 
 /* The axisymmetric scene: 8 rings of 0.25, a pile, a wall ring, the outer
- * side open. */
+ * side open and held at 0.3. */
 enum { NR = 8, WALLR = 5 };
 #define DR 0.25
 
@@ -243,7 +303,8 @@ static int build_scene_axi(dpsm_grid **out, double *q) {
         (st = dpsm_set_rest_tolerance(g, 1e-3)) != DPSM_OK ||
         (st = dpsm_set_max_substeps(g, PROBE_MAX_SUBSTEPS)) != DPSM_OK ||
         (st = dpsm_set_boundary(g, DPSM_XMAX, DPSM_OPEN)) != DPSM_OK || (st = dpsm_set_heights(g, h)) != DPSM_OK ||
-        (st = dpsm_set_cell_kinds(g, kinds)) != DPSM_OK || (st = dpsm_set_source(g, q)) != DPSM_OK) {
+        (st = dpsm_set_cell_kinds(g, kinds)) != DPSM_OK || (st = dpsm_set_source(g, q)) != DPSM_OK ||
+        (st = set_levels_and_recording(g, NR, 1, 0, 1, 0.3)) != DPSM_OK) {
         dpsm_destroy(g);
         return st;
     }
@@ -623,12 +684,14 @@ static void test_defaults_equal_explicit_settings(void **state) {
     dpsm_destroy(g);
 }
 
-/* The default limit: a driven one-cell grid may take exactly
+/* The default limit: a driven one-cell grid (its source raises it above the
+ * open side's level, steeper than the angle of repose) may take exactly
  * DPSM_DEFAULT_MAX_SUBSTEPS sub-steps in one call, not one more. */
 static void test_default_max_substeps(void **state) {
     (void)state;
     dpsm_grid *g = NULL;
     CHECK_OK(NULL, dpsm_create_1d(1, 1.0, &g));
+    CHECK_OK(g, dpsm_set_boundary(g, DPSM_XMAX, DPSM_OPEN));
     const double q = 1e-3;
     CHECK_OK(g, dpsm_set_source(g, &q));
     double sdt = 0.0;
@@ -1010,7 +1073,8 @@ static void test_last_error_cleared_by_every_successful_call(void **state) {
     double h[6] = {0, 0, 1, 0, 0, 0}, v = 0.0;
     uint8_t kinds[6] = {0};
     int64_t nx, ny;
-    for (int k = 0; k < 18; ++k) {
+    double faces[9]; /* (3 + 1) x 2 x faces, then 3 x (2 + 1) y faces, into one buffer */
+    for (int k = 0; k < 22; ++k) {
         assert_int_equal(dpsm_set_mobility(g, -1.0), DPSM_ERR_INVALID_VALUE);
         REQUIRE(dpsm_last_error(g)[0] != '\0', "no message after a failed call");
         const char *name = "";
@@ -1033,6 +1097,10 @@ static void test_last_error_cleared_by_every_successful_call(void **state) {
             case 15: name = "add_heights_region"; st = dpsm_add_heights_region(g, 0, 0, 3, 2, h); break;
             case 16: name = "get_heights_region"; st = dpsm_get_heights_region(g, 2, 0, 1, 2, h); break;
             case 17: name = "set_threads"; st = dpsm_set_threads(g, 2); break;
+            case 18: name = "set_side_levels"; st = dpsm_set_side_levels(g, DPSM_YMIN, h); break;
+            case 19: name = "get_side_outflow"; st = dpsm_get_side_outflow(g, DPSM_YMAX, &v); break;
+            case 20: name = "set_face_flux_recording"; st = dpsm_set_face_flux_recording(g, 1); break;
+            case 21: name = "get_face_fluxes"; st = dpsm_get_face_fluxes(g, faces, faces); break;
             case 12: name = "set_rest_tolerance + set_max_substeps";
                 st = dpsm_set_rest_tolerance(g, 1e-5);
                 if (st == DPSM_OK) {
@@ -1187,9 +1255,20 @@ static void test_step_info(void **state) {
     CHECK_OK(g, dpsm_get_step_info(g, DPSM_INFO_CELL_UPDATES, &updates));
     REQUIRE(substeps == 0.0 && time == 0.0 && rest == 1.0 && updates == 0.0,
             "resting step: %g sub-steps, time %g, rest %g, %g cell updates", substeps, time, rest, updates);
-    /* A driven step: every sub-step taken, time exactly dt, not at rest. */
+    /* A source that cannot make a face steep within the step is applied in
+     * closed form: no sub-step, the whole dt integrated, at rest. */
     double q[NX];
     for (int i = 0; i < NX; ++i) q[i] = 0.01;
+    CHECK_OK(g, dpsm_set_source(g, q));
+    CHECK_OK(g, dpsm_step(g, 5.0));
+    CHECK_OK(g, dpsm_get_step_info(g, DPSM_INFO_SUBSTEPS, &substeps));
+    CHECK_OK(g, dpsm_get_step_info(g, DPSM_INFO_TIME_INTEGRATED, &time));
+    CHECK_OK(g, dpsm_get_step_info(g, DPSM_INFO_AT_REST, &rest));
+    REQUIRE(substeps == 0.0 && time == 5.0 && rest == 1.0, "gentle source: %g sub-steps, time %g, rest %g", substeps,
+            time, rest);
+    /* A driven step (a source that makes faces steep): every sub-step taken,
+     * time exactly dt, not at rest. */
+    q[NX / 2] = 50.0;
     CHECK_OK(g, dpsm_set_source(g, q));
     /* dt = (k + 0.37) stable steps, k = 0..63: k + 1 sub-steps each; the time
      * must be dt itself, not (k + 1) * (dt / (k + 1)) rounded. */
@@ -1298,8 +1377,8 @@ static void test_work_limit(void **state) {
     double v = 0.0;
     CHECK_OK(g, dpsm_get_step_info(g, DPSM_INFO_SUBSTEPS, &v));
     REQUIRE(v > 3.0, "collapse took %g sub-steps; the limit of 3 must not apply to it", v);
-    /* Driven: 3 sub-steps allowed, 4 refused. */
-    double q[NX] = {0.1, 0.1, 0.1, 0.1, 0.1, 0.1};
+    /* Driven (a source that makes faces steep): 3 sub-steps allowed, 4 refused. */
+    double q[NX] = {0.1, 0.1, 0.1, 50.0, 0.1, 0.1};
     CHECK_OK(g, dpsm_set_source(g, q));
     CHECK_OK(g, dpsm_step(g, 2.5 * sdt));
     CHECK_OK(g, dpsm_get_step_info(g, DPSM_INFO_SUBSTEPS, &v));
@@ -1797,6 +1876,174 @@ static void test_source_on_sand_cells_only(void **state) {
 }
 
 /* ------------------------------------------------------------------------ */
+/* Coupling: side levels, side outflows, face fluxes with good inputs        */
+/* ------------------------------------------------------------------------ */
+
+enum { PILE_1D = 1, PILE_2D = 2, PILE_AXI = 3 };
+static const char *const kPileNames[4] = {"", "1D", "2D", "axisymmetric"};
+
+/* A steep pile against the outer side (DPSM_XMAX, open) of a small grid of
+ * each kind; *nfx and *nfy receive the numbers of x and y faces. */
+static dpsm_grid *pile_grid(int kind, size_t *nfx, size_t *nfy) {
+    enum { NX = 7, NY = 5 };
+    dpsm_grid *g = NULL;
+    const int64_t ny = kind == PILE_2D ? NY : 1;
+    if (kind == PILE_1D) CHECK_OK(NULL, dpsm_create_1d(NX, 0.25, &g));
+    if (kind == PILE_2D) CHECK_OK(NULL, dpsm_create_2d(NX, NY, 0.25, 0.2, &g));
+    if (kind == PILE_AXI) CHECK_OK(NULL, dpsm_create_axisymmetric(NX, 0.25, &g));
+    double h[NX * NY] = {0};
+    for (int64_t j = 0; j < ny; ++j) h[NX - 2 + NX * j] = 2.0 + 0.1 * (double)j;
+    CHECK_OK(g, dpsm_set_heights(g, h));
+    CHECK_OK(g, dpsm_set_boundary(g, DPSM_XMAX, DPSM_OPEN));
+    *nfx = (size_t)((NX + 1) * ny);
+    *nfy = kind == PILE_2D ? (size_t)(NX * (NY + 1)) : 0;
+    return g;
+}
+
+/* Recording is off by default; on, the fluxes read 0 until a step and then
+ * what the step carried, in exactly (nx+1)*ny and nx*(ny+1) values; turned
+ * on again it keeps them; off drops them; on again they read 0. */
+static void test_face_flux_recording_and_readers(void **state) {
+    (void)state;
+    enum { ROOM = 64 };
+    for (int kind = PILE_1D; kind <= PILE_AXI; ++kind) {
+        size_t nfx, nfy;
+        dpsm_grid *g = pile_grid(kind, &nfx, &nfy);
+        double x[ROOM + 1], y[ROOM + 1], x2[ROOM + 1], y2[ROOM + 1];
+        double *fy = nfy ? y : NULL;
+        EXPECT_FAIL_EX(NULL, g, dpsm_get_face_fluxes(g, x, fy), DPSM_ERR_NOT_APPLICABLE, "dpsm_get_face_fluxes",
+                       "dpsm_set_face_flux_recording", NULL);
+        CHECK_OK(g, dpsm_set_face_flux_recording(g, 1));
+        for (int k = 0; k <= ROOM; ++k) x[k] = y[k] = 42.0;
+        CHECK_OK(g, dpsm_get_face_fluxes(g, x, fy));
+        for (size_t f = 0; f < nfx; ++f) REQUIRE(x[f] == 0.0, "%s: x face %zu reads %g before any step", kPileNames[kind], f, x[f]);
+        for (size_t f = 0; f < nfy; ++f) REQUIRE(y[f] == 0.0, "%s: y face %zu reads %g before any step", kPileNames[kind], f, y[f]);
+        REQUIRE(x[nfx] == 42.0 && (nfy == 0 || y[nfy] == 42.0), "%s: more values written than there are faces",
+                kPileNames[kind]);
+        CHECK_OK(g, dpsm_step(g, 0.05));
+        CHECK_OK(g, dpsm_get_face_fluxes(g, x, fy));
+        REQUIRE(x[nfx] == 42.0 && (nfy == 0 || y[nfy] == 42.0), "%s: more values written than there are faces",
+                kPileNames[kind]);
+        REQUIRE(max_of(x, nfx) > 0.0, "%s: the pile's faces carried nothing towards the open side", kPileNames[kind]);
+        CHECK_OK(g, dpsm_set_face_flux_recording(g, 1)); /* on again: kept */
+        CHECK_OK(g, dpsm_get_face_fluxes(g, x2, nfy ? y2 : NULL));
+        REQUIRE(memcmp(x, x2, nfx * sizeof(double)) == 0 && memcmp(y, y2, nfy * sizeof(double)) == 0,
+                "%s: turning recording on again changed the fluxes", kPileNames[kind]);
+        CHECK_OK(g, dpsm_set_face_flux_recording(g, 0));
+        EXPECT_FAIL_EX(NULL, g, dpsm_get_face_fluxes(g, x, fy), DPSM_ERR_NOT_APPLICABLE, "dpsm_get_face_fluxes",
+                       "dpsm_set_face_flux_recording", NULL);
+        CHECK_OK(g, dpsm_set_face_flux_recording(g, 1));
+        CHECK_OK(g, dpsm_get_face_fluxes(g, x, fy));
+        REQUIRE(max_of(x, nfx) == 0.0 && min_of(x, nfx) == 0.0, "%s: fluxes kept after recording was off",
+                kPileNames[kind]);
+        dpsm_destroy(g);
+    }
+}
+
+/* Recording the fluxes changes no result: heights, ledger, side outflows and
+ * step information bit for bit as without it. */
+static void test_face_flux_recording_changes_nothing(void **state) {
+    (void)state;
+    for (int kind = PILE_1D; kind <= PILE_AXI; ++kind) {
+        size_t nfx, nfy;
+        dpsm_grid *plain = pile_grid(kind, &nfx, &nfy), *recording = pile_grid(kind, &nfx, &nfy);
+        CHECK_OK(recording, dpsm_set_face_flux_recording(recording, 1));
+        for (int k = 0; k < 3; ++k) {
+            CHECK_OK(plain, dpsm_step(plain, k == 2 ? 1e3 : 0.03));
+            CHECK_OK(recording, dpsm_step(recording, k == 2 ? 1e3 : 0.03));
+            snapshot_t a, b;
+            SNAPSHOT(plain, &a);
+            SNAPSHOT(recording, &b);
+            REQUIRE(a.fluxes_status == DPSM_ERR_NOT_APPLICABLE && b.fluxes_status == DPSM_OK,
+                    "%s: fluxes %s without recording, %s with it", kPileNames[kind],
+                    dpsm_status_string(a.fluxes_status), dpsm_status_string(b.fluxes_status));
+            b.fluxes_status = a.fluxes_status;
+            b.nfx = b.nfy = 0;
+            a.nfx = a.nfy = 0;
+            COMPARE_SNAPSHOTS(&a, &b, "without and with recording");
+        }
+        dpsm_destroy(plain);
+        dpsm_destroy(recording);
+    }
+}
+
+/* A step relaxed to rest carries sand by no face: the fluxes are refused
+ * until a step in time records them again. */
+static void test_face_fluxes_after_relaxation_to_rest(void **state) {
+    (void)state;
+    enum { NX = 8, NY = 8 };
+    dpsm_grid *g = NULL;
+    CHECK_OK(NULL, dpsm_create_2d(NX, NY, 1.0, 1.0, &g));
+    load_pile_2d(g, NX, NY, 8.0);
+    CHECK_OK(g, dpsm_set_face_flux_recording(g, 1));
+    CHECK_OK(g, dpsm_set_relaxation(g, DPSM_RELAX_TO_REST));
+    CHECK_OK(g, dpsm_step(g, 1.0));
+    REQUIRE(step_info_of(g, DPSM_INFO_AT_REST) == 1.0 && step_info_of(g, DPSM_INFO_TIME_INTEGRATED) == 0.0,
+            "the pile was not relaxed to rest");
+    double x[(NX + 1) * NY], y[NX * (NY + 1)];
+    EXPECT_FAIL_EX(NULL, g, dpsm_get_face_fluxes(g, x, y), DPSM_ERR_NOT_APPLICABLE, "dpsm_get_face_fluxes",
+                   "DPSM_RELAX_TO_REST", NULL);
+    CHECK_OK(g, dpsm_set_relaxation(g, DPSM_RELAX_TIME_ACCURATE));
+    CHECK_OK(g, dpsm_step(g, 1.0));
+    CHECK_OK(g, dpsm_get_face_fluxes(g, x, y)); /* at rest: all 0 */
+    REQUIRE(max_of(x, (NX + 1) * NY) == 0.0 && min_of(x, (NX + 1) * NY) == 0.0 && max_of(y, NX * (NY + 1)) == 0.0 &&
+                min_of(y, NX * (NY + 1)) == 0.0,
+            "a step at rest carried sand");
+    dpsm_destroy(g);
+}
+
+/* Each side a grid has reads 0 on a fresh grid; a side that took sand while
+ * open keeps that figure once it is a wall again. */
+static void test_side_outflow_reader(void **state) {
+    (void)state;
+    for (int kind = PILE_1D; kind <= PILE_AXI; ++kind) {
+        size_t nfx, nfy;
+        dpsm_grid *g = pile_grid(kind, &nfx, &nfy);
+        for (int side = DPSM_XMIN; side <= DPSM_YMAX; ++side) {
+            double v = 42.0;
+            const int has = side == DPSM_XMAX || (side == DPSM_XMIN && kind != PILE_AXI) || kind == PILE_2D;
+            REQUIRE(dpsm_get_side_outflow(g, side, &v) == (has ? DPSM_OK : DPSM_ERR_NOT_APPLICABLE),
+                    "%s: side %d: %s", kPileNames[kind], side, dpsm_last_error(g));
+            if (has) REQUIRE(v == 0.0 && !signbit(v), "%s: side %d of a fresh grid reads %g", kPileNames[kind], side, v);
+        }
+        double out = 0.0, kept = 0.0;
+        CHECK_OK(g, dpsm_step(g, 1e3));
+        CHECK_OK(g, dpsm_get_side_outflow(g, DPSM_XMAX, &out));
+        REQUIRE(out > 0.0, "%s: nothing left through the open side", kPileNames[kind]);
+        CHECK_OK(g, dpsm_set_boundary(g, DPSM_XMAX, DPSM_WALL));
+        CHECK_OK(g, dpsm_add_heights_region(g, 0, 0, 1, 1, (const double[]){5.0}));
+        CHECK_OK(g, dpsm_step(g, 1e3));
+        CHECK_OK(g, dpsm_get_side_outflow(g, DPSM_XMAX, &kept));
+        REQUIRE(kept == out, "%s: a wall side's outflow went from %.17g to %.17g", kPileNames[kind], out, kept);
+        dpsm_destroy(g);
+    }
+}
+
+/* Levels set and then returned to 0 with NULL leave the grid as one that
+ * never had them, on every side of every kind of grid. */
+static void test_side_levels_null_returns_to_zero(void **state) {
+    (void)state;
+    const double levels[8] = {0.4, 0.5, 0.6, 0.7, 0.8, 0.9, 1.0, 1.1};
+    for (int kind = PILE_1D; kind <= PILE_AXI; ++kind) {
+        size_t nfx, nfy;
+        dpsm_grid *g = pile_grid(kind, &nfx, &nfy), *never = pile_grid(kind, &nfx, &nfy);
+        for (int side = kind == PILE_AXI ? DPSM_XMAX : DPSM_XMIN; side <= (kind == PILE_2D ? DPSM_YMAX : DPSM_XMAX);
+             ++side) {
+            CHECK_OK(g, dpsm_set_side_levels(g, side, levels));
+            CHECK_OK(g, dpsm_set_side_levels(g, side, NULL));
+            CHECK_OK(g, dpsm_set_boundary(g, side, DPSM_OPEN));
+            CHECK_OK(never, dpsm_set_boundary(never, side, DPSM_OPEN));
+        }
+        CHECK_OK(g, dpsm_step(g, 1e3));
+        CHECK_OK(never, dpsm_step(never, 1e3));
+        compare_grids_at(g, never, "levels returned to 0 vs never set", __FILE__, __LINE__);
+        REQUIRE(step_info_of(g, DPSM_INFO_AT_REST) == 1.0, "%s: not at rest", kPileNames[kind]);
+        dpsm_destroy(g);
+        dpsm_destroy(never);
+    }
+}
+
+/* ------------------------------------------------------------------------ */
 /* NULL grid, for every function                                             */
 /* ------------------------------------------------------------------------ */
 
@@ -1847,6 +2094,14 @@ static void test_null_grid_every_function(void **state) {
     EXPECT_NULL_GRID(dpsm_set_max_substeps(NULL, 0), "dpsm_set_max_substeps");
     EXPECT_NULL_GRID(dpsm_set_threads(NULL, 1), "dpsm_set_threads");
     EXPECT_NULL_GRID(dpsm_set_threads(NULL, -1), "dpsm_set_threads");
+    EXPECT_NULL_GRID(dpsm_set_side_levels(NULL, DPSM_XMAX, h), "dpsm_set_side_levels");
+    EXPECT_NULL_GRID(dpsm_set_side_levels(NULL, 99, NULL), "dpsm_set_side_levels");
+    EXPECT_NULL_GRID(dpsm_get_side_outflow(NULL, DPSM_XMAX, &v), "dpsm_get_side_outflow");
+    EXPECT_NULL_GRID(dpsm_get_side_outflow(NULL, 99, NULL), "dpsm_get_side_outflow");
+    EXPECT_NULL_GRID(dpsm_set_face_flux_recording(NULL, 1), "dpsm_set_face_flux_recording");
+    EXPECT_NULL_GRID(dpsm_set_face_flux_recording(NULL, 2), "dpsm_set_face_flux_recording");
+    EXPECT_NULL_GRID(dpsm_get_face_fluxes(NULL, h, h), "dpsm_get_face_fluxes");
+    EXPECT_NULL_GRID(dpsm_get_face_fluxes(NULL, NULL, NULL), "dpsm_get_face_fluxes");
     assert_non_null(dpsm_last_error(NULL));
     assert_string_equal(dpsm_last_error(fx->g), kept);
     probe_behaviour_at(fx, __FILE__, __LINE__);
@@ -2037,12 +2292,14 @@ static void test_bad_bedrock(void **state) {
         snprintf(detail, sizeof detail, "zb[%zu]", where[w]);
         for (int k = 0; k < 4; ++k) {
             CHECK_OK(fx->g, dpsm_get_heights(fx->g, h)); /* the probe after each failure steps the grid */
-            for (size_t c = 0; c < fx->n; ++c) zb[c] = h[c] - 1.0;
-            /* Not finite, outside the supported range, or above the cell's height. */
-            zb[where[w]] = k < 3 ? non_finite(k) : nextafter(h[where[w]], INFINITY);
+            /* Every other cell's bed above its height: a bed that lifts the
+             * surface (dpsm_set_bedrock accepts it), so a partial update shows. */
+            for (size_t c = 0; c < fx->n; ++c) zb[c] = h[c] + 1.0;
+            /* Not finite, or outside the supported range. */
+            zb[where[w]] = k < 3 ? non_finite(k) : 2e50;
             EXPECT_FAIL_D(fx, dpsm_set_bedrock(fx->g, zb), DPSM_ERR_INVALID_VALUE, "dpsm_set_bedrock", "zb", detail);
         }
-        for (size_t c = 0; c < fx->n; ++c) zb[c] = h[c] - 1.0;
+        for (size_t c = 0; c < fx->n; ++c) zb[c] = h[c] + 1.0;
         zb[where[w]] = -2e50;
         EXPECT_FAIL_D(fx, dpsm_set_bedrock(fx->g, zb), DPSM_ERR_INVALID_VALUE, "dpsm_set_bedrock", "zb", "range");
     }
@@ -2151,6 +2408,124 @@ static void test_bad_max_substeps(void **state) {
         EXPECT_FAIL(fx, dpsm_set_max_substeps(fx->g, bad[k]), DPSM_ERR_INVALID_VALUE, "dpsm_set_max_substeps", "n");
 }
 
+/* ------------------------------------------------------------------------ */
+/* Coupling: side levels, side outflows, face fluxes                         */
+/* ------------------------------------------------------------------------ */
+
+static const char *const kSideNames[4] = {"DPSM_XMIN", "DPSM_XMAX", "DPSM_YMIN", "DPSM_YMAX"};
+
+/* Whether the fixture's grid has this side (not the y sides of a line, not
+ * the axis of an axisymmetric grid), and how many faces lie along it. */
+static int fixture_has_side(const fixture_t *fx, int side) {
+    if (side >= DPSM_YMIN) return fx->dim == 2;
+    return !(fx->axi && side == DPSM_XMIN);
+}
+static int64_t faces_along(const fixture_t *fx, int side) {
+    return fx->dim == 1 ? 1 : side <= DPSM_XMAX ? fx->ny : fx->nx;
+}
+/* The side each fixture's scene opens. */
+static int fixture_open_side(const fixture_t *fx) { return fx->dim == 1 && !fx->axi ? DPSM_XMIN : DPSM_XMAX; }
+
+/* What a bad call did to a wall side's levels shows only once the side is
+ * open: open it on the grid and its twin, probe, and make it a wall again. */
+static void probe_with_side_open(fixture_t *fx, int side, const char *file, int line) {
+    dpsm_grid *grids[2] = {fx->g, fx->ref};
+    for (int k = 0; k < 2; ++k)
+        check_ok_(grids[k], dpsm_set_boundary(grids[k], side, DPSM_OPEN), "dpsm_set_boundary(OPEN)", file, line);
+    probe_behaviour_at(fx, file, line);
+    for (int k = 0; k < 2; ++k)
+        check_ok_(grids[k], dpsm_set_boundary(grids[k], side, DPSM_WALL), "dpsm_set_boundary(WALL)", file, line);
+}
+
+/* Unknown sides, sides the grid does not have, and a level that is not finite
+ * or out of range at the first, a middle and the last face of every side
+ * (open or wall), among valid levels that differ from the grid's so that a
+ * partial update would show: refused, the message naming the face and the
+ * side, the grid unchanged. */
+static void test_bad_side_levels(void **state) {
+    fixture_t *fx = *state;
+    const char *fn = "dpsm_set_side_levels";
+    double levels[MAX_CELLS];
+    for (int k = 0; k < MAX_CELLS; ++k) levels[k] = 0.7 + 0.01 * k;
+    const int bad_sides[] = {-1, 4, 5, 255, INT_MAX, INT_MIN};
+    for (size_t k = 0; k < sizeof bad_sides / sizeof *bad_sides; ++k) {
+        EXPECT_FAIL(fx, dpsm_set_side_levels(fx->g, bad_sides[k], levels), DPSM_ERR_UNKNOWN_ENUM, fn, "side");
+        EXPECT_FAIL(fx, dpsm_set_side_levels(fx->g, bad_sides[k], NULL), DPSM_ERR_UNKNOWN_ENUM, fn, "side");
+    }
+    const double bad[] = {NAN, INFINITY, -INFINITY, 2e50, -2e50};
+    char detail[32];
+    for (int side = DPSM_XMIN; side <= DPSM_YMAX; ++side) {
+        if (!fixture_has_side(fx, side)) {
+            EXPECT_FAIL(fx, dpsm_set_side_levels(fx->g, side, levels), DPSM_ERR_NOT_APPLICABLE, fn, "side");
+            EXPECT_FAIL(fx, dpsm_set_side_levels(fx->g, side, NULL), DPSM_ERR_NOT_APPLICABLE, fn, "side");
+            continue;
+        }
+        const int64_t n = faces_along(fx, side), where[3] = {0, n / 2, n - 1};
+        for (int w = 0; w < (n < 3 ? 1 : 3); ++w)
+            for (size_t b = 0; b < sizeof bad / sizeof *bad; ++b) {
+                for (int k = 0; k < MAX_CELLS; ++k) levels[k] = 0.7 + 0.01 * k;
+                levels[where[w]] = bad[b];
+                snprintf(detail, sizeof detail, "levels[%lld]", (long long)where[w]);
+                EXPECT_FAIL_D(fx, dpsm_set_side_levels(fx->g, side, levels), DPSM_ERR_INVALID_VALUE, fn, "levels",
+                              detail);
+                /* The probe has cleared the message: repeat the call to read
+                 * that it names the side and what is wrong. */
+                assert_int_equal(dpsm_set_side_levels(fx->g, side, levels), DPSM_ERR_INVALID_VALUE);
+                const char *msg = dpsm_last_error(fx->g);
+                REQUIRE(strstr(msg, kSideNames[side]) != NULL, "message \"%s\" does not name %s", msg,
+                        kSideNames[side]);
+                const char *wrong = isfinite(bad[b]) ? "range" : isnan(bad[b]) ? "NaN" : bad[b] > 0 ? "+Inf" : "-Inf";
+                REQUIRE(strstr(msg, wrong) != NULL, "message \"%s\" does not say what is wrong with %g", msg, bad[b]);
+                compare_grids_at(fx->g, fx->ref, "after the repeated bad call", __FILE__, __LINE__);
+            }
+        if (side != fixture_open_side(fx)) probe_with_side_open(fx, side, __FILE__, __LINE__);
+    }
+}
+
+static void test_bad_side_outflow(void **state) {
+    fixture_t *fx = *state;
+    const char *fn = "dpsm_get_side_outflow";
+    double v = 0.0;
+    const int bad_sides[] = {-1, 4, 5, 255, INT_MAX, INT_MIN};
+    for (size_t k = 0; k < sizeof bad_sides / sizeof *bad_sides; ++k)
+        EXPECT_FAIL(fx, dpsm_get_side_outflow(fx->g, bad_sides[k], &v), DPSM_ERR_UNKNOWN_ENUM, fn, "side");
+    for (int side = DPSM_XMIN; side <= DPSM_YMAX; ++side) {
+        if (fixture_has_side(fx, side))
+            EXPECT_FAIL(fx, dpsm_get_side_outflow(fx->g, side, NULL), DPSM_ERR_NULL_POINTER, fn, "value");
+        else
+            EXPECT_FAIL(fx, dpsm_get_side_outflow(fx->g, side, &v), DPSM_ERR_NOT_APPLICABLE, fn, "side");
+    }
+}
+
+static void test_bad_face_flux_recording(void **state) {
+    fixture_t *fx = *state;
+    const int bad[] = {2, -1, 3, 255, INT_MAX, INT_MIN};
+    for (size_t k = 0; k < sizeof bad / sizeof *bad; ++k)
+        EXPECT_FAIL(fx, dpsm_set_face_flux_recording(fx->g, bad[k]), DPSM_ERR_INVALID_VALUE,
+                    "dpsm_set_face_flux_recording", "on");
+}
+
+/* NULL arrays, an fy on a grid without y faces, and recording off. */
+static void test_bad_face_fluxes(void **state) {
+    fixture_t *fx = *state;
+    const char *fn = "dpsm_get_face_fluxes";
+    double fxs[2 * MAX_CELLS], fys[2 * MAX_CELLS];
+    double *y = fx->dim == 2 ? fys : NULL;
+    EXPECT_FAIL(fx, dpsm_get_face_fluxes(fx->g, NULL, y), DPSM_ERR_NULL_POINTER, fn, "fx");
+    if (fx->dim == 2)
+        EXPECT_FAIL(fx, dpsm_get_face_fluxes(fx->g, fxs, NULL), DPSM_ERR_NULL_POINTER, fn, "fy");
+    else
+        EXPECT_FAIL_D(fx, dpsm_get_face_fluxes(fx->g, fxs, fys), DPSM_ERR_INVALID_VALUE, fn, "fy",
+                      fx->axi ? "axisymmetric" : "1D");
+    /* Recording off on both grids: nothing to read; back on, the fluxes start
+     * from 0 again. */
+    dpsm_grid *grids[2] = {fx->g, fx->ref};
+    for (int k = 0; k < 2; ++k) CHECK_OK(grids[k], dpsm_set_face_flux_recording(grids[k], 0));
+    EXPECT_FAIL(fx, dpsm_get_face_fluxes(fx->g, fxs, y), DPSM_ERR_NOT_APPLICABLE, fn, "dpsm_set_face_flux_recording");
+    for (int k = 0; k < 2; ++k) CHECK_OK(grids[k], dpsm_set_face_flux_recording(grids[k], 1));
+    EXPECT_FAIL(fx, dpsm_get_face_fluxes(fx->g, NULL, NULL), DPSM_ERR_NULL_POINTER, fn, "fx");
+}
+
 /* The last test of each group: after every bad call above, the grid and its
  * twin still agree, and a run of ordinary steps keeps them together. */
 static void test_twin_still_identical(void **state) {
@@ -2202,6 +2577,11 @@ int main(int argc, char **argv) {
         cmocka_unit_test(test_source_on_sand_cells_only),
         cmocka_unit_test(test_physics_setters),
         cmocka_unit_test(test_heights_below_bed_refused),
+        cmocka_unit_test(test_face_flux_recording_and_readers),
+        cmocka_unit_test(test_face_flux_recording_changes_nothing),
+        cmocka_unit_test(test_face_fluxes_after_relaxation_to_rest),
+        cmocka_unit_test(test_side_outflow_reader),
+        cmocka_unit_test(test_side_levels_null_returns_to_zero),
     };
 #define BAD_INPUT_TESTS                                                                                       \
     cmocka_unit_test(test_null_grid_every_function), cmocka_unit_test(test_bad_repose_angle),                 \
@@ -2215,8 +2595,9 @@ int main(int argc, char **argv) {
         cmocka_unit_test(test_bad_rest_tolerance), cmocka_unit_test(test_bad_max_substeps),                   \
         cmocka_unit_test(test_bad_threads), cmocka_unit_test(test_bad_bedrock),                               \
         cmocka_unit_test(test_bad_repose_angle_field), cmocka_unit_test(test_bad_flux_exponent),              \
-        cmocka_unit_test(test_bad_static_angle),                                                              \
-        cmocka_unit_test(test_twin_still_identical)
+        cmocka_unit_test(test_bad_static_angle), cmocka_unit_test(test_bad_side_levels),                      \
+        cmocka_unit_test(test_bad_side_outflow), cmocka_unit_test(test_bad_face_flux_recording),              \
+        cmocka_unit_test(test_bad_face_fluxes), cmocka_unit_test(test_twin_still_identical)
     const struct CMUnitTest bad_2d[] = {BAD_INPUT_TESTS};
     const struct CMUnitTest bad_1d[] = {BAD_INPUT_TESTS};
     const struct CMUnitTest bad_axi[] = {BAD_INPUT_TESTS};

@@ -150,6 +150,46 @@ static void require_same(const dpsm_grid *a, const dpsm_grid *b, int with_cost, 
     free(hb);
 }
 
+/* What a host couples, as dpsm_save must keep it: what left through each side
+ * the grid has, bit for bit, and whether face fluxes are recorded. Right after
+ * a load the loaded grid's fluxes read 0 (the file holds none); after the same
+ * steps they equal the saved grid's. */
+static void require_same_coupling(const dpsm_grid *a, const dpsm_grid *b, int just_loaded, const char *when) {
+    for (int side = DPSM_XMIN; side <= DPSM_YMAX; ++side) {
+        double va = 0.0, vb = 0.0;
+        const int sa = dpsm_get_side_outflow(a, side, &va), sb = dpsm_get_side_outflow(b, side, &vb);
+        REQUIRE(sa == sb && memcmp(&va, &vb, sizeof va) == 0, "%s: side %d took %.17g (%s) and %.17g (%s)", when,
+                side, va, dpsm_status_string(sa), vb, dpsm_status_string(sb));
+    }
+    int64_t nx, ny;
+    CHECK_OK(a, dpsm_get_shape(a, &nx, &ny));
+    const int two_d = dpsm_get_side_outflow(a, DPSM_YMIN, &(double){0.0}) == DPSM_OK;
+    const size_t nfx = (size_t)((nx + 1) * ny), nfy = two_d ? (size_t)(nx * (ny + 1)) : 0;
+    double *xa = calloc(nfx, sizeof(double)), *xb = calloc(nfx, sizeof(double));
+    double *ya = calloc(nfy + 1, sizeof(double)), *yb = calloc(nfy + 1, sizeof(double));
+    const int sa = dpsm_get_face_fluxes(a, xa, two_d ? ya : NULL), sb = dpsm_get_face_fluxes(b, xb, two_d ? yb : NULL);
+    REQUIRE(sa == sb, "%s: face fluxes %s and %s", when, dpsm_status_string(sa), dpsm_status_string(sb));
+    if (sa == DPSM_OK) {
+        size_t differ = 0, nonzero = 0;
+        for (size_t f = 0; f < nfx; ++f) {
+            differ += memcmp(&xa[f], &xb[f], sizeof(double)) != 0;
+            nonzero += xb[f] != 0.0;
+        }
+        for (size_t f = 0; f < nfy; ++f) {
+            differ += memcmp(&ya[f], &yb[f], sizeof(double)) != 0;
+            nonzero += yb[f] != 0.0;
+        }
+        if (just_loaded)
+            REQUIRE(nonzero == 0, "%s: %zu faces of the loaded grid read other than 0 before a step", when, nonzero);
+        else
+            REQUIRE(differ == 0, "%s: %zu of %zu face fluxes differ", when, differ, nfx + nfy);
+    }
+    free(xa);
+    free(xb);
+    free(ya);
+    free(yb);
+}
+
 /* A reproducible rough terrain in [0, amplitude). */
 static void rough(double *h, size_t n, double amplitude, unsigned seed) {
     unsigned s = seed;
@@ -174,6 +214,7 @@ static void require_continues(dpsm_grid *g, continuation more, int rounds, const
     CHECK_OK(NULL, dpsm_load(path, &loaded));
     assert_non_null(loaded);
     require_same(g, loaded, 1, name);
+    require_same_coupling(g, loaded, 1, name);
     /* Every field comes back exactly: the loaded grid writes the same file. */
     CHECK_OK(loaded, dpsm_save(loaded, again));
     size_t n1, n2;
@@ -190,6 +231,7 @@ static void require_continues(dpsm_grid *g, continuation more, int rounds, const
         char when[64];
         snprintf(when, sizeof when, "%s, round %d", name, round);
         require_same(g, loaded, 0, when);
+        require_same_coupling(g, loaded, 0, when);
     }
     dpsm_destroy(loaded);
 }
@@ -213,9 +255,10 @@ static void continue_full(dpsm_grid *g, int round) {
     if (round == 3) CHECK_OK(g, dpsm_step(g, 5.0));
 }
 
-/* Every feature at once: obstacles and open cells, open sides, a source
+/* Every feature at once: obstacles and open cells, open sides (one held at
+ * levels that vary along it, a wall side with levels of its own), a source
  * with erosion on a bed (some of it unmet), an angle field, exponent 1.5, a
- * static angle, both schemes, several threads. */
+ * static angle, face fluxes recorded, both schemes, several threads. */
 static void test_every_feature_continues_bit_for_bit(void **state) {
     (void)state;
     for (int scheme = DPSM_SCHEME_PAIRWISE; scheme <= DPSM_SCHEME_ISOTROPIC; ++scheme) {
@@ -253,6 +296,11 @@ static void test_every_feature_continues_bit_for_bit(void **state) {
         CHECK_OK(g, dpsm_set_flux_exponent(g, 1.5));
         CHECK_OK(g, dpsm_set_static_angle(g, 0.62));
         CHECK_OK(g, dpsm_set_source(g, q));
+        double levels[kNx];
+        for (int k = 0; k < kNx; ++k) levels[k] = 0.05 + 0.01 * (double)(k % 7);
+        CHECK_OK(g, dpsm_set_side_levels(g, DPSM_XMAX, levels));
+        CHECK_OK(g, dpsm_set_side_levels(g, DPSM_YMAX, levels));
+        CHECK_OK(g, dpsm_set_face_flux_recording(g, 1));
         for (int k = 0; k < 3; ++k) CHECK_OK(g, dpsm_step(g, 0.03));
         double unmet, outflow;
         CHECK_OK(g, dpsm_get_mass(g, DPSM_MASS_UNMET, &unmet));
@@ -310,6 +358,9 @@ static void test_1d_continues_bit_for_bit(void **state) {
     CHECK_OK(g, dpsm_set_source(g, q));
     CHECK_OK(g, dpsm_set_flux_exponent(g, 2.0));
     CHECK_OK(g, dpsm_set_static_angle(g, 0.7));
+    const double level = 0.4;
+    CHECK_OK(g, dpsm_set_side_levels(g, DPSM_XMAX, &level));
+    CHECK_OK(g, dpsm_set_face_flux_recording(g, 1));
     CHECK_OK(g, dpsm_step(g, 0.05));
     require_continues(g, continue_1d, 4, "line.dpsm");
     dpsm_destroy(g);
@@ -329,6 +380,7 @@ static void test_axisymmetric_continues_bit_for_bit(void **state) {
     }
     CHECK_OK(g, dpsm_set_heights(g, h));
     CHECK_OK(g, dpsm_set_repose_angle_field(g, theta));
+    CHECK_OK(g, dpsm_set_face_flux_recording(g, 1));
     CHECK_OK(g, dpsm_step(g, 0.02));
     require_continues(g, continue_axisymmetric, 4, "rings.dpsm");
     dpsm_destroy(g);
@@ -360,6 +412,27 @@ static unsigned char *small_file(const char *path, size_t *size) {
     return read_file(path, size);
 }
 
+/* A small file with every part of version 4: a 5 x 4 grid whose open side
+ * XMAX is held at levels and has taken sand, a wall side YMIN with levels of
+ * its own, face fluxes recorded; time-accurate. */
+enum { kCoupledBytes = kHeaderBytes + 20 * 13 + 4 * 16 + 8 * (4 + 5) + 4 };
+static unsigned char *small_coupled_file(const char *path, size_t *size) {
+    dpsm_grid *g = NULL;
+    CHECK_OK(NULL, dpsm_create_2d(5, 4, 0.1, 0.1, &g));
+    CHECK_OK(g, dpsm_set_relaxation(g, DPSM_RELAX_TIME_ACCURATE));
+    double h[20], levels[5] = {0.01, 0.02, 0.03, 0.04, 0.05};
+    for (int c = 0; c < 20; ++c) h[c] = 0.3 * (c % 5);
+    CHECK_OK(g, dpsm_set_heights(g, h));
+    CHECK_OK(g, dpsm_set_boundary(g, DPSM_XMAX, DPSM_OPEN));
+    CHECK_OK(g, dpsm_set_side_levels(g, DPSM_XMAX, levels));
+    CHECK_OK(g, dpsm_set_side_levels(g, DPSM_YMIN, levels));
+    CHECK_OK(g, dpsm_set_face_flux_recording(g, 1));
+    CHECK_OK(g, dpsm_step(g, 0.1));
+    CHECK_OK(g, dpsm_save(g, path));
+    dpsm_destroy(g);
+    return read_file(path, size);
+}
+
 /* dpsm_load must refuse the file with DPSM_ERR_BAD_FILE, make no grid and
  * name the file; `phrase` (if any) must be in the message. */
 static void require_refused(const char *path, const char *phrase, const char *what) {
@@ -373,14 +446,30 @@ static void require_refused(const char *path, const char *phrase, const char *wh
     if (phrase) REQUIRE(strstr(message, phrase) != NULL, "%s: the message lacks '%s': %s", what, phrase, message);
 }
 
-static void test_every_changed_byte_is_refused(void **state) {
-    (void)state;
+/* The file `good` with the double at `offset` replaced by `value`, its
+ * checksums made right again, written to `path`: dpsm_load must refuse it
+ * with `phrase` in the message (bytes: scratch of `size`). */
+static void require_refused_with_f64(const char *path, unsigned char *bytes, const unsigned char *good, size_t size,
+                                     size_t offset, double value, const char *phrase, const char *what) {
+    memcpy(bytes, good, size);
+    put_f64(bytes + offset, value);
+    reseal(bytes, size);
+    write_file(path, bytes, size);
+    require_refused(path, phrase, what);
+}
+
+/* Every byte changed, of a file with every array (version 1) and of one
+ * with every part of version 4. */
+static void every_changed_byte_is_refused(int coupled) {
     char path[300], bad[300];
     path_of(path, sizeof path, "small.dpsm");
     path_of(bad, sizeof bad, "changed.dpsm");
     size_t size;
-    unsigned char *good = small_file(path, &size);
-    REQUIRE(size == kHeaderBytes + 20 * (8 + 4 + 1 + 8 + 8 + 8 + 1) + 4, "the small file has %zu bytes", size);
+    unsigned char *good = coupled ? small_coupled_file(path, &size) : small_file(path, &size);
+    const size_t want = coupled ? kCoupledBytes : kHeaderBytes + 20 * (8 + 4 + 1 + 8 + 8 + 8 + 1) + 4;
+    REQUIRE(size == want, "the small file has %zu bytes, not %zu", size, want);
+    REQUIRE(get_u32(good + kOffsetVersion) == (coupled ? 4u : 1u), "the small file is of version %u",
+            get_u32(good + kOffsetVersion));
     unsigned char *bytes = malloc(size);
     const unsigned char masks[2] = {0xff, 0x01};
     int tried = 0;
@@ -408,13 +497,18 @@ static void test_every_changed_byte_is_refused(void **state) {
     free(good);
 }
 
-static void test_every_truncation_is_refused(void **state) {
+static void test_every_changed_byte_is_refused(void **state) {
     (void)state;
+    every_changed_byte_is_refused(0);
+    every_changed_byte_is_refused(1);
+}
+
+static void every_truncation_is_refused(int coupled) {
     char path[300], cut[300];
     path_of(path, sizeof path, "small.dpsm");
     path_of(cut, sizeof cut, "cut.dpsm");
     size_t size;
-    unsigned char *good = small_file(path, &size);
+    unsigned char *good = coupled ? small_coupled_file(path, &size) : small_file(path, &size);
     for (size_t length = 0; length < size; ++length) {
         write_file(cut, good, length);
         char what[64];
@@ -437,6 +531,12 @@ static void test_every_truncation_is_refused(void **state) {
     free(good);
 }
 
+static void test_every_truncation_is_refused(void **state) {
+    (void)state;
+    every_truncation_is_refused(0);
+    every_truncation_is_refused(1);
+}
+
 /* Behind intact checksums, every value is still checked as a setter would. */
 static void test_values_are_checked_behind_the_checksum(void **state) {
     (void)state;
@@ -452,10 +552,10 @@ static void test_values_are_checked_behind_the_checksum(void **state) {
     REQUIRE(get_u32(good + kOffsetVersion) == 1, "the small file is of version %u, not 1",
             get_u32(good + kOffsetVersion));
     memcpy(bytes, good, size);
-    put_u32(bytes + kOffsetVersion, 4);
+    put_u32(bytes + kOffsetVersion, 5);
     reseal(bytes, size);
     write_file(bad, bytes, size);
-    require_refused(bad, "written by a newer dpsm, version 4", "version 4");
+    require_refused(bad, "written by a newer dpsm, version 5", "version 5");
 
     /* The relaxations' flags: DPSM_RELAX_AUTO's needs version 3, and a file
      * cannot ask for both. */
@@ -463,12 +563,12 @@ static void test_values_are_checked_behind_the_checksum(void **state) {
     require_refused(bad, "need version 3", "the flag of DPSM_RELAX_AUTO in version 2");
     write_with_header(bad, bytes, good, size, 3, 64u | 32u);
     require_refused(bad, "both relaxation flags", "both relaxations");
+    /* Version 4's parts need version 4: the recording flag (no data of its own). */
+    write_with_header(bad, bytes, good, size, 3, 1u << 12);
+    require_refused(bad, "need version 4", "the recording flag in version 3");
 
-    memcpy(bytes, good, size);
-    put_f64(bytes + kOffsetRepose, 2.0);
-    reseal(bytes, size);
-    write_file(bad, bytes, size);
-    require_refused(bad, "angle of repose 2 radians", "a repose angle of 2");
+    require_refused_with_f64(bad, bytes, good, size, kOffsetRepose, 2.0, "angle of repose 2 radians",
+                             "a repose angle of 2");
 
     memcpy(bytes, good, size);
     bytes[kHeaderBytes + 20 * 12 + 7] = 3; /* kinds[7] */
@@ -476,17 +576,10 @@ static void test_values_are_checked_behind_the_checksum(void **state) {
     write_file(bad, bytes, size);
     require_refused(bad, "kinds[7] (cell i = 2, j = 1) = 3", "a cell kind 3");
 
-    memcpy(bytes, good, size);
-    put_f64(bytes + kHeaderBytes + 8 * 4, -1.0); /* h[4], below its bed */
-    reseal(bytes, size);
-    write_file(bad, bytes, size);
-    require_refused(bad, "below its bed", "a height below the bed");
-
-    memcpy(bytes, good, size);
-    put_f64(bytes + kHeaderBytes + 8 * 4, NAN);
-    reseal(bytes, size);
-    write_file(bad, bytes, size);
-    require_refused(bad, "h[4]", "a NaN height");
+    /* h[4], below its bed, then NaN. */
+    require_refused_with_f64(bad, bytes, good, size, kHeaderBytes + 8 * 4, -1.0, "below its bed",
+                             "a height below the bed");
+    require_refused_with_f64(bad, bytes, good, size, kHeaderBytes + 8 * 4, NAN, "h[4]", "a NaN height");
 
     /* A header that claims a huge grid is refused by the size of the file,
      * before anything of that size is allocated. */
@@ -699,6 +792,78 @@ static void test_null_arguments(void **state) {
     dpsm_destroy(g);
 }
 
+/* Version 4: written exactly when a grid has side levels, sand that left
+ * through a side, or its face fluxes recorded (each alone makes it, and adds
+ * its bytes); behind intact checksums its values are checked too. */
+static void test_version_4(void **state) {
+    (void)state;
+    char path[300], bad[300];
+    path_of(path, sizeof path, "v4.dpsm");
+    path_of(bad, sizeof bad, "v4_bad.dpsm");
+    const size_t base = kHeaderBytes + 20 * 13 + 4;
+    const double levels[5] = {0.1, 0.2, 0.3, 0.4, 0.5}, pile = 3.0;
+    for (int part = 0; part < 4; ++part) {
+        dpsm_grid *g = NULL;
+        CHECK_OK(NULL, dpsm_create_2d(5, 4, 0.1, 0.1, &g));
+        CHECK_OK(g, dpsm_set_relaxation(g, DPSM_RELAX_TIME_ACCURATE));
+        size_t more = 0;
+        if (part == 1) {
+            CHECK_OK(g, dpsm_set_side_levels(g, DPSM_YMAX, levels)); /* on a wall side */
+            more = 8 * 5;
+        }
+        if (part == 2) CHECK_OK(g, dpsm_set_face_flux_recording(g, 1));
+        if (part == 3) { /* a pile that leaves through XMIN, a side made a wall again */
+            CHECK_OK(g, dpsm_set_heights_region(g, 0, 1, 1, 1, &pile));
+            CHECK_OK(g, dpsm_set_boundary(g, DPSM_XMIN, DPSM_OPEN));
+            CHECK_OK(g, dpsm_step(g, 1.0));
+            CHECK_OK(g, dpsm_set_boundary(g, DPSM_XMIN, DPSM_WALL));
+            more = 4 * 16;
+        }
+        CHECK_OK(g, dpsm_save(g, path));
+        size_t size;
+        unsigned char *file = read_file(path, &size);
+        const uint32_t version = get_u32(file + kOffsetVersion);
+        REQUIRE(version == (part == 0 ? 1u : 4u) && size == base + more,
+                "part %d: version %u and %zu bytes, expected %u and %zu", part, version, size, part == 0 ? 1u : 4u,
+                base + more);
+        dpsm_grid *loaded = NULL;
+        CHECK_OK(NULL, dpsm_load(path, &loaded));
+        require_same(g, loaded, 1, "a file of version 4");
+        require_same_coupling(g, loaded, 1, "a file of version 4");
+        free(file);
+        dpsm_destroy(g);
+        dpsm_destroy(loaded);
+    }
+
+    /* Behind the checksums: a level or a side's account that is not finite. */
+    size_t size;
+    unsigned char *good = small_coupled_file(path, &size), *bytes = malloc(size);
+    const size_t accounts = kHeaderBytes + 20 * 13, xmax_levels = accounts + 4 * 16;
+    require_refused_with_f64(bad, bytes, good, size, xmax_levels + 8 * 2, NAN, "the level beyond face 2 of side 1",
+                             "a NaN level");
+    require_refused_with_f64(bad, bytes, good, size, xmax_levels + 8 * 4 + 8 * 1, 2e50, /* YMIN's second */
+                             "the level beyond face 1 of side 2", "a level out of range");
+    require_refused_with_f64(bad, bytes, good, size, accounts + 16 * 1 + 8, INFINITY, /* XMAX's correction */
+                             "ledger account is not finite", "an infinite side account");
+    /* Levels of a side a 1D grid does not have. */
+    dpsm_grid *line = NULL;
+    CHECK_OK(NULL, dpsm_create_1d(6, 0.1, &line));
+    CHECK_OK(line, dpsm_set_side_levels(line, DPSM_XMAX, levels));
+    CHECK_OK(line, dpsm_save(line, path));
+    dpsm_destroy(line);
+    free(good);
+    free(bytes);
+    good = read_file(path, &size);
+    bytes = malloc(size);
+    memcpy(bytes, good, size);
+    put_u32(bytes + kOffsetFlags, (get_u32(bytes + kOffsetFlags) & ~(1u << 9)) | (1u << 10));
+    reseal(bytes, size);
+    write_file(bad, bytes, size);
+    require_refused(bad, "levels beyond side 2", "levels beyond the y side of a line");
+    free(good);
+    free(bytes);
+}
+
 /* The figure of the report: a 64 x 64 grid with and without every array. */
 static void test_file_sizes(void **state) {
     (void)state;
@@ -733,6 +898,7 @@ int main(void) {
         cmocka_unit_test(test_every_changed_byte_is_refused),
         cmocka_unit_test(test_every_truncation_is_refused),
         cmocka_unit_test(test_values_are_checked_behind_the_checksum),
+        cmocka_unit_test(test_version_4),
         cmocka_unit_test(test_block_files_need_dpsm_load_mpi),
         cmocka_unit_test(test_files_that_cannot_be_used),
         cmocka_unit_test(test_failed_save_leaves_the_old_file),

@@ -112,6 +112,7 @@ module dpsm
   public :: dpsm_set_source, dpsm_stable_dt, dpsm_step, dpsm_get_mass, dpsm_get_step_info
   public :: dpsm_get_shape, dpsm_set_rest_tolerance, dpsm_set_max_substeps, dpsm_set_threads
   public :: dpsm_set_bedrock, dpsm_set_repose_angle_field, dpsm_set_flux_exponent, dpsm_set_static_angle
+  public :: dpsm_set_side_levels, dpsm_get_side_outflow, dpsm_set_face_flux_recording, dpsm_get_face_fluxes
   public :: dpsm_save, dpsm_load
   public :: dpsm_last_error, dpsm_status_string, dpsm_version_string, dpsm_version_number
   ! Not in C: .true. when g holds a grid (its handle is not NULL).
@@ -162,6 +163,12 @@ module dpsm
   interface dpsm_get_shape
     module procedure get_shape_i64, get_shape_i32
   end interface dpsm_get_shape
+  interface dpsm_set_side_levels
+    module procedure set_side_levels_r1, set_side_levels_none
+  end interface dpsm_set_side_levels
+  interface dpsm_get_face_fluxes
+    module procedure get_face_fluxes_r1, get_face_fluxes_r2
+  end interface dpsm_get_face_fluxes
   interface dpsm_set_max_substeps
     module procedure set_max_substeps_i64, set_max_substeps_i32
   end interface dpsm_set_max_substeps
@@ -344,6 +351,33 @@ module dpsm
       real(c_double), value :: radians
     end function c_dpsm_set_static_angle
 
+    integer(c_int) function c_dpsm_set_side_levels(g, side, levels) bind(C, name='dpsm_set_side_levels')
+      import :: c_int, c_double, c_ptr
+      type(c_ptr), value :: g
+      integer(c_int), value :: side
+      real(c_double), intent(in), optional :: levels(*) ! absent: NULL
+    end function c_dpsm_set_side_levels
+
+    integer(c_int) function c_dpsm_get_side_outflow(g, side, value) bind(C, name='dpsm_get_side_outflow')
+      import :: c_int, c_double, c_ptr
+      type(c_ptr), value :: g
+      integer(c_int), value :: side
+      real(c_double), intent(out) :: value
+    end function c_dpsm_get_side_outflow
+
+    integer(c_int) function c_dpsm_set_face_flux_recording(g, on) bind(C, name='dpsm_set_face_flux_recording')
+      import :: c_int, c_ptr
+      type(c_ptr), value :: g
+      integer(c_int), value :: on
+    end function c_dpsm_set_face_flux_recording
+
+    integer(c_int) function c_dpsm_get_face_fluxes(g, fx, fy) bind(C, name='dpsm_get_face_fluxes')
+      import :: c_int, c_double, c_ptr
+      type(c_ptr), value :: g
+      real(c_double), intent(out) :: fx(*)
+      real(c_double), intent(out), optional :: fy(*) ! absent: NULL
+    end function c_dpsm_get_face_fluxes
+
     integer(c_int) function c_dpsm_save(g, path) bind(C, name='dpsm_save')
       import :: c_int, c_char, c_ptr
       type(c_ptr), value :: g
@@ -461,21 +495,57 @@ contains
     character(len=*), intent(in) :: where, name
     integer, intent(in) :: array_shape(:)
     integer(c_int) :: status
-    integer(c_int64_t) :: nx, ny
+    status = check_grid_shape_plus(g, where, name, 0, 0, array_shape)
+  end function check_grid_shape
+
+  !> As check_grid_shape, for an array of (nx + extra_x) by (ny + extra_y)
+  !> values, one per face of a kind: the x faces are (nx+1, ny), the y faces
+  !> (nx, ny+1).
+  function check_grid_shape_plus(g, where, name, extra_x, extra_y, array_shape) result(status)
+    type(dpsm_grid), intent(in) :: g
+    character(len=*), intent(in) :: where, name
+    integer, intent(in) :: extra_x, extra_y
+    integer, intent(in) :: array_shape(:)
+    integer(c_int) :: status
+    integer(c_int64_t) :: nx, ny, ni, nj
+    character(len=:), allocatable :: along_x, along_y
     logical :: ok
     status = c_dpsm_get_shape(g%ptr, nx, ny)
     if (status /= DPSM_OK) return
+    ni = nx + extra_x
+    nj = ny + extra_y
     if (size(array_shape) == 1) then
-      ok = int(array_shape(1), c_int64_t) == nx*ny
+      ok = int(array_shape(1), c_int64_t) == ni*nj
     else
-      ok = int(array_shape(1), c_int64_t) == nx .and. int(array_shape(2), c_int64_t) == ny
+      ok = int(array_shape(1), c_int64_t) == ni .and. int(array_shape(2), c_int64_t) == nj
     end if
     if (ok) return
     status = DPSM_ERR_INVALID_SIZE
+    along_x = plus_one('nx', extra_x)
+    along_y = plus_one('ny', extra_y)
     call set_message(g, where//': '//name//' has shape '//shape_string(array_shape)// &
                      ' but the grid has nx = '//itoa(nx)//', ny = '//itoa(ny)// &
-                     ': pass '//name//'(nx, ny) or '//name//'(nx*ny)')
-  end function check_grid_shape
+                     ': pass '//name//'('//along_x//', '//along_y//') or '//name//'('// &
+                     factor(along_x, extra_x)//'*'//factor(along_y, extra_y)//')')
+  end function check_grid_shape_plus
+
+  !> 'nx' or 'nx+1', for a message.
+  function plus_one(n, extra) result(s)
+    character(len=*), intent(in) :: n
+    integer, intent(in) :: extra
+    character(len=:), allocatable :: s
+    s = n
+    if (extra > 0) s = n//'+1'
+  end function plus_one
+
+  !> A sum in parentheses, as a factor in a message.
+  function factor(term, extra) result(s)
+    character(len=*), intent(in) :: term
+    integer, intent(in) :: extra
+    character(len=:), allocatable :: s
+    s = term
+    if (extra > 0) s = '('//term//')'
+  end function factor
 
   !> As check_grid_shape, for a block of ni by nj cells.
   function check_block_shape(g, where, name, ni, nj, array_shape) result(status)
@@ -645,7 +715,7 @@ contains
   end subroutine dpsm_set_scheme
 
   !> dpsm_set_relaxation(g, relaxation[, ierr]): DPSM_RELAX_AUTO (the default:
-  !> DPSM_RELAX_TO_REST where the scene allows it, else time-accurate),
+  !> sub-steps over dt, as DPSM_RELAX_TIME_ACCURATE),
   !> DPSM_RELAX_TO_REST (each dpsm_step relaxes to rest, fast) or
   !> DPSM_RELAX_TIME_ACCURATE (sub-steps over dt).
   subroutine dpsm_set_relaxation(g, relaxation, ierr)
@@ -1015,7 +1085,7 @@ contains
   ! ==== physics for real scenes =============================================
 
   !> dpsm_set_bedrock(g, zb[, ierr]): zb(nx, ny) or zb(nx*ny), a bed the sand
-  !> cannot erode, each value at or below its cell's height; without zb no bed.
+  !> cannot erode (a cell below it is lifted to it); without zb no bed.
   subroutine set_bedrock_r1(g, zb, ierr)
     type(dpsm_grid), intent(in) :: g
     real(c_double), intent(in), contiguous :: zb(:)
@@ -1093,6 +1163,113 @@ contains
     call clear_message(g)
     call finish(c_dpsm_set_static_angle(g%ptr, radians), ierr, 'dpsm_set_static_angle', g)
   end subroutine dpsm_set_static_angle
+
+  ! ==== coupling: side levels, side outflows, face fluxes ====================
+
+  !> dpsm_set_side_levels(g, side, levels[, ierr]): the level beyond each face
+  !> of `side`, levels(ny) for DPSM_XMIN and DPSM_XMAX, levels(nx) for
+  !> DPSM_YMIN and DPSM_YMAX (levels(1) on 1D and axisymmetric grids); without
+  !> levels the side returns to 0.
+  subroutine set_side_levels_r1(g, side, levels, ierr)
+    type(dpsm_grid), intent(in) :: g
+    integer(c_int), intent(in) :: side
+    real(c_double), intent(in), contiguous :: levels(:)
+    integer, intent(out), optional :: ierr
+    integer(c_int) :: status
+    integer(c_int64_t) :: nx, ny, faces
+    call clear_message(g)
+    status = c_dpsm_get_shape(g%ptr, nx, ny)
+    if (status == DPSM_OK) then
+      ! The C function refuses an unknown side before it reads any level.
+      faces = size(levels, kind=c_int64_t)
+      if (side == DPSM_XMIN .or. side == DPSM_XMAX) faces = ny
+      if (side == DPSM_YMIN .or. side == DPSM_YMAX) faces = nx
+      if (size(levels, kind=c_int64_t) /= faces) then
+        status = DPSM_ERR_INVALID_SIZE
+        call set_message(g, 'dpsm_set_side_levels: levels has '//itoa(size(levels, kind=c_int64_t))// &
+                         ' values but the side has '//itoa(faces)//' faces (ny for DPSM_XMIN and DPSM_XMAX, '// &
+                         'nx for DPSM_YMIN and DPSM_YMAX)')
+      else
+        status = c_dpsm_set_side_levels(g%ptr, side, levels)
+      end if
+    end if
+    call finish(status, ierr, 'dpsm_set_side_levels', g)
+  end subroutine set_side_levels_r1
+
+  subroutine set_side_levels_none(g, side, ierr)
+    type(dpsm_grid), intent(in) :: g
+    integer(c_int), intent(in) :: side
+    integer, intent(out), optional :: ierr
+    call clear_message(g)
+    call finish(c_dpsm_set_side_levels(g%ptr, side), ierr, 'dpsm_set_side_levels', g)
+  end subroutine set_side_levels_none
+
+  !> dpsm_get_side_outflow(g, side, value[, ierr]): the net mass that has left
+  !> through `side` since the grid was made (negative where more came in).
+  subroutine dpsm_get_side_outflow(g, side, value, ierr)
+    type(dpsm_grid), intent(in) :: g
+    integer(c_int), intent(in) :: side
+    real(c_double), intent(out) :: value
+    integer, intent(out), optional :: ierr
+    call clear_message(g)
+    call finish(c_dpsm_get_side_outflow(g%ptr, side, value), ierr, 'dpsm_get_side_outflow', g)
+  end subroutine dpsm_get_side_outflow
+
+  !> dpsm_set_face_flux_recording(g, on[, ierr]): on = 1 records the volume
+  !> each face carries in every step, 0 stops.
+  subroutine dpsm_set_face_flux_recording(g, on, ierr)
+    type(dpsm_grid), intent(in) :: g
+    integer(c_int), intent(in) :: on
+    integer, intent(out), optional :: ierr
+    call clear_message(g)
+    call finish(c_dpsm_set_face_flux_recording(g%ptr, on), ierr, 'dpsm_set_face_flux_recording', g)
+  end subroutine dpsm_set_face_flux_recording
+
+  !> dpsm_get_face_fluxes(g, fx[, fy][, ierr]): the volume each face carried in
+  !> the last step, positive towards increasing x (y): fx(nx+1, ny) or
+  !> fx((nx+1)*ny), fx(i, j) the face on the low side of cell (i, j); fy(nx, ny+1)
+  !> or fy(nx*(ny+1)) on 2D grids, left out on 1D and axisymmetric grids.
+  subroutine get_face_fluxes_r1(g, fx, fy, ierr)
+    type(dpsm_grid), intent(in) :: g
+    real(c_double), intent(out), contiguous :: fx(:)
+    real(c_double), intent(out), contiguous, optional :: fy(:)
+    integer, intent(out), optional :: ierr
+    if (present(fy)) then
+      call face_fluxes(g, shape(fx), fx, ierr, shape(fy), fy)
+    else
+      call face_fluxes(g, shape(fx), fx, ierr)
+    end if
+  end subroutine get_face_fluxes_r1
+
+  subroutine get_face_fluxes_r2(g, fx, fy, ierr)
+    type(dpsm_grid), intent(in) :: g
+    real(c_double), intent(out), contiguous :: fx(:, :)
+    real(c_double), intent(out), contiguous, optional :: fy(:, :)
+    integer, intent(out), optional :: ierr
+    if (present(fy)) then
+      call face_fluxes(g, shape(fx), fx, ierr, shape(fy), fy)
+    else
+      call face_fluxes(g, shape(fx), fx, ierr)
+    end if
+  end subroutine get_face_fluxes_r2
+
+  !> The shapes checked and the C function called, for both ranks (an absent
+  !> fy reaches C as NULL).
+  subroutine face_fluxes(g, fx_shape, fx, ierr, fy_shape, fy)
+    type(dpsm_grid), intent(in) :: g
+    integer, intent(in) :: fx_shape(:)
+    real(c_double), intent(out) :: fx(*)
+    integer, intent(out), optional :: ierr
+    integer, intent(in), optional :: fy_shape(:)
+    real(c_double), intent(out), optional :: fy(*)
+    integer(c_int) :: status
+    call clear_message(g)
+    status = check_grid_shape_plus(g, 'dpsm_get_face_fluxes', 'fx', 1, 0, fx_shape)
+    if (status == DPSM_OK .and. present(fy_shape)) &
+      status = check_grid_shape_plus(g, 'dpsm_get_face_fluxes', 'fy', 0, 1, fy_shape)
+    if (status == DPSM_OK) status = c_dpsm_get_face_fluxes(g%ptr, fx, fy)
+    call finish(status, ierr, 'dpsm_get_face_fluxes', g)
+  end subroutine face_fluxes
 
   ! ==== restart files ========================================================
 

@@ -93,8 +93,10 @@ typedef struct dpsm_grid dpsm_grid;
 /** @name Boundary kinds
  *  For dpsm_set_boundary(). @{ */
 /** Sand that reaches the side leaves the domain and is counted as outflow.
- *  The outside acts as a cell of height 0 one cell width beyond the edge cell
- *  (the paper's node held at h = 0). */
+ *  The outside acts as a cell held at a level one cell width beyond the edge
+ *  cell: 0 (the paper's node held at h = 0) unless dpsm_set_side_levels()
+ *  sets another; sand flows in from a higher outside level as it flows out
+ *  to a lower one. */
 #define DPSM_OPEN 0
 /** No flux crosses the side. The default for every side. */
 #define DPSM_WALL 1
@@ -118,14 +120,17 @@ typedef struct dpsm_grid dpsm_grid;
 /** @name Relaxations
  *  For dpsm_set_relaxation(): how dpsm_step() moves the surface. @{ */
 /** Explicit sub-steps, each stable and time accurate, to the end of `dt` or
- *  to rest: for a host that needs the flow's timing. */
+ *  to rest: the model's time advances by `dt`. */
 #define DPSM_RELAX_TIME_ACCURATE 0
 /** To rest in each dpsm_step(), in few flux evaluations, without a time
- *  scale; refused on scenes it does not support. */
+ *  scale, as dune models treat avalanches (instantaneous); refused on
+ *  scenes it does not support. A host's explicit choice: it does not keep
+ *  the flow's time. */
 #define DPSM_RELAX_TO_REST 1
-/** The default: ::DPSM_RELAX_TO_REST where the scene allows it and the
- *  relaxation rests within as many flux evaluations as `dt` holds stable
- *  sub-steps, else ::DPSM_RELAX_TIME_ACCURATE; decided at every dpsm_step(). */
+/** The default: the time-accurate steps of ::DPSM_RELAX_TIME_ACCURATE (the
+ *  model's time advances by `dt`), by whatever integrator this version
+ *  finds fastest among those that land within 1e-3 of them; in this version
+ *  they themselves. */
 #define DPSM_RELAX_AUTO 2
 /** @} */
 
@@ -150,10 +155,12 @@ typedef struct dpsm_grid dpsm_grid;
 #define DPSM_MASS_TOTAL 0
 /** Net mass added by sources (negative where erosion dominated). */
 #define DPSM_MASS_SOURCED 1
-/** Net mass added or removed by the host: dpsm_set_heights() and cell-kind
- *  changes that turn sand cells into wall or open cells or back. */
+/** Net mass added or removed by the host: dpsm_set_heights() and the other
+ *  height setters, a bed set above the sand (dpsm_set_bedrock() lifts it),
+ *  and cell-kind changes that turn sand cells into wall or open cells or back. */
 #define DPSM_MASS_EXTERNAL 2
-/** Net mass that left through open sides and open cells. */
+/** Net mass that left through open sides and open cells (negative where
+ *  more came in than left); dpsm_get_side_outflow() tells each side's part. */
 #define DPSM_MASS_OUTFLOW 3
 /** Erosion that found no sand above the bed (see dpsm_set_bedrock()) and was
  *  therefore not applied: the mass a host should give back to its flow. Never
@@ -166,12 +173,17 @@ typedef struct dpsm_grid dpsm_grid;
  *  For dpsm_get_step_info(): what the last successful dpsm_step() did. @{ */
 /** The number of sub-steps it took. */
 #define DPSM_INFO_SUBSTEPS 0
-/** The simulated time it integrated before the surface came to rest (equal to
- *  the requested `dt` when it did not come to rest). */
+/** The simulated time it integrated: the requested `dt` when sand moved to
+ *  its end or a source acted (a source acts over all of `dt`, in closed form
+ *  where it cannot make a face steep), else the time until the surface came
+ *  to rest; 0 after a relaxation to rest (::DPSM_RELAX_TO_REST), which
+ *  integrates no time. */
 #define DPSM_INFO_TIME_INTEGRATED 1
-/** 1 if it stopped because it found the surface at rest (or had nothing to
- *  do), 0 if it integrated all of `dt`; a surface that came to rest in the last
- *  sub-step reads 0 here, and the next step returns at once with 1. */
+/** 1 if it stopped because it found no sand sliding (or had nothing to do),
+ *  0 if sand slid to the end of `dt`; a surface that came to rest in the last
+ *  sub-step reads 0 here, and the next step returns at once with 1. A source
+ *  that cannot make a face steep does not keep a surface from rest: its
+ *  heights still grow by `q dt`. */
 #define DPSM_INFO_AT_REST 2
 /** The largest slope excess `|grad h| - tan(theta)` over the faces that
  *  carried sand in its last sub-step, measured at the start of that sub-step:
@@ -324,21 +336,15 @@ DPSM_API int dpsm_set_scheme(dpsm_grid *g, int scheme);
  * open cells at different levels. A host adds its deposit with
  * dpsm_add_heights_region() instead of a source.
  *
- * ::DPSM_RELAX_AUTO, the default, relaxes to rest where that is the shorter
- * way to where the time-accurate steps would go: where ::DPSM_RELAX_TO_REST
- * would be accepted, `dt` holds at least 16 stable sub-steps
- * (dpsm_stable_dt()), and the relaxation rests within as many flux
- * evaluations as `dt` holds sub-steps (the sand would then have come to rest
- * within about `dt` anyway). Otherwise it takes the time-accurate sub-steps
- * over `dt`: where the relaxation is refused (a source that pours, a bed, a
- * distributed grid, ...), where `dt` is short, and, from the same start
- * (residuals included), where the flow outlasts the relaxation's budget. So
- * a step by default never costs much more than the time-accurate one plus
- * what the relaxation tried, and a flow that lasts longer than `dt` is
- * advanced in time. ::DPSM_INFO_TIME_INTEGRATED tells which it took (0 after
- * a relaxation to rest). A host that needs the flow's timing in every step
- * (a transient, a coupling through the avalanche's duration) asks for
- * ::DPSM_RELAX_TIME_ACCURATE; \ref guide_time_steps compares the three.
+ * ::DPSM_RELAX_AUTO, the default, keeps the flow's time: after every call
+ * the heights are those of the time-accurate sub-steps over the same `dt`
+ * (in this version it takes them; \ref guide_time_steps says what faster
+ * integrators were measured against that promise), and rest is reported
+ * when they would report it. ::DPSM_INFO_TIME_INTEGRATED tells which mode a
+ * step took (0 after a relaxation to rest). On the column collapse of the
+ * guide, relaxing to rest reports rest after 0.15 model seconds where the
+ * flow takes 1.05, its summit 5 % lower at that time: a host that needs the
+ * flow's timing keeps the default.
  *
  * @param g           the grid.
  * @param relaxation  ::DPSM_RELAX_AUTO, ::DPSM_RELAX_TO_REST or
@@ -358,6 +364,36 @@ DPSM_API int dpsm_set_relaxation(dpsm_grid *g, int relaxation);
  *         axisymmetric grid.
  */
 DPSM_API int dpsm_set_boundary(dpsm_grid *g, int side, int kind);
+
+/**
+ * @brief Sets the surface level outside an open side, face by face.
+ *
+ * The outside of an open side acts as a cell held at this level one cell
+ * width beyond each boundary face (the paper's node held at `h = 0` is the
+ * default): sand leaves towards a lower level and comes in from a higher one,
+ * until the faces are no steeper than the angle of repose, and the ledger
+ * books both as outflow (dpsm_get_side_outflow()). For a host that knows what
+ * lies beyond (a table at some height, the surface of a neighbouring domain
+ * it couples itself). Levels may be set on a wall side; they act once the
+ * side is made open (dpsm_set_boundary()). Beyond a corner of two open sides
+ * the outside is the mean of the two levels nearest to it (it only enters
+ * the transverse slopes of the corner's faces). A scene whose held levels
+ * differ (open sides and open cells) may flow for ever: dpsm_step() then
+ * limits its sub-steps (dpsm_set_max_substeps()).
+ *
+ * @param g       the grid.
+ * @param side    ::DPSM_XMIN, ::DPSM_XMAX, ::DPSM_YMIN or ::DPSM_YMAX (the
+ *                last two on 2D grids only; not the axis of an axisymmetric grid).
+ * @param levels  one finite value per boundary face, within the supported
+ *                range: `ny` values for ::DPSM_XMIN and ::DPSM_XMAX (face `j`
+ *                beside cell `(0, j)` or `(nx-1, j)`), `nx` for ::DPSM_YMIN and
+ *                ::DPSM_YMAX; on a 1D or axisymmetric grid one value. NULL
+ *                returns the side to 0.
+ * @return ::DPSM_OK, ::DPSM_ERR_NULL_POINTER, ::DPSM_ERR_UNKNOWN_ENUM,
+ *         ::DPSM_ERR_NOT_APPLICABLE (a side the grid does not have) or
+ *         ::DPSM_ERR_INVALID_VALUE (the message names the face).
+ */
+DPSM_API int dpsm_set_side_levels(dpsm_grid *g, int side, const double *levels);
 
 /**
  * @brief Sets the kind of every cell.
@@ -474,27 +510,34 @@ DPSM_API int dpsm_set_source(dpsm_grid *g, const double *q);
 DPSM_API int dpsm_stable_dt(const dpsm_grid *g, double *dt);
 
 /**
- * @brief Advances the surface by `dt`, or (by default, where the scene
- *        allows it) straight to rest.
+ * @brief Advances the surface by `dt` (or, with ::DPSM_RELAX_TO_REST,
+ *        straight to rest).
  *
- * By default (::DPSM_RELAX_AUTO) a step on a 2D grid whose scene the fast
- * relaxation supports brings the surface to rest, in far fewer flux
- * evaluations than sub-steps would take, when it gets there within as many
- * evaluations as `dt` holds sub-steps; dpsm_set_relaxation() tells which
- * scenes those are and how to ask for time-accurate steps always. What
- * follows describes the time-accurate steps.
+ * By default the step is time-accurate, as described here;
+ * dpsm_set_relaxation() tells the relaxation to rest, a host's explicit choice.
  *
  * Sub-steps of at most dpsm_stable_dt() are taken. When the surface is at rest
  * (no face steeper than `tan(theta) * (1 + tol)`, see
- * dpsm_set_rest_tolerance()) and nothing drives it (no source acts), stepping
- * stops early: nothing would move in the remaining time. So a large `dt` on a
+ * dpsm_set_rest_tolerance()) and nothing drives it (no source can make a
+ * face steep by the end of `dt`), stepping stops early: nothing would slide
+ * in the remaining time, and a source adds the rest of `dt` in closed form. So a large `dt` on a
  * collapsing pile costs the work to reach rest, not `dt / dpsm_stable_dt()`
  * sub-steps.
  *
- * A scene that may flow forever must finish all its sub-steps: one with an
- * active source, or with held levels that differ (open cells at different
- * heights, or an open cell not at 0 while a side is open), between which sand
- * can run without end. If it would need more than the limit of
+ * A source costs what the sand it moves needs. Where it cannot make a face
+ * steep within the step (a face's slope under the sources alone moves
+ * linearly in time, so looking at the start and the end of the step
+ * suffices), it is applied in closed form, `h += q dt`, which equals what
+ * the sub-steps would add to round-off; sub-steps are taken only where a
+ * face is, or becomes within `dt`, steeper than the threshold, and a cell
+ * takes what its source added while it waited when one of its faces first
+ * carries sand. So a source on a resting dune field costs about a pass over
+ * its cells, and a source of 1e-300 does not keep a pile from stopping early.
+ *
+ * A scene that may flow forever must finish all its sub-steps: one with a
+ * source that makes a face steep within the step, or with held levels that
+ * differ (open cells and the outside of open sides at different levels,
+ * dpsm_set_side_levels()), between which sand can run without end. If it would need more than the limit of
  * dpsm_set_max_substeps(), the call fails at once with ::DPSM_ERR_WORK_LIMIT
  * and changes nothing. Any other scene comes to rest by itself (its energy
  * falls while sand moves) and is not limited.
@@ -527,6 +570,69 @@ DPSM_API int dpsm_get_mass(const dpsm_grid *g, int quantity, double *value);
  * @return ::DPSM_OK, ::DPSM_ERR_NULL_POINTER or ::DPSM_ERR_UNKNOWN_ENUM.
  */
 DPSM_API int dpsm_get_step_info(const dpsm_grid *g, int item, double *value);
+
+/**
+ * @brief Reads the net mass that has left through one side since the grid was
+ *        created (negative where more came in from a higher outside level).
+ *
+ * The four sides and the open cells together make ::DPSM_MASS_OUTFLOW, to
+ * round-off; a wall side, or a side a grid does not have on a 1D grid, reads
+ * what it took while it was open.
+ *
+ * @param g      the grid.
+ * @param side   ::DPSM_XMIN, ::DPSM_XMAX, ::DPSM_YMIN or ::DPSM_YMAX (the last
+ *               two on 2D grids only; not the axis of an axisymmetric grid).
+ * @param value  receives the mass.
+ * @return ::DPSM_OK, ::DPSM_ERR_NULL_POINTER, ::DPSM_ERR_UNKNOWN_ENUM or
+ *         ::DPSM_ERR_NOT_APPLICABLE.
+ */
+DPSM_API int dpsm_get_side_outflow(const dpsm_grid *g, int side, double *value);
+
+/**
+ * @brief Turns the recording of face fluxes on (1) or off (0, the default).
+ *
+ * While it is on, every dpsm_step() keeps the volume each face carried, for
+ * dpsm_get_face_fluxes(). It costs memory for one value per face and, on a
+ * 2D grid, a little time in every sub-step that moves sand, so it is off
+ * unless a host asks for it (a host that carries sediment fractions, or adds
+ * the avalanche's flux to its bed load on the faces).
+ *
+ * @param g   the grid.
+ * @param on  1 to record, 0 to stop (the recorded fluxes are dropped).
+ * @return ::DPSM_OK, ::DPSM_ERR_NULL_POINTER or ::DPSM_ERR_INVALID_VALUE.
+ */
+DPSM_API int dpsm_set_face_flux_recording(dpsm_grid *g, int on);
+
+/**
+ * @brief Reads the volume of sand that crossed each face during the last
+ *        successful dpsm_step().
+ *
+ * Positive towards increasing x (y). For every sand cell, what its faces
+ * brought in less what they took out equals its change of height times its
+ * area, less what its source added, to round-off; on an open side the faces
+ * add up to what the side took in that step (dpsm_get_side_outflow()), and
+ * faces next to an open cell to what that cell took. Faces of walls and
+ * between two cells that are not sand carry nothing. After a step that moved
+ * nothing every face reads 0.
+ *
+ * Recording must be on before the step (dpsm_set_face_flux_recording());
+ * a relaxation to rest (::DPSM_RELAX_TO_REST) carries sand by combinations of
+ * trial states, not across faces in time, and leaves no fluxes.
+ *
+ * @param g   the grid.
+ * @param fx  room for `(nx+1)*ny` values: `fx[i + (nx+1)*j]` is the face on
+ *            the low side of cell `(i, j)` (`i = nx`: the high side of the
+ *            last column); on a 1D or axisymmetric grid `nx+1` values (on the
+ *            axisymmetric grid face `i` lies at radius `i*dr`).
+ * @param fy  room for `nx*(ny+1)` values: `fy[i + nx*j]` is the face on the
+ *            low side of cell `(i, j)` (`j = ny`: the high side of the last
+ *            row); NULL on a 1D or axisymmetric grid.
+ * @return ::DPSM_OK, ::DPSM_ERR_NULL_POINTER, ::DPSM_ERR_INVALID_VALUE (an
+ *         `fy` given to a grid without y faces), or ::DPSM_ERR_NOT_APPLICABLE
+ *         (recording is off, or the last step relaxed to rest). Before the
+ *         first step every face reads 0.
+ */
+DPSM_API int dpsm_get_face_fluxes(const dpsm_grid *g, double *fx, double *fy);
 
 /**
  * @brief Reads the size of the grid.
@@ -588,6 +694,11 @@ DPSM_API int dpsm_set_threads(dpsm_grid *g, int n);
 /**
  * @brief Sets a non-erodible bed `zb` under the sand, or removes it.
  *
+ * It may be set before the sand or after: a cell whose height lies below its
+ * bed is lifted to it (whatever its kind), and the sand this adds to sand
+ * cells is booked as ::DPSM_MASS_EXTERNAL, as dpsm_set_heights() would book
+ * it. So a host sets the rock, then the sand (heights at or above the bed).
+ *
  * Sand above the bed moves as usual; the surface never goes below it. A face
  * takes from its upstream cell at most a quarter (a half in 1D) of the sand
  * that cell holds above its bed in a sub-step, after that cell's own erosion,
@@ -604,10 +715,10 @@ DPSM_API int dpsm_set_threads(dpsm_grid *g, int n);
  * dpsm_add_heights_region() refuse heights below it (any cell kind).
  *
  * @param g   the grid.
- * @param zb  `nx*ny` finite values within the supported range, each at or
- *            below the current height of its cell; NULL removes the bed.
+ * @param zb  `nx*ny` finite values within the supported range; NULL removes
+ *            the bed.
  * @return ::DPSM_OK, ::DPSM_ERR_NULL_POINTER or ::DPSM_ERR_INVALID_VALUE (a
- *         value not finite, outside the range, or above its cell's height).
+ *         value not finite or outside the range).
  */
 DPSM_API int dpsm_set_bedrock(dpsm_grid *g, const double *zb);
 

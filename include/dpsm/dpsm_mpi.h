@@ -13,26 +13,36 @@
  *    x fastest, region offsets counted from the block's first cell;
  *  - sides (dpsm_set_boundary()) name the sides of the global domain; the
  *    edges between blocks are neither walls nor open;
+ *  - side levels (dpsm_set_side_levels()) are the rank's part of a side of
+ *    the global domain: `ny_local` values for ::DPSM_XMIN and ::DPSM_XMAX (the
+ *    block's rows), `nx_local` for ::DPSM_YMIN and ::DPSM_YMAX (its columns);
+ *    a rank whose block does not touch that side may pass any valid values,
+ *    which are ignored. The next dpsm_step() assembles each side from the
+ *    blocks along it when any rank changed its part;
+ *  - face fluxes (dpsm_get_face_fluxes()) are the block's own faces,
+ *    `(nx_local+1)*ny_local` x faces and `nx_local*(ny_local+1)` y faces,
+ *    both edges of the block included: a face between two blocks is read on
+ *    both ranks, with the same value;
  *  - dpsm_step() exchanges the cells along the blocks' edges and takes the same
  *    sub-steps on every rank; its results equal those of one serial grid of
  *    `nx_global * ny_global` cells holding the same scene, bit for bit, for
  *    any decomposition;
- *  - dpsm_get_mass() and dpsm_get_step_info() return global figures, the same
- *    on every rank.
+ *  - dpsm_get_mass(), dpsm_get_side_outflow() and dpsm_get_step_info()
+ *    return global figures, the same on every rank.
  *
  * Collective calls: dpsm_create_2d_mpi(), dpsm_create_2d_mpi_f(), dpsm_step(),
- * dpsm_get_mass(), dpsm_save(), dpsm_load_mpi(), dpsm_load_mpi_f() and
- * dpsm_destroy(). Every rank
+ * dpsm_get_mass(), dpsm_get_side_outflow(), dpsm_save(), dpsm_load_mpi(),
+ * dpsm_load_mpi_f() and dpsm_destroy(). Every rank
  * of the communicator must call the collective ones, in the same order, with
  * the same `dt` and the same parameters (repose angle, mobility, scheme, rest
  * tolerance, sub-step limit, sides, flux exponent, static angle) and the same
  * features (a bed on every rank or none, an angle field on every rank or
  * none; their values are the rank's own block); dpsm_step() checks this and
  * fails on every rank alike when they differ. A rank whose own arguments to
- * dpsm_step() or dpsm_get_mass() are refused (a `dt` that is not finite or not
- * positive, a NULL `value`, an unknown quantity) still takes part, and the
- * call fails on every rank: no rank waits for it. All other calls are local to the
- * rank.
+ * dpsm_step(), dpsm_get_mass() or dpsm_get_side_outflow() are refused (a `dt`
+ * that is not finite or not positive, a NULL `value`, an unknown quantity or
+ * side) still takes part, and the call fails on every rank: no rank waits for
+ * it. All other calls are local to the rank.
  *
  * Restart files: dpsm_save() on a distributed grid writes each rank's block to
  * the path that rank passes (one file per rank, e.g. `run.0003.dpsm` for rank

@@ -14,7 +14,8 @@
 //    reads them back on as many ranks, checks that they are the blocks of one
 //    save, and builds the grid as dpsm_create_2d_mpi does;
 //  - agreement: one MAX all-reduce before a step (flags, and the parameters,
-//    so that ranks that disagree fail alike), one after each sweep (each
+//    so that ranks that disagree fail alike; one more for the levels along the
+//    global domain's sides when a host changed them), one after each sweep (each
 //    level's "moved" and largest excess slope), and gathers for sums, which
 //    are added in rank order so every rank gets the same figure.
 //
@@ -25,6 +26,7 @@
 #include <mpi.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdint>
@@ -140,6 +142,7 @@ public:
                                  open ? grid.open_level_max() : none};
         v.push_back(-grid.own_min_repose_angle());
         v.push_back(refused ? 1.0 : 0.0);
+        v.push_back(grid.side_levels_version() != exchanged_levels_ ? 1.0 : 0.0);
         const std::size_t first_parameter = v.size();
         const double parameters[] = {refused ? 0.0 : dt,
                                      grid.repose_angle(),
@@ -191,12 +194,21 @@ public:
         }
         grid.set_distributed_min_repose_angle(-v[6]);
         if (v[3] != 0.0) exchange_masks(grid);
+        if (v[8] != 0.0) assemble_side_levels(grid);
         StepAgreement state;
         state.source_active = v[0] != 0.0;
+        // Lazy sources (tiled_sweep.hpp): the halo carries each cell's clock.
+        lazy_sources_ = state.source_active && !grid.uses_physics();
         state.has_open_cells = v[1] != 0.0;
         state.may_move = v[2] != 0.0;
         state.open_level_min = state.has_open_cells ? -v[4] : 0.0;
         state.open_level_max = state.has_open_cells ? v[5] : 0.0;
+        // The sides' levels are whole on every rank, and the sides agreed on.
+        const std::array<bool, 4> open_sides{grid.side_open(kXMin), grid.side_open(kXMax), grid.side_open(kYMin),
+                                       grid.side_open(kYMax)};
+        const SideLevelRange range = side_level_range(open_sides, halo_.side_levels);
+        state.side_level_min = range.lowest;
+        state.side_level_max = range.highest;
         return state;
     }
 
@@ -206,9 +218,13 @@ public:
         const std::vector<float> &res = grid.residuals();
         const std::vector<std::uint8_t> &moving = grid.moving();
         const bool hysteresis = grid.hysteresis();  // the same on every rank (agree_before_step)
+        const bool lazy = lazy_sources_;
+        const std::vector<double> &clock = grid.source_clock();
+        const double base = grid.clock_base();
+        const int per_cell = 2 + (hysteresis ? 1 : 0) + (lazy ? 1 : 0);
         for (std::size_t k = 0; k < neighbours_.size(); ++k) {
             Neighbour &n = neighbours_[k];
-            n.receive_buffer.resize(static_cast<std::size_t>((hysteresis ? 3 : 2) * n.receive.cells() + 1 + 4 * n.tiles));
+            n.receive_buffer.resize(static_cast<std::size_t>(per_cell * n.receive.cells() + 1 + 8 * n.tiles));
             check_mpi(MPI_Irecv(n.receive_buffer.data(), static_cast<int>(n.receive_buffer.size()), MPI_DOUBLE, n.rank,
                                 kTagHeights, comm_, &requests_[k]),
                       "MPI_Irecv of the halo");
@@ -220,20 +236,28 @@ public:
             for_cells(n.send, [&](std::size_t c) { out.push_back(h[c]); });
             for_cells(n.send, [&](std::size_t c) { out.push_back(static_cast<double>(res[c])); });
             if (hysteresis) for_cells(n.send, [&](std::size_t c) { out.push_back(static_cast<double>(moving[c])); });
-            // The hot boxes that can reach its block within a sweep, in global coordinates.
+            if (lazy)
+                for_cells(n.send, [&](std::size_t c) {
+                    out.push_back(clock.empty() ? 0.0 : std::max(clock[c], base) - base);
+                });
+            // The hot and driven boxes that can reach its block within a
+            // sweep, in global coordinates (a driven box grown by one is a hot box).
             const std::size_t count_at = out.size();
             out.push_back(0.0);
             CellBox near;
             near.add(n.block.i0 - block_.i0, n.block.i0 + n.block.ni - block_.i0, n.block.j0 - block_.j0,
                      n.block.j0 + n.block.nj - block_.j0);
-            for (std::int64_t t = 0; t < active.tiles(); ++t) {
-                const CellBox &box = active.hot(t);
-                if (!box.reaches(near, kHaloDepth)) continue;
+            auto send_box = [&](const CellBox &box) {
+                if (!box.reaches(near, kHaloDepth)) return;
                 out.push_back(static_cast<double>(box.i0 + block_.i0));
                 out.push_back(static_cast<double>(box.i1 + block_.i0));
                 out.push_back(static_cast<double>(box.j0 + block_.j0));
                 out.push_back(static_cast<double>(box.j1 + block_.j0));
                 out[count_at] += 1.0;
+            };
+            for (std::int64_t t = 0; t < active.tiles(); ++t) {
+                send_box(active.hot(t));
+                send_box(active.driven(t).grown(1));
             }
             check_mpi(MPI_Isend(out.data(), static_cast<int>(out.size()), MPI_DOUBLE, n.rank, kTagHeights, comm_,
                                 &requests_[neighbours_.size() + k]),
@@ -249,6 +273,7 @@ public:
             for_halo_cells(n.receive, [&](std::size_t at) { halo_.residuals[at] = static_cast<float>(in[k++]); });
             if (hysteresis)
                 for_halo_cells(n.receive, [&](std::size_t at) { halo_.moving[at] = static_cast<std::uint8_t>(in[k++]); });
+            if (lazy) for_halo_cells(n.receive, [&](std::size_t at) { halo_.since[at] = in[k++]; });
             const std::size_t boxes = static_cast<std::size_t>(in[k]);
             for (std::size_t b = 0; b < boxes; ++b) {
                 const double *box = in + k + 1 + 4 * b;
@@ -353,6 +378,34 @@ private:
             for (std::int64_t i = r.i0; i < r.i0 + r.ni; ++i) f(halo_.index(i - block_.i0, j - block_.j0));
     }
 
+    // The levels along the global domain's sides, whole on every rank: each
+    // face of a side belongs to the one block beside it, which gives its level
+    // (what the host set on that block, 0 where it set none); the others give
+    // -infinity, and a maximum keeps the level, every bit of it.
+    void assemble_side_levels(const Grid &grid) {
+        const std::int64_t along[4] = {halo_.global_ny, halo_.global_ny, halo_.global_nx, halo_.global_nx};
+        const bool touches[4] = {block_.i0 == 0, block_.i0 + block_.ni == halo_.global_nx, block_.j0 == 0,
+                                 block_.j0 + block_.nj == halo_.global_ny};
+        const std::int64_t first[4] = {block_.j0, block_.j0, block_.i0, block_.i0};
+        const std::int64_t count[4] = {block_.nj, block_.nj, block_.ni, block_.ni};
+        std::vector<double> all;
+        for (int side = 0; side < 4; ++side) {
+            const std::size_t at = all.size();
+            all.resize(at + static_cast<std::size_t>(along[side]), -std::numeric_limits<double>::infinity());
+            if (!touches[side]) continue;
+            for (std::int64_t k = 0; k < count[side]; ++k)
+                all[at + static_cast<std::size_t>(first[side] + k)] = grid.side_level(side, k);
+        }
+        check_mpi(MPI_Allreduce(MPI_IN_PLACE, all.data(), static_cast<int>(all.size()), MPI_DOUBLE, MPI_MAX, comm_),
+                  "MPI_Allreduce of the side levels");
+        auto next = all.begin();
+        for (int side = 0; side < 4; ++side) {
+            halo_.side_levels[side].assign(next, next + along[side]);
+            next += along[side];
+        }
+        exchanged_levels_ = grid.side_levels_version();
+    }
+
     // The halo's kinds, sources, bed and angles, and the boxes of its cells with a source.
     void exchange_masks(Grid &grid) {
         const std::vector<std::uint8_t> &kinds = grid.kinds();
@@ -403,7 +456,9 @@ private:
     std::vector<Neighbour> neighbours_;
     std::vector<MPI_Request> requests_;
     std::vector<CellBox> remote_hot_, remote_sources_;
+    bool lazy_sources_ = false;  // this step applies sources lazily (agree_before_step)
     std::uint64_t exchanged_masks_ = std::numeric_limits<std::uint64_t>::max();  // none yet
+    std::uint64_t exchanged_levels_ = std::numeric_limits<std::uint64_t>::max();  // none yet
 };
 
 // What each rank passes to dpsm_create_2d_mpi, gathered on every rank.

@@ -21,6 +21,7 @@ program test_fortran
   call test_1d()
   call test_axisymmetric()
   call test_physics()
+  call test_coupling()
   call test_restart()
   call test_destroyed()
 
@@ -338,10 +339,18 @@ contains
     call dpsm_set_source(g, q(1:nx, 1:ny - 1), ierr)
     call expect(ierr == DPSM_ERR_INVALID_SIZE, 'dpsm_set_source(q(nx, ny-1)) fails')
 
-    ! A driven scene is limited by dpsm_set_max_substeps.
+    ! A driven scene (a source that makes a face steep within the step) is
+    ! limited by dpsm_set_max_substeps; the uniform source above, which
+    ! cannot, is applied in closed form and is not.
     call dpsm_stable_dt(g, stable)
     call dpsm_set_max_substeps(g, 1, ierr)
     call expect(ierr == DPSM_OK, 'dpsm_set_max_substeps (default integer)')
+    call dpsm_step(g, 10*stable, ierr)
+    call expect(ierr == DPSM_OK, 'a gentle source is not limited')
+    call dpsm_get_mass(g, DPSM_MASS_SOURCED, sourced)
+    q(3, 3) = 100
+    call dpsm_set_source(g, q, ierr)
+    call expect(ierr == DPSM_OK, 'dpsm_set_source with a steep cell')
     call dpsm_get_heights(g, h)
     call dpsm_step(g, 10*stable, ierr)
     call expect(ierr == DPSM_ERR_WORK_LIMIT, 'a driven step over the sub-step limit fails with WORK_LIMIT')
@@ -464,9 +473,9 @@ contains
     call expect(ierr == DPSM_OK, 'dpsm_set_bedrock(zb(nx, ny))')
     call dpsm_set_bedrock(g, reshape(zb, [nx*ny]), ierr)
     call expect(ierr == DPSM_OK, 'dpsm_set_bedrock(zb(nx*ny))')
-    zb(2, 3) = h(2, 3) + 1
+    zb(2, 3) = 1.0e60_c_double
     call dpsm_set_bedrock(g, zb, ierr)
-    call expect(ierr == DPSM_ERR_INVALID_VALUE, 'dpsm_set_bedrock above a height fails with INVALID_VALUE')
+    call expect(ierr == DPSM_ERR_INVALID_VALUE, 'dpsm_set_bedrock outside the supported range fails with INVALID_VALUE')
     call expect(index(dpsm_last_error(g), 'zb[') > 0, 'the message names the cell: '//dpsm_last_error(g))
     wrong = 0
     call dpsm_set_bedrock(g, wrong, ierr)
@@ -517,6 +526,88 @@ contains
     call expect(ierr == DPSM_OK, 'dpsm_set_repose_angle_field without theta returns to the uniform angle')
     call dpsm_destroy(g)
   end subroutine test_physics
+
+  !> What a host couples: levels beyond the sides, what left through each
+  !> side, the face fluxes (2D and 1D), with good and bad arguments.
+  subroutine test_coupling()
+    integer, parameter :: nx = 8, ny = 5
+    real(c_double), parameter :: d = 0.25_c_double
+    type(dpsm_grid) :: g, line
+    real(c_double) :: h(nx, ny), after(nx, ny), fx(nx + 1, ny), fy(nx, ny + 1), flat_x((nx + 1)*ny), flat_y(nx*(ny + 1))
+    real(c_double) :: levels(ny), total, out, brought, line_fx(nx + 1), line_fy(2*nx)
+    integer :: ierr, i, j
+    logical :: balanced
+    call dpsm_create_2d(g, nx, ny, d, d)
+    call dpsm_get_face_fluxes(g, fx, fy, ierr)
+    call expect(ierr == DPSM_ERR_NOT_APPLICABLE, 'dpsm_get_face_fluxes before recording fails with NOT_APPLICABLE')
+    call dpsm_set_face_flux_recording(g, 2_c_int, ierr)
+    call expect(ierr == DPSM_ERR_INVALID_VALUE, 'dpsm_set_face_flux_recording(2) fails with INVALID_VALUE')
+    call dpsm_set_face_flux_recording(g, 1_c_int)
+
+    ! An empty table beside a side held at 0.4: sand comes in, booked as negative outflow.
+    levels = 0.4_c_double
+    call dpsm_set_side_levels(g, DPSM_XMIN, levels, ierr)
+    call expect(ierr == DPSM_OK, 'dpsm_set_side_levels(levels(ny))')
+    call dpsm_set_boundary(g, DPSM_XMIN, DPSM_OPEN)
+    h = 0
+    call dpsm_step(g, 0.05_c_double)
+    call dpsm_get_heights(g, after)
+    call dpsm_get_face_fluxes(g, fx, fy, ierr)
+    call expect(ierr == DPSM_OK, 'dpsm_get_face_fluxes(fx(nx+1, ny), fy(nx, ny+1))')
+    balanced = .true.
+    do j = 1, ny
+      do i = 1, nx
+        brought = fx(i, j) - fx(i + 1, j) + fy(i, j) - fy(i, j + 1)
+        balanced = balanced .and. abs(brought - (after(i, j) - h(i, j))*d*d) <= 1e-15_c_double
+      end do
+    end do
+    call expect(balanced, 'each cell gained what its faces brought')
+    call expect(all(fx(1, :) > 0), 'the faces of the raised side carry sand in (towards increasing x)')
+    call dpsm_get_face_fluxes(g, flat_x, flat_y, ierr)
+    call expect(ierr == DPSM_OK .and. all(flat_x == reshape(fx, [(nx + 1)*ny])) .and. &
+                all(flat_y == reshape(fy, [nx*(ny + 1)])), 'dpsm_get_face_fluxes(flat arrays)')
+    call dpsm_get_face_fluxes(g, h, fy, ierr)
+    call expect(ierr == DPSM_ERR_INVALID_SIZE, 'dpsm_get_face_fluxes(fx(nx, ny)) fails with INVALID_SIZE')
+    call expect(index(dpsm_last_error(g), 'fx(nx+1, ny)') > 0, 'the message names the shape: '//dpsm_last_error(g))
+    call dpsm_get_face_fluxes(g, fx, ierr=ierr)
+    call expect(ierr == DPSM_ERR_NULL_POINTER, 'dpsm_get_face_fluxes without fy on a 2D grid fails with NULL_POINTER')
+    call dpsm_get_mass(g, DPSM_MASS_TOTAL, total)
+    call dpsm_get_side_outflow(g, DPSM_XMIN, out, ierr)
+    call expect(ierr == DPSM_OK .and. close_to(out, -total, 1e-12_c_double), 'dpsm_get_side_outflow(XMIN) = -TOTAL')
+    call dpsm_get_side_outflow(g, 7_c_int, out, ierr)
+    call expect(ierr == DPSM_ERR_UNKNOWN_ENUM, 'dpsm_get_side_outflow(7) fails with UNKNOWN_ENUM')
+    call expect_ledger(g, 'coupling')
+
+    call dpsm_set_side_levels(g, DPSM_YMIN, levels, ierr)
+    call expect(ierr == DPSM_ERR_INVALID_SIZE, 'dpsm_set_side_levels(YMIN, levels(ny)) fails with INVALID_SIZE')
+    levels(3) = ieee_value(levels(3), ieee_quiet_nan)
+    call dpsm_set_side_levels(g, DPSM_XMAX, levels, ierr)
+    call expect(ierr == DPSM_ERR_INVALID_VALUE, 'dpsm_set_side_levels with a NaN fails with INVALID_VALUE')
+    call expect(index(dpsm_last_error(g), 'levels[2]') > 0, 'the message names the face: '//dpsm_last_error(g))
+    call dpsm_set_side_levels(g, DPSM_XMIN, ierr=ierr)
+    call expect(ierr == DPSM_OK, 'dpsm_set_side_levels without levels returns the side to 0')
+    call dpsm_set_face_flux_recording(g, 0_c_int)
+    call dpsm_get_face_fluxes(g, fx, fy, ierr)
+    call expect(ierr == DPSM_ERR_NOT_APPLICABLE, 'dpsm_get_face_fluxes after recording stopped fails')
+    call dpsm_destroy(g)
+
+    ! A line: fx(nx+1) and no fy; its y sides are refused.
+    call dpsm_create_1d(line, nx, d)
+    call dpsm_set_face_flux_recording(line, 1_c_int)
+    call dpsm_set_side_levels(line, DPSM_XMAX, [0.3_c_double], ierr)
+    call expect(ierr == DPSM_OK, 'dpsm_set_side_levels(line, XMAX, levels(1))')
+    call dpsm_set_side_levels(line, DPSM_YMIN, [0.3_c_double], ierr)
+    call expect(ierr == DPSM_ERR_INVALID_SIZE .or. ierr == DPSM_ERR_NOT_APPLICABLE, 'a line has no y side')
+    call dpsm_get_side_outflow(line, DPSM_YMAX, out, ierr)
+    call expect(ierr == DPSM_ERR_NOT_APPLICABLE, 'dpsm_get_side_outflow(line, YMAX) fails with NOT_APPLICABLE')
+    call dpsm_set_boundary(line, DPSM_XMAX, DPSM_OPEN)
+    call dpsm_step(line, 1.0_c_double)
+    call dpsm_get_face_fluxes(line, line_fx, ierr=ierr)
+    call expect(ierr == DPSM_OK .and. line_fx(nx + 1) < 0, 'dpsm_get_face_fluxes(line, fx(nx+1)): sand comes in')
+    call dpsm_get_face_fluxes(line, line_fx, line_fy, ierr)
+    call expect(ierr == DPSM_ERR_INVALID_VALUE, 'a line given fy fails with INVALID_VALUE')
+    call dpsm_destroy(line)
+  end subroutine test_coupling
 
   !> Restart files: a saved and loaded grid continues bit for bit; missing,
   !> unwritable and damaged files fail with IO or BAD_FILE and no grid.

@@ -13,16 +13,24 @@
  *     block off the grid, a step over the sub-step limit in a scene that may
  *     flow forever, ...); never DPSM_ERR_INTERNAL;
  *   - a failed call left a message naming the function and changed nothing
- *     (heights, ledger, step information, stable step: bit for bit); a
- *     successful one cleared the message;
+ *     (heights, ledger, what left through each side, face fluxes, step
+ *     information, stable step: bit for bit); a successful one cleared the
+ *     message;
  *   - every height is finite; the ledger closes to 1e-12 of the largest mass
  *     figure; the grid and its twin are bit-identical;
  *   - after a step without a source: no new extremum (sand, held levels of
- *     open cells, 0 beyond an open side), held cells unchanged; at rest (and
+ *     open cells, the levels beyond open sides), held cells unchanged; at rest (and
  *     not driven, without a bed, an angle field or a static angle, which
  *     change what rest means): no face steeper than tan(theta) (1 + tol);
  *   - with a bed: no height below it after any operation, and the height
- *     setters refuse heights below it;
+ *     setters refuse heights below it; a bed set above a cell lifts it, and
+ *     the sand added is booked as external;
+ *   - where face fluxes are recorded, after every step: each sand cell's
+ *     faces bring its change of height times its area less what its source
+ *     added (with a bed: erosion at most what was asked, as SOURCED and
+ *     UNMET book it); walls' faces carry nothing; each side's faces carry
+ *     what dpsm_get_side_outflow says it took; the sides and the open cells
+ *     make up DPSM_MASS_OUTFLOW;
  *   - every fourth operation, when it is a step: the grid saved before it
  *     (dpsm_save) and loaded (dpsm_load) reads back bit for bit, and after the
  *     same step matches the grid bit for bit (all but the cell updates, which
@@ -81,6 +89,10 @@ static double pick(reader_t *r, const double *ok, size_t nok, const double *bad,
     if ((b & 0x80) && nbad) return bad[(b & 0x7f) % nbad];
     return ok[b % nok];
 }
+
+/* Opcode bytes (and NULL-grid choices) from here on name what was added
+ * later (the coupling of issue 17); below it they keep their meaning. */
+enum { kLaterOps = 250 };
 
 static const double kNaN = NAN;
 static const double kInf = INFINITY;
@@ -169,6 +181,9 @@ typedef struct {
     int scheme;        /* DPSM_SCHEME_* */
     double exponent;   /* the flux exponent */
     double mass_scale;
+    double *levels[4]; /* beyond each side, as set; NULL: 0 */
+    int record;        /* face fluxes recorded */
+    int relaxed;       /* the last step may have relaxed to rest (then no fluxes) */
 } slot_t;
 
 /* The step information items this header knows (a newer header may add some). */
@@ -182,6 +197,10 @@ typedef struct {
     int64_t nx, ny;
     double *h;
     double mass[4], info[NINFO], stable_dt;
+    int side_status[4];  /* dpsm_get_side_outflow: DPSM_OK on the sides the grid has */
+    double side[4];      /* what left through each side */
+    int fluxes_status;   /* dpsm_get_face_fluxes: DPSM_OK where recorded */
+    double *fx, *fy;     /* (nx+1)*ny and nx*(ny+1) faces (fy: 2D only) */
 } snap_t;
 
 static slot_t g_slots[NSLOTS];
@@ -198,14 +217,30 @@ static void snap(const dpsm_grid *g, const slot_t *s, snap_t *out) {
     for (int i = 0; i < NINFO; ++i)
         if (dpsm_get_step_info(g, i, &out->info[i]) != DPSM_OK) die("get_step_info failed");
     if (dpsm_stable_dt(g, &out->stable_dt) != DPSM_OK) die("stable_dt failed");
+    for (int side = 0; side < 4; ++side) {
+        out->side[side] = 0.0;
+        out->side_status[side] = dpsm_get_side_outflow(g, side, &out->side[side]);
+    }
+    out->fx = calloc((size_t)((s->nx + 1) * s->ny), sizeof(double));
+    out->fy = calloc((size_t)(s->nx * (s->ny + 1)), sizeof(double));
+    if (!out->fx || !out->fy) die("out of memory");
+    out->fluxes_status = dpsm_get_face_fluxes(g, out->fx, s->geom == GEOM_2D ? out->fy : NULL);
+    /* Those may have failed (a side the grid does not have, no fluxes
+     * recorded): a last call that succeeds leaves the message empty, as the
+     * snapshot found it. */
+    if (dpsm_get_shape(g, &out->nx, &out->ny) != DPSM_OK) die("get_shape failed: %s", dpsm_last_error(g));
 }
 
 static void unsnap(snap_t *s) {
     free(s->h);
-    s->h = NULL;
+    free(s->fx);
+    free(s->fy);
+    s->h = s->fx = s->fy = NULL;
 }
 
-static void same(const slot_t *s, const snap_t *a, const snap_t *b, const char *what) {
+/* Bit for bit the same snapshots; the face fluxes only `with_fluxes` (a grid
+ * just loaded from a restart file reads 0 on every face until its next step). */
+static void same_but_fluxes(const slot_t *s, const snap_t *a, const snap_t *b, int with_fluxes, const char *what) {
     if (a->nx != b->nx || a->ny != b->ny) die("%s: the shape changed", what);
     for (int64_t c = 0; c < s->n; ++c)
         if (memcmp(&a->h[c], &b->h[c], sizeof(double)) != 0)
@@ -221,6 +256,21 @@ static void same(const slot_t *s, const snap_t *a, const snap_t *b, const char *
             die("%s: step info %s differs: %.17g vs %.17g", what, info_names[i], a->info[i], b->info[i]);
     if (memcmp(&a->stable_dt, &b->stable_dt, sizeof(double)) != 0)
         die("%s: stable_dt differs: %.17g vs %.17g", what, a->stable_dt, b->stable_dt);
+    for (int side = 0; side < 4; ++side)
+        if (a->side_status[side] != b->side_status[side] || memcmp(&a->side[side], &b->side[side], sizeof(double)) != 0)
+            die("%s: side %d's outflow differs: %.17g (%s) vs %.17g (%s)", what, side, a->side[side],
+                dpsm_status_string(a->side_status[side]), b->side[side], dpsm_status_string(b->side_status[side]));
+    if (!with_fluxes) return;
+    if (a->fluxes_status != b->fluxes_status)
+        die("%s: dpsm_get_face_fluxes %s vs %s", what, dpsm_status_string(a->fluxes_status),
+            dpsm_status_string(b->fluxes_status));
+    const size_t nfx = (size_t)((s->nx + 1) * s->ny), nfy = s->geom == GEOM_2D ? (size_t)(s->nx * (s->ny + 1)) : 0;
+    if (memcmp(a->fx, b->fx, nfx * sizeof(double)) != 0 || memcmp(a->fy, b->fy, nfy * sizeof(double)) != 0)
+        die("%s: the face fluxes differ", what);
+}
+
+static void same(const slot_t *s, const snap_t *a, const snap_t *b, const char *what) {
+    same_but_fluxes(s, a, b, 1, what);
 }
 
 static double cell_area(const slot_t *s, int64_t c) {
@@ -230,6 +280,15 @@ static double cell_area(const slot_t *s, int64_t c) {
 
 static int any_side_open(const slot_t *s) { return s->open[0] || s->open[1] || s->open[2] || s->open[3]; }
 
+/* The sides a grid has (not the y sides of a line, not the axis), the faces
+ * along each, and the level held beyond face k of a side. */
+static int has_side(const slot_t *s, int side) {
+    if (side >= DPSM_YMIN) return s->geom == GEOM_2D;
+    return !(s->geom == GEOM_AXI && side == DPSM_XMIN);
+}
+static int64_t faces_along(const slot_t *s, int side) { return side <= DPSM_XMAX ? s->ny : s->nx; }
+static double level_at(const slot_t *s, int side, int64_t k) { return s->levels[side] ? s->levels[side][k] : 0.0; }
+
 static int source_active(const slot_t *s) {
     if (!s->source) return 0;
     for (int64_t c = 0; c < s->n; ++c)
@@ -237,17 +296,24 @@ static int source_active(const slot_t *s) {
     return 0;
 }
 
-/* As dpsm_step documents: a source acts, or held levels differ. */
+/* As dpsm_step documents: a source acts, or held levels differ (open cells,
+ * and the levels beyond open sides). */
 static int driven(const slot_t *s, const double *h) {
     if (source_active(s)) return 1;
-    int have = any_side_open(s);
+    int have = 0;
     double level = 0.0;
-    for (int64_t c = 0; c < s->n; ++c) {
-        if (s->kinds[c] != DPSM_CELL_OPEN) continue;
-        if (have && h[c] != level) return 1;
-        level = h[c];
-        have = 1;
-    }
+#define HELD_AT(v)                                  \
+    do {                                            \
+        if (have && (v) != level) return 1;         \
+        level = (v);                                \
+        have = 1;                                   \
+    } while (0)
+    for (int side = 0; side < 4; ++side)
+        if (s->open[side])
+            for (int64_t k = 0; k < faces_along(s, side); ++k) HELD_AT(level_at(s, side, k));
+    for (int64_t c = 0; c < s->n; ++c)
+        if (s->kinds[c] == DPSM_CELL_OPEN) HELD_AT(h[c]);
+#undef HELD_AT
     return 0;
 }
 
@@ -343,6 +409,7 @@ static void destroy_slot(slot_t *s) {
     free(s->source);
     free(s->bed);
     free(s->tan_field);
+    for (int side = 0; side < 4; ++side) free(s->levels[side]);
     memset(s, 0, sizeof *s);
 }
 
@@ -702,16 +769,20 @@ static double rest_excess(const slot_t *s, const double *h) {
             const int64_t c = i + s->nx * j;
             for (int f = 0; f < 6; ++f) {
                 int64_t b;
-                double d;
+                double d, outside = 0.0;
                 if (f == 0 && i + 1 < s->nx) b = c + 1, d = s->dx;
                 else if (f == 1 && j + 1 < s->ny) b = c + s->nx, d = s->dy;
-                else if (f == 2 && i == 0 && s->open[DPSM_XMIN] && s->geom != GEOM_AXI) b = -1, d = s->dx;
-                else if (f == 3 && i == s->nx - 1 && s->open[DPSM_XMAX]) b = -1, d = s->dx;
-                else if (f == 4 && j == 0 && s->geom == GEOM_2D && s->open[DPSM_YMIN]) b = -1, d = s->dy;
-                else if (f == 5 && j == s->ny - 1 && s->geom == GEOM_2D && s->open[DPSM_YMAX]) b = -1, d = s->dy;
+                else if (f == 2 && i == 0 && s->open[DPSM_XMIN] && s->geom != GEOM_AXI)
+                    b = -1, d = s->dx, outside = level_at(s, DPSM_XMIN, j);
+                else if (f == 3 && i == s->nx - 1 && s->open[DPSM_XMAX])
+                    b = -1, d = s->dx, outside = level_at(s, DPSM_XMAX, j);
+                else if (f == 4 && j == 0 && s->geom == GEOM_2D && s->open[DPSM_YMIN])
+                    b = -1, d = s->dy, outside = level_at(s, DPSM_YMIN, i);
+                else if (f == 5 && j == s->ny - 1 && s->geom == GEOM_2D && s->open[DPSM_YMAX])
+                    b = -1, d = s->dy, outside = level_at(s, DPSM_YMAX, i);
                 else continue;
                 const int kb = b < 0 ? DPSM_CELL_OPEN : s->kinds[b];
-                const double hb = b < 0 ? 0.0 : h[b];
+                const double hb = b < 0 ? outside : h[b];
                 if (s->kinds[c] == DPSM_CELL_WALL || kb == DPSM_CELL_WALL) continue;
                 if (s->kinds[c] != DPSM_CELL_SAND && kb != DPSM_CELL_SAND) continue;
                 const int64_t up = h[c] >= hb ? c : b;
@@ -744,7 +815,7 @@ static dpsm_grid *restart_copy(slot_t *s, const snap_t *before) {
     if (dpsm_load(path, &copy) != DPSM_OK || !copy) die("dpsm_load(%s) failed: %s", path, dpsm_last_error(NULL));
     snap_t loaded;
     snap(copy, s, &loaded);
-    same(s, before, &loaded, "a grid loaded from a restart file");
+    same_but_fluxes(s, before, &loaded, 0, "a grid loaded from a restart file");
     unsnap(&loaded);
     return copy;
 }
@@ -771,6 +842,80 @@ static void after_step(slot_t *s, double dt, const snap_t *before, snap_t *after
     for (int64_t c = 0; c < s->n; ++c)
         if (s->kinds[c] != DPSM_CELL_SAND && memcmp(&after->h[c], &before->h[c], sizeof(double)) != 0)
             die("the held height of cell %lld changed from %.17g to %.17g", (long long)c, before->h[c], after->h[c]);
+}
+
+/* After a step that recorded its face fluxes (`after` read them): what each
+ * sand cell's faces brought is its change of height times its area less what
+ * its source added (with a bed, erosion takes at most what it asked for, and
+ * the sources took what SOURCED and UNMET say); walls' faces carry nothing;
+ * each side's faces carry what that side's account took; the sides and the
+ * open cells make up OUTFLOW. Face volumes are plain sums over the sub-steps:
+ * they agree to the round-off of that many additions. */
+static void check_fluxes(const slot_t *s, const snap_t *before, const snap_t *after) {
+    const double time = after->info[DPSM_INFO_TIME_INTEGRATED];
+    const double rel = 1e-11 + 16.0 * DBL_EPSILON * fmax(after->info[DPSM_INFO_SUBSTEPS], 1.0);
+    const int two_d = s->geom == GEOM_2D;
+    double applied = 0.0, asked = 0.0, scale_all = 0.0, into_open = 0.0;
+    for (int64_t j = 0; j < s->ny; ++j)
+        for (int64_t i = 0; i < s->nx; ++i) {
+            const int64_t c = i + s->nx * j, xl = i + (s->nx + 1) * j, yl = i + s->nx * j;
+            double in = after->fx[xl] - after->fx[xl + 1];
+            double gross = fabs(after->fx[xl]) + fabs(after->fx[xl + 1]);
+            if (two_d) {
+                in += after->fy[yl] - after->fy[yl + s->nx];
+                gross += fabs(after->fy[yl]) + fabs(after->fy[yl + s->nx]);
+            }
+            if (s->kinds[c] == DPSM_CELL_WALL) {
+                if (gross != 0.0) die("the faces of wall cell %lld carried %g", (long long)c, gross);
+                continue;
+            }
+            if (s->kinds[c] == DPSM_CELL_OPEN) {
+                into_open += in;
+                scale_all += gross;
+                continue;
+            }
+            const double area = cell_area(s, c), q = s->source ? s->source[c] : 0.0;
+            const double source = (after->h[c] - before->h[c]) * area - in, want = q * time * area;
+            const double scale = (fabs(before->h[c]) + fabs(after->h[c])) * area + gross + fabs(want);
+            const double tol = rel * scale + DBL_MIN;
+            asked += want;
+            applied += source;
+            scale_all += scale;
+            if (s->bed && q < 0.0) {
+                if (source < want - tol || source > tol)
+                    die("cell %lld on its bed lost %.17g to erosion that asked %.17g", (long long)c, source, want);
+            } else if (fabs(source - want) > tol) {
+                die("cell %lld changed by %.17g, its faces brought %.17g, its source %.17g: off by %.3g of %.3g",
+                    (long long)c, (after->h[c] - before->h[c]) * area, in, want, source - want, scale);
+            }
+        }
+    const double sourced = after->mass[1] - before->mass[1];
+    const double totals = fabs(before->mass[1]) + fabs(before->mass[3]) + fabs(after->mass[3]);
+    if (fabs(applied - sourced) > rel * (scale_all + totals) + DBL_MIN)
+        die("the cells took %.17g from their sources, SOURCED grew by %.17g", applied, sourced);
+    double sides = 0.0;
+    for (int side = 0; side < 4; ++side) {
+        if (!has_side(s, side)) continue;
+        double out = 0.0, gross = 0.0;
+        for (int64_t k = 0; k < faces_along(s, side); ++k) {
+            const double v = side == DPSM_XMIN   ? -after->fx[(s->nx + 1) * k]
+                             : side == DPSM_XMAX ? after->fx[s->nx + (s->nx + 1) * k]
+                             : side == DPSM_YMIN ? -after->fy[k]
+                                                 : after->fy[k + s->nx * s->ny];
+            out += v;
+            gross += fabs(v);
+        }
+        const double booked = after->side[side] - before->side[side];
+        if (!s->open[side] && (gross != 0.0 || booked != 0.0))
+            die("wall side %d: its faces carried %g, its account took %g", side, gross, booked);
+        if (fabs(out - booked) > rel * (gross + fabs(before->side[side]) + fabs(after->side[side])) + DBL_MIN)
+            die("side %d: its faces carried %.17g out, its account took %.17g", side, out, booked);
+        sides += booked;
+        scale_all += gross + fabs(before->side[side]) + fabs(after->side[side]);
+    }
+    const double outflow = after->mass[3] - before->mass[3];
+    if (fabs(outflow - sides - into_open) > rel * (scale_all + totals) + DBL_MIN)
+        die("OUTFLOW grew by %.17g; the sides took %.17g, the open cells %.17g", outflow, sides, into_open);
 }
 
 static void op_step(reader_t *r) {
@@ -817,10 +962,12 @@ static void op_step(reader_t *r) {
             hi = fmax(hi, before.h[c]);
             lo = fmin(lo, before.h[c]);
         }
-    if (any_side_open(s)) {
-        hi = fmax(hi, 0.0);
-        lo = fmin(lo, 0.0);
-    }
+    for (int side = 0; side < 4; ++side)
+        if (s->open[side])
+            for (int64_t k = 0; k < faces_along(s, side); ++k) {
+                hi = fmax(hi, level_at(s, side, k));
+                lo = fmin(lo, level_at(s, side, k));
+            }
 
     dpsm_grid *restored = g_opcount % 4 == 1 && want == DPSM_OK ? restart_copy(s, &before) : NULL;
     const int st = dpsm_step(s->g, dt);
@@ -838,6 +985,13 @@ static void op_step(reader_t *r) {
     }
     snap_t after;
     after_step(s, dt, &before, &after);
+    s->relaxed = 0;
+    if (s->record) {
+        if (after.fluxes_status != DPSM_OK)
+            die("face fluxes are recorded, but after a step dpsm_get_face_fluxes says %s",
+                dpsm_status_string(after.fluxes_status));
+        check_fluxes(s, &before, &after);
+    }
     if (!source_active(s) && hi >= lo) {
         const double magnitude = fmax(fmax(fabs(hi), fabs(lo)), DBL_MIN);
         for (int64_t c = 0; c < s->n; ++c) {
@@ -917,6 +1071,7 @@ static void op_relax(reader_t *r) {
         g_work += (double)limit * (double)s->n;
         snap_t after;
         after_step(s, dt, &before, &after);
+        s->relaxed = 1; /* or, where it fell back, stepped in time: fluxes or none */
         const double evaluations = after.info[DPSM_INFO_SUBSTEPS], at_rest = after.info[DPSM_INFO_AT_REST];
         const double time = after.info[DPSM_INFO_TIME_INTEGRATED];
         if (!(time >= 0.0) || !(evaluations >= 0.0 && evaluations <= (double)limit))
@@ -944,6 +1099,29 @@ static void op_relax(reader_t *r) {
     }
 }
 
+/* After dpsm_set_bedrock(zb) succeeded on a grid that was `before`: every
+ * cell below its bed was lifted to it, every other cell kept its height, and
+ * the sand added to sand cells was booked as external mass. */
+static void check_lifted_to_bed(slot_t *s, const snap_t *before, const double *zb) {
+    snap_t after;
+    snap(s->g, s, &after);
+    double lifted = 0.0, scale = 0.0;
+    for (int64_t c = 0; c < s->n; ++c) {
+        const double want = before->h[c] < zb[c] ? zb[c] : before->h[c];
+        if (memcmp(&after.h[c], &want, sizeof(double)) != 0)
+            die("cell %lld is %.17g after a bed of %.17g under a surface at %.17g", (long long)c, after.h[c], zb[c],
+                before->h[c]);
+        if (s->kinds[c] == DPSM_CELL_SAND) {
+            lifted += (want - before->h[c]) * cell_area(s, c);
+            scale += fabs(want) * cell_area(s, c);
+        }
+    }
+    const double booked = after.mass[DPSM_MASS_EXTERNAL] - before->mass[DPSM_MASS_EXTERNAL];
+    if (fabs(booked - lifted) > 1e-12 * fmax(fmax(scale, s->mass_scale), fabs(before->mass[DPSM_MASS_EXTERNAL])))
+        die("the bed lifted %.17g onto sand cells, EXTERNAL grew by %.17g", lifted, booked);
+    unsnap(&after);
+}
+
 /* The physics of real scenes: a bed under the sand, an angle of repose per
  * cell, the flux exponent, the static angle. */
 static void op_physics(reader_t *r) {
@@ -960,7 +1138,8 @@ static void op_physics(reader_t *r) {
                 s->bed = NULL;
                 break;
             }
-            /* A bed some depth below the surface, or (planted) one cell above it. */
+            /* A bed some depth below the surface, or with one cell above it
+             * (mode 0x40), which lifts that cell to it. */
             double *zb = malloc(sizeof(double) * (size_t)s->n);
             if (!zb) die("out of memory");
             const int planted = fill(r, zb, s->n, s->nx, 0);
@@ -971,17 +1150,17 @@ static void op_physics(reader_t *r) {
             if ((mode & 0xc0) == 0x40) {
                 const int64_t c = (int64_t)(u16(r) % (unsigned)s->n);
                 if (isfinite(zb[c])) zb[c] = now.h[c] + 0.5 * fabs(now.h[c]) + 1e-3;
-                want = DPSM_ERR_INVALID_VALUE;
             }
             for (int64_t c = 0; c < s->n; ++c)
                 if (!(fabs(zb[c]) <= 1e50)) want = DPSM_ERR_INVALID_VALUE;
-            unsnap(&now);
             ON_BOTH(s, want, g_op, dpsm_set_bedrock(g_, zb));
             if (want == DPSM_OK) {
+                check_lifted_to_bed(s, &now, zb);
                 free(s->bed);
                 s->bed = zb;
                 zb = NULL;
             }
+            unsnap(&now);
             free(zb);
             break;
         }
@@ -1025,6 +1204,83 @@ static void op_physics(reader_t *r) {
             const int ok = isfinite(v) && v > 0.0 && v < 0.5 * 3.14159265358979323846;
             ON_BOTH(s, ok ? DPSM_OK : DPSM_ERR_INVALID_VALUE, g_op, dpsm_set_static_angle(g_, v));
             if (ok) s->tan_static = tan(v);
+            break;
+        }
+    }
+}
+
+/* What a host couples: the levels beyond a side (refused for unknown sides,
+ * sides the grid does not have, levels not finite or out of range), what left
+ * through a side, the recording of face fluxes and their reader (refused for
+ * NULL or extra arrays, recording off, after a relaxation to rest). */
+static void op_coupling(reader_t *r) {
+    slot_t *s = pick_slot(r);
+    if (!s) return;
+    const unsigned which = u8(r), b = u8(r);
+    const int side = (int)(b % 6) - 1;
+    const int known = side >= DPSM_XMIN && side <= DPSM_YMAX;
+    const int side_status = !known ? DPSM_ERR_UNKNOWN_ENUM : has_side(s, side) ? DPSM_OK : DPSM_ERR_NOT_APPLICABLE;
+    switch (which % 4) {
+        case 0: {
+            g_op = "dpsm_set_side_levels";
+            const int64_t n = known ? faces_along(s, side) : 1;
+            double *levels = NULL;
+            int want = side_status;
+            if (u8(r) % 4 != 0) {
+                if (!(levels = malloc(sizeof(double) * (size_t)n))) die("out of memory");
+                const int planted = fill(r, levels, n, n, 0);
+                for (int64_t k = 0; k < n; ++k)
+                    if (want == DPSM_OK && (planted || !(fabs(levels[k]) <= 1e50))) want = DPSM_ERR_INVALID_VALUE;
+            }
+            ON_BOTH(s, want, g_op, dpsm_set_side_levels(g_, side, levels));
+            if (want == DPSM_OK) {
+                free(s->levels[side]);
+                s->levels[side] = levels;
+                levels = NULL;
+            }
+            free(levels);
+            break;
+        }
+        case 1: {
+            g_op = "dpsm_get_side_outflow";
+            double value = 0.0;
+            const int null_out = (b & 0x80) != 0;
+            ON_BOTH(s, null_out ? DPSM_ERR_NULL_POINTER : side_status, g_op,
+                    dpsm_get_side_outflow(g_, side, null_out ? NULL : &value));
+            break;
+        }
+        case 2: {
+            g_op = "dpsm_set_face_flux_recording";
+            static const int values[] = {0, 1, 1, 2, -1, INT32_MAX};
+            const int on = values[b % COUNT(values)];
+            ON_BOTH(s, on == 0 || on == 1 ? DPSM_OK : DPSM_ERR_INVALID_VALUE, g_op, dpsm_set_face_flux_recording(g_, on));
+            if (on == 0) s->record = 0;
+            if (on == 1 && !s->record) s->record = 1, s->relaxed = 0;
+            break;
+        }
+        default: {
+            g_op = "dpsm_get_face_fluxes";
+            double *fx = malloc(sizeof(double) * (size_t)((s->nx + 1) * s->ny));
+            double *fy = malloc(sizeof(double) * (size_t)(s->nx * (s->ny + 1)));
+            if (!fx || !fy) die("out of memory");
+            /* b % 3: the arrays the grid takes; 1: no fx; 2: the other fy (none in 2D, one on a line). */
+            const int two_d = s->geom == GEOM_2D, variant = (int)(b % 3);
+            double *x = variant == 1 ? NULL : fx, *y = (variant == 2) == two_d ? NULL : fy;
+            int want = DPSM_OK;
+            if (!x || (two_d && !y)) want = DPSM_ERR_NULL_POINTER;
+            else if (!two_d && y) want = DPSM_ERR_INVALID_VALUE;
+            else if (!s->record) want = DPSM_ERR_NOT_APPLICABLE;
+            snap_t now;
+            snap(s->g, s, &now);
+            if (want == DPSM_OK && s->relaxed) want = now.fluxes_status; /* relaxed, or fell back to steps */
+            ON_BOTH(s, want, g_op, dpsm_get_face_fluxes(g_, x, y));
+            if (want == DPSM_OK &&
+                (memcmp(fx, now.fx, sizeof(double) * (size_t)((s->nx + 1) * s->ny)) != 0 ||
+                 (two_d && memcmp(fy, now.fy, sizeof(double) * (size_t)(s->nx * (s->ny + 1))) != 0)))
+                die("two reads of the face fluxes differ");
+            unsnap(&now);
+            free(fx);
+            free(fy);
             break;
         }
     }
@@ -1099,7 +1355,7 @@ static void op_null_grid(reader_t *r) {
     int64_t a, c;
     int st;
     const char *fn;
-    switch (b % 25) {
+    switch (b >= kLaterOps ? 25 + (b - kLaterOps) % 4 : b % 25) {
         case 0: st = dpsm_set_repose_angle(NULL, 0.5), fn = "dpsm_set_repose_angle"; break;
         case 1: st = dpsm_set_mobility(NULL, 1.0), fn = "dpsm_set_mobility"; break;
         case 2: st = dpsm_set_scheme(NULL, 0), fn = "dpsm_set_scheme"; break;
@@ -1124,6 +1380,10 @@ static void op_null_grid(reader_t *r) {
         case 21: st = dpsm_set_flux_exponent(NULL, 1.0), fn = "dpsm_set_flux_exponent"; break;
         case 22: st = dpsm_set_static_angle(NULL, 0.6), fn = "dpsm_set_static_angle"; break;
         case 23: st = dpsm_set_relaxation(NULL, DPSM_RELAX_TO_REST), fn = "dpsm_set_relaxation"; break;
+        case 25: st = dpsm_set_side_levels(NULL, DPSM_XMIN, NULL), fn = "dpsm_set_side_levels"; break;
+        case 26: st = dpsm_get_side_outflow(NULL, DPSM_XMIN, &d), fn = "dpsm_get_side_outflow"; break;
+        case 27: st = dpsm_set_face_flux_recording(NULL, 1), fn = "dpsm_set_face_flux_recording"; break;
+        case 28: st = dpsm_get_face_fluxes(NULL, h, NULL), fn = "dpsm_get_face_fluxes"; break;
         default: {
             dpsm_destroy(NULL);
             const int code = (int)(int8_t)u8(r);
@@ -1152,7 +1412,9 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
     memset(g_slots, 0, sizeof g_slots);
     while (more(&r) && g_opcount < 400) {
         ++g_opcount;
-        const unsigned op = u8(&r) % 25;
+        /* Bytes from kLaterOps on name the operations added later, so that
+         * older inputs (the corpus' regression_* files) replay as they did. */
+        const unsigned byte = u8(&r), op = byte >= kLaterOps ? 25 : byte % 25;
         if (op < 2)
             op_create(&r);
         else if (op < 9)
@@ -1175,8 +1437,10 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
             op_destroy(&r);
         else if (op == 23)
             op_physics(&r);
-        else
+        else if (op == 24)
             op_relax(&r);
+        else
+            op_coupling(&r);
         /* Every live grid: the state invariants and the twin. */
         for (int k = 0; k < NSLOTS; ++k) {
             slot_t *s = &g_slots[k];

@@ -11,14 +11,24 @@ import random
 HERE = os.path.dirname(os.path.abspath(__file__))
 OUT = os.path.join(HERE, "corpus")
 
-# Opcodes (first byte of an operation, taken modulo 25 by the harness).
+# Opcodes (first byte of an operation, taken modulo 25 by the harness; from
+# 250 on, the operations added later).
 CREATE, ANGLE, MOBILITY, SCHEME, BOUNDARY, TOLERANCE, MAX_SUBSTEPS, THREADS = 0, 2, 3, 4, 5, 6, 7, 8
 KINDS, HEIGHTS, SET_REGION, ADD_REGION, GET_REGION, SOURCE, STEP = 9, 10, 12, 13, 14, 15, 16
 GETTERS, NULL_GRID, DESTROY, PHYSICS, RELAX = 20, 21, 22, 23, 24
+COUPLING = 250
+# COUPLING, slot, which, b, then:
+#   which 0 dpsm_set_side_levels: side = b % 6 - 1; a mode byte (0: NULL; else a
+#            fill pattern of heights, one per face, follows)
+#   which 1 dpsm_get_side_outflow: side = b % 6 - 1, b & 0x80: a NULL value
+#   which 2 dpsm_set_face_flux_recording: on = {0, 1, 1, 2, -1, INT_MAX}[b % 6]
+#   which 3 dpsm_get_face_fluxes: b % 3: 0 the arrays the grid takes, 1 no fx,
+#            2 the other fy (none in 2D, one on a line)
+# NULL_GRID, 250 .. 253: the four coupling functions with a NULL grid
 # RELAX, slot, dt byte (0xe0 + 0..6: a bad dt; else 1): one step relaxed to rest
 # PHYSICS, slot, which (0 bed, 1 angle field, 2 flux exponent, 3 static angle), then:
 #   bed: mode (0 removes; else a fill pattern of depths below the surface follows;
-#        mode 0x40 + a u16 cell plants one cell above its height)
+#        mode 0x40 + a u16 cell puts one cell's bed above its height, which lifts it)
 #   angle field: mode (0 removes), two kAngles indices (west half, east half)
 #   exponent: kExponents index {1, 1.5, 2, 1.25, 1+1e-10, 2}; static angle: kAngles index
 GEOM = {"1d": 0, "2d": 1, "axi": 2}
@@ -210,6 +220,36 @@ seed("relax_2d", create(0, "2d", 9, 9), heights(0, 2, 30.0, 0.0), relax(0), rela
 seed("relax_refused", create(0, "2d", 6, 6), heights(0, 2, 10.0, 0.0), source(0, 1, 0.1, 0.0), relax(0),
      source(0, 0, 0, 0, none=True), [SCHEME, 0, 0], relax(0), [SCHEME, 0, 1], [PHYSICS, 0, 2, 1], relax(0),
      [PHYSICS, 0, 2, 0], relax(0), create(1, "1d", 9), heights(1, 2, 10.0, 0.0), relax(1))
+
+# What a host couples (issue 17): levels beyond the sides (sand comes in), face
+# fluxes recorded through steps, sources and a bed, a relaxation to rest and a
+# restart; each function's bad arguments.
+def coupling(slot, which, b, *more):
+    return [COUPLING, slot, which, b] + list(more)
+
+
+def side_levels(slot, side, v, w=0.0, mode=0, plant=None):
+    return coupling(slot, 0, side + 1, 1) + fill(mode, H[v], H[w], plant=plant)
+
+
+RECORD_ON = 1
+for geom in ("1d", "axi", "2d"):
+    raised = 1 if geom != "2d" else 0  # XMAX on lines and disks, XMIN in 2D
+    seed(f"coupling_{geom}", create(0, geom, 9, 9), all_open(0, geom), coupling(0, 2, RECORD_ON),
+         side_levels(0, raised, 3.0), heights(0, 2, 10.0, 0.0), step(0, 1.0), step(0, 100.0),
+         coupling(0, 3, 0), coupling(0, 3, 1), coupling(0, 3, 2),
+         coupling(0, 1, 2), coupling(0, 1, 0x82), coupling(0, 1, 0), coupling(0, 1, 5), coupling(0, 1, 3),
+         side_levels(0, 1, 1.0, plant=0), coupling(0, 0, 0, 0), coupling(0, 0, 3, 0), coupling(0, 0, 2, 0),
+         coupling(0, 2, 3), coupling(0, 2, 4), source(0, 1, 0.1, -1e-3), step(0, 4.0), step(0, 10.0),
+         [PHYSICS, 0, 0, 1] + fill(0, H[0.25], H[0.0]), source(0, 0, -1.0, 0.0), step(0, 10.0), step(0, 3.7),
+         coupling(0, 2, 0), coupling(0, 3, 0), step(0, 1.0))
+seed("coupling_relax_2d", create(0, "2d", 9, 9), all_open(0, "2d"), coupling(0, 2, RECORD_ON),
+     heights(0, 2, 30.0, 0.0), relax(0), coupling(0, 3, 0), step(0, 10.0), coupling(0, 3, 0),
+     side_levels(0, 2, 0.5, 2.0, mode=1), step(0, 10.0), relax(0), step(0, 100.0),
+     [NULL_GRID, 250, NULL_GRID, 251, NULL_GRID, 252, NULL_GRID, 253])
+seed("coupling_large_2d", create(0, "2d", 71, 65), coupling(0, 2, RECORD_ON), all_open(0, "2d"),
+     region(SET_REGION, 0, 30, 30, 4, 4, 0, 30.0, 0.0), step(0, 10.0), step(0, 100.0),
+     region(SET_REGION, 0, 2, 2, 2, 2, 0, 10.0, 0.0), step(0, 100.0), coupling(0, 3, 0))
 
 rng = random.Random(20240611)
 for k in range(8):

@@ -9,8 +9,10 @@
  *   - its block's heights equal the serial heights bit for bit;
  *   - the step information (sub-steps, time integrated, rest, largest excess
  *     slope) equals the serial figures, on every rank;
- *   - the four mass figures equal the serial ones to 1e-12 of the mass;
- *     the ledger closes.
+ *   - the four mass figures and what left through each side equal the
+ *     serial ones to 1e-12 of the mass; the ledger closes;
+ *   - where the scene records face fluxes, the block's faces (both of its
+ *     edges included) carried what the serial grid's did, bit for bit.
  * Then bad decompositions and disagreeing ranks must fail on every rank with
  * a message naming the problem.
  *
@@ -151,6 +153,13 @@ typedef struct {
     /* The physics of real scenes (0 / NULL: not used). */
     double *bed, *theta_field;
     double exponent, static_angle;
+    /* What a host couples: the levels beyond each side of the global domain
+     * (NULL: none; ny values for the x sides, nx for the y sides), new ones
+     * for the first side before step `levels_before_step`, face fluxes. */
+    double *side_levels[4];
+    int levels_before_step;
+    double *new_levels;
+    int record;
 } scene_t;
 
 static double *zeros(int64_t n) { return calloc((size_t)n, sizeof(double)); }
@@ -166,7 +175,7 @@ static void add_column(double *h, int64_t nx, int64_t ny, double cx, double cy, 
 
 static scene_t collapse_open(void) {
     scene_t s = {"collapsing column, open sides", 150, 131, 1.0, 1.0, {DPSM_OPEN, DPSM_OPEN, DPSM_OPEN, DPSM_OPEN},
-                 DPSM_SCHEME_ISOTROPIC, 0.55, 6, 60.0, NULL, NULL, NULL, 0, {0, 0, 0, 0}, 0, NULL, 0.0, NULL, NULL, 0.0, 0.0};
+                 DPSM_SCHEME_ISOTROPIC, 0.55, 6, 60.0, NULL, NULL, NULL, 0, {0, 0, 0, 0}, 0, NULL, 0.0, NULL, NULL, 0.0, 0.0, {NULL, NULL, NULL, NULL}, 0, NULL, 0};
     s.h = zeros(s.nx * s.ny);
     add_column(s.h, s.nx, s.ny, 66.0, 60.5, 24.0, 30.0);
     s.bump_before_step = 3;
@@ -177,7 +186,7 @@ static scene_t collapse_open(void) {
 static scene_t source_walls(void) {
     scene_t s = {"source straddling blocks, walls and an open side", 97, 140, 0.5, 0.7,
                  {DPSM_WALL, DPSM_OPEN, DPSM_WALL, DPSM_WALL}, DPSM_SCHEME_ISOTROPIC, 0.6, 8, 25.0,
-                 NULL, NULL, NULL, 0, {0, 0, 0, 0}, 0, NULL, 0.0, NULL, NULL, 0.0, 0.0};
+                 NULL, NULL, NULL, 0, {0, 0, 0, 0}, 0, NULL, 0.0, NULL, NULL, 0.0, 0.0, {NULL, NULL, NULL, NULL}, 0, NULL, 0};
     s.h = zeros(s.nx * s.ny);
     s.q = zeros(s.nx * s.ny);
     for (int64_t j = 0; j < s.ny; ++j)
@@ -191,7 +200,7 @@ static scene_t source_walls(void) {
 static scene_t obstacles(void) {
     scene_t s = {"walls and sinks straddling blocks, pairwise scheme", 140, 100, 1.0, 1.0,
                  {DPSM_WALL, DPSM_WALL, DPSM_OPEN, DPSM_WALL}, DPSM_SCHEME_PAIRWISE, 0.5, 6, 40.0,
-                 NULL, NULL, NULL, 0, {0, 0, 0, 0}, 0, NULL, 0.0, NULL, NULL, 0.0, 0.0};
+                 NULL, NULL, NULL, 0, {0, 0, 0, 0}, 0, NULL, 0.0, NULL, NULL, 0.0, 0.0, {NULL, NULL, NULL, NULL}, 0, NULL, 0};
     int64_t n = s.nx * s.ny;
     s.h = zeros(n);
     s.kinds = calloc((size_t)n, 1);
@@ -211,13 +220,14 @@ static scene_t obstacles(void) {
     for (int64_t c = 0; c < n; ++c)
         if (s.kinds[c] == DPSM_CELL_OPEN) s.h[c] = 1.5; /* sinks held at 1.5 */
     s.new_kinds_before_step = 3;
+    s.record = 1;
     return s;
 }
 
 static scene_t spike_near_edge(void) {
     scene_t s = {"a spike near a block's edge on a surface at rest", 140, 120, 1.0, 1.0,
                  {DPSM_WALL, DPSM_WALL, DPSM_WALL, DPSM_WALL}, DPSM_SCHEME_ISOTROPIC, 0.6, 6, 10.0,
-                 NULL, NULL, NULL, 0, {0, 0, 0, 0}, 0, NULL, 0.0, NULL, NULL, 0.0, 0.0};
+                 NULL, NULL, NULL, 0, {0, 0, 0, 0}, 0, NULL, 0.0, NULL, NULL, 0.0, 0.0, {NULL, NULL, NULL, NULL}, 0, NULL, 0};
     s.h = zeros(s.nx * s.ny);
     for (int64_t j = 0; j < s.ny; ++j)
         for (int64_t i = 0; i < s.nx; ++i) s.h[i + s.nx * j] = 0.3 * (double)((i + j) % 2); /* at rest: slope 0.3 < tan 0.6 */
@@ -232,7 +242,7 @@ static scene_t spike_near_edge(void) {
 static scene_t physics(void) {
     scene_t s = {"bed, erosion, angle field, exponent 1.5, hysteresis", 130, 110, 0.5, 0.5,
                  {DPSM_OPEN, DPSM_WALL, DPSM_WALL, DPSM_WALL}, DPSM_SCHEME_ISOTROPIC, 0.55, 8, 30.0,
-                 NULL, NULL, NULL, 0, {0, 0, 0, 0}, 0, NULL, 0.0, NULL, NULL, 1.5, 0.62};
+                 NULL, NULL, NULL, 0, {0, 0, 0, 0}, 0, NULL, 0.0, NULL, NULL, 1.5, 0.62, {NULL, NULL, NULL, NULL}, 0, NULL, 0};
     const int64_t n = s.nx * s.ny;
     s.h = zeros(n);
     s.q = zeros(n);
@@ -248,10 +258,39 @@ static scene_t physics(void) {
         }
     add_column(s.h, s.nx, s.ny, 64.0, 55.0, 12.0, 4.0);
     add_column(s.h, s.nx, s.ny, 100.0, 80.0, 8.0, 3.0);
+    s.record = 1;
+    return s;
+}
+
+/* Sand flows in from a raised side whose level varies along it, out to a
+ * lower side and to an open side at 0, past a wall side with levels of its
+ * own; the raised side's levels change mid-run; every face recorded. */
+static scene_t side_levels(void) {
+    scene_t s = {"levels beyond the sides, inflow and outflow, face fluxes", 120, 100, 1.0, 1.0,
+                 {DPSM_OPEN, DPSM_OPEN, DPSM_WALL, DPSM_OPEN}, DPSM_SCHEME_ISOTROPIC, 0.55, 6, 30.0,
+                 NULL, NULL, NULL, 0, {0, 0, 0, 0}, 0, NULL, 0.0, NULL, NULL, 0.0, 0.0, {NULL, NULL, NULL, NULL}, 0, NULL, 0};
+    s.h = zeros(s.nx * s.ny);
+    add_column(s.h, s.nx, s.ny, 70.0, 45.0, 20.0, 15.0);
+    s.side_levels[DPSM_XMIN] = zeros(s.ny);
+    s.new_levels = zeros(s.ny);
+    for (int64_t j = 0; j < s.ny; ++j) {
+        s.side_levels[DPSM_XMIN][j] = 6.0 + 0.5 * (double)(j % 7);
+        s.new_levels[j] = 2.0 + 0.25 * (double)(j % 5);
+    }
+    s.side_levels[DPSM_YMIN] = zeros(s.nx);
+    s.side_levels[DPSM_YMAX] = zeros(s.nx);
+    for (int64_t i = 0; i < s.nx; ++i) {
+        s.side_levels[DPSM_YMIN][i] = 9.0; /* a wall side: no effect */
+        s.side_levels[DPSM_YMAX][i] = 0.5 + 0.01 * (double)i;
+    }
+    s.levels_before_step = 3;
+    s.record = 1;
     return s;
 }
 
 static void free_scene(scene_t *s) {
+    for (int side = 0; side < 4; ++side) free(s->side_levels[side]);
+    free(s->new_levels);
     free(s->bed);
     free(s->theta_field);
     free(s->h);
@@ -269,8 +308,26 @@ static void *sub_array(const void *global, size_t size, int64_t nx, block_t b) {
     return out;
 }
 
+/* Sets the levels beyond `side` on g: block b's part of the global `levels`
+ * (its rows for an x side, its columns for a y side). A block that does not
+ * touch the side passes levels of 1000 instead, which must be ignored. */
+static void set_side_levels(dpsm_grid *g, const scene_t *s, int side, const double *levels, block_t b) {
+    const int touches = side == DPSM_XMIN   ? b.i0 == 0
+                        : side == DPSM_XMAX ? b.i0 + b.ni == s->nx
+                        : side == DPSM_YMIN ? b.j0 == 0
+                                            : b.j0 + b.nj == s->ny;
+    const int64_t n = side <= DPSM_XMAX ? b.nj : b.ni;
+    double *mine = malloc((size_t)n * sizeof(double));
+    for (int64_t k = 0; k < n; ++k) mine[k] = touches ? levels[(side <= DPSM_XMAX ? b.j0 : b.i0) + k] : 1000.0;
+    OK(g, dpsm_set_side_levels(g, side, mine));
+    free(mine);
+}
+
 /* Sets up g (the whole scene when b is the whole grid, else its block b). */
 static void set_scene(dpsm_grid *g, const scene_t *s, block_t b) {
+    for (int side = DPSM_XMIN; side <= DPSM_YMAX; ++side)
+        if (s->side_levels[side]) set_side_levels(g, s, side, s->side_levels[side], b);
+    if (s->record) OK(g, dpsm_set_face_flux_recording(g, 1));
     for (int side = DPSM_XMIN; side <= DPSM_YMAX; ++side) OK(g, dpsm_set_boundary(g, side, s->sides[side]));
     OK(g, dpsm_set_scheme(g, s->scheme));
     OK(g, dpsm_set_repose_angle(g, s->theta));
@@ -321,6 +378,63 @@ static void host_changes(dpsm_grid *g, const scene_t *s, block_t b, int step) {
         OK(g, dpsm_set_cell_kinds(g, k));
         free(k);
     }
+    if (s->new_levels && s->levels_before_step == step) set_side_levels(g, s, DPSM_XMIN, s->new_levels, b);
+}
+
+/* The same figure on every rank: its smallest and largest agree. */
+static int same_on_every_rank(double x) {
+    double lo = x, hi = x;
+    MPI_Allreduce(MPI_IN_PLACE, &lo, 1, MPI_DOUBLE, MPI_MIN, MPI_COMM_WORLD);
+    MPI_Allreduce(MPI_IN_PLACE, &hi, 1, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
+    return lo == hi;
+}
+
+/* What left through each side: global figures, as the serial grid's to 1e-12
+ * of the mass, the same on every rank. */
+static void compare_side_outflows(const dpsm_grid *g, const dpsm_grid *serial, const char *what) {
+    double scale = 0.0;
+    for (int q = DPSM_MASS_TOTAL; q <= DPSM_MASS_OUTFLOW; ++q) {
+        double m = 0.0;
+        OK(serial, dpsm_get_mass(serial, q, &m));
+        scale += fabs(m);
+    }
+    for (int side = DPSM_XMIN; side <= DPSM_YMAX; ++side) {
+        double a = 0.0, b = 0.0;
+        OK(g, dpsm_get_side_outflow(g, side, &a));
+        OK(serial, dpsm_get_side_outflow(serial, side, &b));
+        require(fabs(a - b) <= 1e-12 * scale, "%s: side %d took %.17g distributed, %.17g serial", what, side, a, b);
+        require(same_on_every_rank(a), "%s: side %d's outflow differs between ranks", what, side);
+    }
+}
+
+/* The block's faces against the serial grid's same faces, bit for bit. */
+static void compare_face_fluxes(const dpsm_grid *g, const dpsm_grid *serial, const scene_t *s, block_t b,
+                                const char *what) {
+    const size_t nfx = (size_t)((b.ni + 1) * b.nj), nfy = (size_t)(b.ni * (b.nj + 1));
+    const size_t sfx = (size_t)((s->nx + 1) * s->ny), sfy = (size_t)(s->nx * (s->ny + 1));
+    double *x = malloc(nfx * sizeof(double)), *y = malloc(nfy * sizeof(double));
+    double *sx = malloc(sfx * sizeof(double)), *sy = malloc(sfy * sizeof(double));
+    OK(g, dpsm_get_face_fluxes(g, x, y));
+    OK(serial, dpsm_get_face_fluxes(serial, sx, sy));
+    int64_t differ = 0, carried = 0;
+    for (int64_t j = 0; j < b.nj; ++j)
+        for (int64_t i = 0; i <= b.ni; ++i) {
+            const double mine = x[i + (b.ni + 1) * j], ref = sx[(b.i0 + i) + (s->nx + 1) * (b.j0 + j)];
+            differ += memcmp(&mine, &ref, sizeof(double)) != 0;
+            carried += ref != 0.0;
+        }
+    for (int64_t j = 0; j <= b.nj; ++j)
+        for (int64_t i = 0; i < b.ni; ++i) {
+            const double mine = y[i + b.ni * j], ref = sy[(b.i0 + i) + s->nx * (b.j0 + j)];
+            differ += memcmp(&mine, &ref, sizeof(double)) != 0;
+            carried += ref != 0.0;
+        }
+    require(differ == 0, "%s: %lld of the block's faces carried other than the serial grid's (of %lld that carried sand)",
+            what, (long long)differ, (long long)carried);
+    free(x);
+    free(y);
+    free(sx);
+    free(sy);
 }
 
 static void compare_step_info(const dpsm_grid *g, const dpsm_grid *serial, const char *what) {
@@ -418,11 +532,21 @@ static void run_scene(const scene_t *s, int kind) {
                 first < 0 ? 0.0 : ref[first]);
         compare_step_info(g, serial, at);
         compare_mass(g, serial, at);
+        compare_side_outflows(g, serial, at);
+        if (s->record) compare_face_fluxes(g, serial, s, b, at);
         double substeps = 0;
         OK(serial, dpsm_get_step_info(serial, DPSM_INFO_SUBSTEPS, &substeps));
         if (substeps > 0) moved_any = 1;
     }
     require(moved_any, "%s: the scene never moved: it tests nothing", what);
+    /* Over a limit of 10 sub-steps, a step of 11 fails where the scene may flow
+     * for ever (a source, held levels that differ: open cells, open sides) and
+     * is taken otherwise, as on the serial grid. */
+    OK(g, dpsm_set_max_substeps(g, 10));
+    OK(serial, dpsm_set_max_substeps(serial, 10));
+    const int limited = dpsm_step(g, 10.5 * stable), serial_limited = dpsm_step(serial, 10.5 * stable);
+    require(limited == serial_limited, "%s: a step over the limit: %s distributed (%s), %s serial", what,
+            dpsm_status_string(limited), dpsm_last_error(g), dpsm_status_string(serial_limited));
     free(mine);
     free(ref);
     dpsm_destroy(serial);
@@ -514,14 +638,6 @@ static void disagreeing_ranks(void) {
     free(h);
     free(after);
     dpsm_destroy(g);
-}
-
-/* The same figure on every rank: its smallest and largest agree. */
-static int same_on_every_rank(double x) {
-    double lo = x, hi = x;
-    MPI_Allreduce(MPI_IN_PLACE, &lo, 1, MPI_DOUBLE, MPI_MIN, MPI_COMM_WORLD);
-    MPI_Allreduce(MPI_IN_PLACE, &hi, 1, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
-    return lo == hi;
 }
 
 /* A rank whose own arguments are refused does not leave the others waiting
@@ -637,9 +753,27 @@ static void expect_load_fails(MPI_Comm comm, const char *path, int null_out, int
     if (rank_ == 0 && status != DPSM_OK) printf("    %s: %s\n", what, msg);
 }
 
-/* Compares two distributed grids: heights bit for bit, every mass figure and
- * the step information exactly; the cells a step computed (its cost, not the
- * state) only when `with_cost`: a loaded grid visits every tile once. */
+/* Two grids of block b record the same fluxes on its faces, bit for bit (or
+ * neither records them). */
+static void compare_block_faces(const dpsm_grid *a, const dpsm_grid *b, block_t blk, const char *what) {
+    const size_t nfx = (size_t)((blk.ni + 1) * blk.nj), nfy = (size_t)(blk.ni * (blk.nj + 1));
+    double *xa = malloc(nfx * sizeof(double)), *xb = malloc(nfx * sizeof(double));
+    double *ya = malloc(nfy * sizeof(double)), *yb = malloc(nfy * sizeof(double));
+    const int sa = dpsm_get_face_fluxes(a, xa, ya), sb = dpsm_get_face_fluxes(b, xb, yb);
+    require(sa == sb, "%s: face fluxes %s saved, %s loaded", what, dpsm_status_string(sa), dpsm_status_string(sb));
+    if (sa == DPSM_OK)
+        require(memcmp(xa, xb, nfx * sizeof(double)) == 0 && memcmp(ya, yb, nfy * sizeof(double)) == 0,
+                "%s: the face fluxes differ between the saved grid and the loaded one", what);
+    free(xa);
+    free(xb);
+    free(ya);
+    free(yb);
+}
+
+/* Compares two distributed grids: heights bit for bit, every mass figure,
+ * what left through each side and the step information exactly, the face
+ * fluxes after a step; the cells a step computed (its cost, not the state)
+ * only when `with_cost`: a loaded grid visits every tile once. */
 static void compare_grids(const dpsm_grid *a, const dpsm_grid *b, block_t blk, int with_cost, const char *what) {
     const size_t cells = (size_t)(blk.ni * blk.nj);
     double *ha = malloc(cells * sizeof(double)), *hb = malloc(cells * sizeof(double));
@@ -655,6 +789,14 @@ static void compare_grids(const dpsm_grid *a, const dpsm_grid *b, block_t blk, i
         OK(b, dpsm_get_mass(b, q[k], &mb));
         require(memcmp(&ma, &mb, sizeof ma) == 0, "%s: mass quantity %d is %.17g saved, %.17g loaded", what, q[k], ma, mb);
     }
+    for (int side = DPSM_XMIN; side <= DPSM_YMAX; ++side) {
+        double sa = -1, sb = -2;
+        OK(a, dpsm_get_side_outflow(a, side, &sa));
+        OK(b, dpsm_get_side_outflow(b, side, &sb));
+        require(memcmp(&sa, &sb, sizeof sa) == 0, "%s: side %d took %.17g saved, %.17g loaded", what, side, sa, sb);
+    }
+    /* The fluxes are not saved: after a step they are the same again. */
+    if (!with_cost) compare_block_faces(a, b, blk, what);
     const int items[] = {DPSM_INFO_SUBSTEPS, DPSM_INFO_TIME_INTEGRATED, DPSM_INFO_AT_REST, DPSM_INFO_MAX_EXCESS_SLOPE,
                          DPSM_INFO_CELL_UPDATES};
     for (int k = 0; k < (with_cost ? 5 : 4); ++k) {
@@ -667,54 +809,65 @@ static void compare_grids(const dpsm_grid *a, const dpsm_grid *b, block_t blk, i
     free(hb);
 }
 
+/* Runs scene s on decomposition `kind` for 3 steps, saves it (this rank's
+ * file: `path`), loads it and requires the loaded grid to continue bit for
+ * bit for 4 more steps with the host's changes. Returns the saved grid (NULL
+ * if it could not be made) and its dt. */
+static dpsm_grid *saved_and_continued(const scene_t *s, int kind, const char *name, char *path, size_t path_size,
+                                      double *dt) {
+    char what[200];
+    snprintf(what, sizeof what, "restart of %s, %s", s->name, decomposition_names[kind]);
+    block_t b = block_of(kind, rank_, size_, s->nx, s->ny);
+    const long failures_before = failures_;
+    dpsm_grid *g = NULL, *loaded = NULL;
+    OK(NULL, dpsm_create_2d_mpi(MPI_COMM_WORLD, s->nx, s->ny, b.i0, b.j0, b.ni, b.nj, s->dx, s->dy, &g));
+    if (!g) return NULL;
+    set_scene(g, s, b);
+    double stable = 0;
+    OK(g, dpsm_stable_dt(g, &stable));
+    *dt = s->dt_in_stable_steps * stable;
+    for (int step = 0; step < 3; ++step) OK(g, dpsm_step(g, *dt));
+    restart_path(path, path_size, name, rank_);
+    OK(g, dpsm_save(g, path));
+    OK(NULL, dpsm_load_mpi(MPI_COMM_WORLD, path, &loaded));
+    if (!loaded) return g;
+    compare_grids(g, loaded, b, 1, what);
+    for (int step = 3; step < 7; ++step) {
+        host_changes(g, s, b, step);
+        host_changes(loaded, s, b, step);
+        OK(g, dpsm_step(g, *dt));
+        OK(loaded, dpsm_step(loaded, *dt));
+        char at[260];
+        snprintf(at, sizeof at, "%s, step %d after the load", what, step);
+        compare_grids(g, loaded, b, 0, at);
+    }
+    double substeps = 0;
+    OK(g, dpsm_get_step_info(g, DPSM_INFO_SUBSTEPS, &substeps));
+    require(substeps > 0, "%s: the scene was at rest after the load: it tests nothing", what);
+    long mine = failures_ - failures_before, total = 0;
+    MPI_Allreduce(&mine, &total, 1, MPI_LONG, MPI_SUM, MPI_COMM_WORLD);
+    if (rank_ == 0) printf("  %s: %s\n", what, total == 0 ? "continues bit for bit for 4 steps" : "FAILED");
+    dpsm_destroy(loaded);
+    return g;
+}
+
 /* dpsm_save on a distributed grid writes one file per rank, dpsm_load_mpi
  * reads them back, and the loaded grid continues bit for bit: heights, all
- * five mass figures and the step information, for several steps with the
- * host's changes, on every decomposition. Then every wrong set of files is
- * refused on every rank, and a save that fails on one rank fails on all. */
+ * five mass figures, what left through each side, the face fluxes and the
+ * step information, for several steps with the host's changes (new side
+ * levels among them), on every decomposition. Then every wrong set of files
+ * is refused on every rank, and a save that fails on one rank fails on all. */
 static void restart_files(void) {
     scene_t s = physics(); /* bed, erosion, angle field, exponent 1.5, hysteresis, a source */
     s.bump_before_step = 4;
     s.bump = (block_t){40, 30, 30, 30};
+    scene_t levels = side_levels(); /* new levels before step 3: after the load */
     char path[256], other[256];
+    double dt = 0.0;
     for (int kind = 0; kind < N_DECOMPOSITIONS; ++kind) {
-        char what[160];
-        snprintf(what, sizeof what, "restart, %s", decomposition_names[kind]);
-        block_t b = block_of(kind, rank_, size_, s.nx, s.ny);
-        const long failures_before = failures_;
-        dpsm_grid *g = NULL, *loaded = NULL;
-        OK(NULL, dpsm_create_2d_mpi(MPI_COMM_WORLD, s.nx, s.ny, b.i0, b.j0, b.ni, b.nj, s.dx, s.dy, &g));
+        dpsm_destroy(saved_and_continued(&levels, kind, "levels", path, sizeof path, &dt));
+        dpsm_grid *g = saved_and_continued(&s, kind, "restart", path, sizeof path, &dt);
         if (!g) continue;
-        set_scene(g, &s, b);
-        double stable = 0;
-        OK(g, dpsm_stable_dt(g, &stable));
-        const double dt = s.dt_in_stable_steps * stable;
-        for (int step = 0; step < 3; ++step) OK(g, dpsm_step(g, dt));
-        restart_path(path, sizeof path, "restart", rank_);
-        OK(g, dpsm_save(g, path));
-        OK(NULL, dpsm_load_mpi(MPI_COMM_WORLD, path, &loaded));
-        if (!loaded) {
-            dpsm_destroy(g);
-            continue;
-        }
-        compare_grids(g, loaded, b, 1, what);
-        for (int step = 3; step < 7; ++step) {
-            host_changes(g, &s, b, step);
-            host_changes(loaded, &s, b, step);
-            OK(g, dpsm_step(g, dt));
-            OK(loaded, dpsm_step(loaded, dt));
-            char at[200];
-            snprintf(at, sizeof at, "%s, step %d after the load", what, step);
-            compare_grids(g, loaded, b, 0, at);
-        }
-        double substeps = 0;
-        OK(g, dpsm_get_step_info(g, DPSM_INFO_SUBSTEPS, &substeps));
-        require(substeps > 0, "%s: the scene was at rest after the load: it tests nothing", what);
-        long mine = failures_ - failures_before, total = 0;
-        MPI_Allreduce(&mine, &total, 1, MPI_LONG, MPI_SUM, MPI_COMM_WORLD);
-        if (rank_ == 0) printf("  %s: %s\n", what, total == 0 ? "continues bit for bit for 4 steps" : "FAILED");
-        dpsm_destroy(loaded);
-
         if (kind != GRID_2D) {
             dpsm_destroy(g);
             continue;
@@ -807,7 +960,10 @@ static void restart_files(void) {
     }
     restart_path(path, sizeof path, "restart", rank_);
     remove(path);
+    restart_path(path, sizeof path, "levels", rank_);
+    remove(path);
     free_scene(&s);
+    free_scene(&levels);
 }
 
 int main(int argc, char **argv) {
@@ -816,7 +972,7 @@ int main(int argc, char **argv) {
     MPI_Comm_size(MPI_COMM_WORLD, &size_);
     if (rank_ == 0) printf("test_mpi on %d ranks\n", size_);
 
-    scene_t (*scenes[])(void) = {collapse_open, source_walls, obstacles, spike_near_edge, physics};
+    scene_t (*scenes[])(void) = {collapse_open, source_walls, obstacles, spike_near_edge, physics, side_levels};
     for (size_t k = 0; k < sizeof scenes / sizeof scenes[0]; ++k) {
         scene_t s = scenes[k]();
         for (int kind = 0; kind < N_DECOMPOSITIONS; ++kind) {

@@ -233,22 +233,30 @@ class Test2D(LedgerMixin, unittest.TestCase):
             self.assertEqual(g.get_step_info(dpsm.INFO_SUBSTEPS), 0.0)  # truly at rest
 
     def test_relax_auto_is_the_default(self):
-        """DPSM_RELAX_AUTO: the default relaxes the cone to rest, and steps in time while a source acts."""
+        """DPSM_RELAX_AUTO: the default steps in time as DPSM_RELAX_TIME_ACCURATE does, source or not."""
         g = self.g
-        with self.cone_twin(dpsm.RELAX_TO_REST) as to_rest:
-            g.step(1e6)  # long enough: a dt of fewer than 16 stable sub-steps is stepped in time
-            to_rest.step(1e6)
-            self.assertEqual(g.get_step_info(dpsm.INFO_TIME_INTEGRATED), 0.0)
-            self.assertEqual(g.get_step_info(dpsm.INFO_SUBSTEPS), to_rest.get_step_info(dpsm.INFO_SUBSTEPS))
-            self.assertEqual(flat(g.get_heights()), flat(to_rest.get_heights()))
-            g.set_source([[0.01] * self.nx for _ in range(self.ny)])
-            g.step(0.5)
-            self.assertEqual(g.get_step_info(dpsm.INFO_TIME_INTEGRATED), 0.5)
-            g.set_source(None)
-            g.set_relaxation(dpsm.RELAX_AUTO)
-            g.step(1e6)
-            self.assertEqual(g.get_step_info(dpsm.INFO_TIME_INTEGRATED), 0.0)
+        with self.cone_twin(dpsm.RELAX_TIME_ACCURATE) as timed:
+            def same_as_timed():
+                self.assertEqual(flat(g.get_heights()), flat(timed.get_heights()))
+                for item in (dpsm.INFO_SUBSTEPS, dpsm.INFO_TIME_INTEGRATED, dpsm.INFO_AT_REST):
+                    self.assertEqual(g.get_step_info(item), timed.get_step_info(item))
+
+            for grid in (g, timed):
+                grid.step(1e6)  # to rest, in time
+            self.assertGreater(g.get_step_info(dpsm.INFO_TIME_INTEGRATED), 0.0)
             self.assertEqual(g.get_step_info(dpsm.INFO_AT_REST), 1.0)
+            same_as_timed()
+            for grid in (g, timed):
+                grid.set_source([[0.01] * self.nx for _ in range(self.ny)])
+                grid.step(0.5)
+            self.assertEqual(g.get_step_info(dpsm.INFO_TIME_INTEGRATED), 0.5)
+            same_as_timed()
+            g.set_relaxation(dpsm.RELAX_AUTO)
+            for grid in (g, timed):
+                grid.set_source(None)
+                grid.step(1e6)
+            self.assertEqual(g.get_step_info(dpsm.INFO_AT_REST), 1.0)
+            same_as_timed()
             self.assertLedger(g)
             self.assertFails(dpsm.ERR_UNKNOWN_ENUM, g.set_relaxation, 3)
 
@@ -330,8 +338,17 @@ class Test2D(LedgerMixin, unittest.TestCase):
         self.assertLedger(g)
         self.assertFails(dpsm.ERR_INVALID_SIZE, g.set_source, [[rate] * nx for _ in range(ny - 1)])
 
-        # A driven scene is limited by set_max_substeps; the refused step changes nothing.
+        # A driven scene (a source that makes a face steep within the step) is
+        # limited by set_max_substeps; the refused step changes nothing. A
+        # source that cannot make a face steep is applied in closed form and
+        # is not limited.
         g.set_max_substeps(1)
+        g.step(10 * g.stable_dt())
+        self.assertEqual(g.get_step_info(dpsm.INFO_SUBSTEPS), 0.0)
+        sourced = g.get_mass(dpsm.MASS_SOURCED)
+        steep = [[rate] * nx for _ in range(ny)]
+        steep[3][3] = 100.0
+        g.set_source(steep)
         before = as_list(g.get_heights())
         self.assertFails(dpsm.ERR_WORK_LIMIT, g.step, 10 * g.stable_dt())
         self.assertEqual(as_list(g.get_heights()), before)
@@ -425,7 +442,7 @@ class TestPhysics(LedgerMixin, unittest.TestCase):
             zb = [[v - 0.01 for v in row] for row in h]
             g.set_bedrock(zb)
             g.set_bedrock(flat(zb))
-            e = self.assertFails(dpsm.ERR_INVALID_VALUE, g.set_bedrock, [[v + 1 for v in row] for row in h])
+            e = self.assertFails(dpsm.ERR_INVALID_VALUE, g.set_bedrock, [[v + 1e60 for v in row] for row in h])
             self.assertIn("zb[", e.message)
             self.assertFails(dpsm.ERR_INVALID_SIZE, g.set_bedrock, flat(zb)[:-1])
             self.assertFails(dpsm.ERR_INVALID_VALUE, g.set_heights, [[0.0] * 8 for _ in range(6)])
@@ -467,6 +484,92 @@ class TestPhysics(LedgerMixin, unittest.TestCase):
             g.set_heights(ramp)
             g.step(1.0)
             self.assertEqual(flat(g.get_heights()), flat(ramp))
+
+
+class TestCoupling(LedgerMixin, unittest.TestCase):
+    """Side levels, side outflows, face fluxes; the bed before the sand."""
+
+    def test_side_levels_and_outflow(self):
+        """Sand comes in from a side held above an empty table, and is booked as negative outflow."""
+        with dpsm.Grid.create_2d(12, 5, 0.1, 0.1) as g:
+            g.set_side_levels(dpsm.XMIN, [0.3] * 5)  # a wall side: nothing happens yet
+            g.step(10.0)
+            self.assertEqual(g.get_mass(dpsm.MASS_TOTAL), 0.0)
+            g.set_boundary(dpsm.XMIN, dpsm.OPEN)
+            g.step(100.0)
+            total = g.get_mass(dpsm.MASS_TOTAL)
+            self.assertGreater(total, 0.0)
+            self.assertAlmostEqual(g.get_side_outflow(dpsm.XMIN), -total, delta=1e-12 * total)
+            self.assertEqual(g.get_side_outflow(dpsm.YMAX), 0.0)
+            self.assertLedger(g)
+            g.set_side_levels(dpsm.YMIN, list(range(12)))
+            g.set_side_levels(dpsm.XMIN)  # back to 0
+            if np is not None:
+                g.set_side_levels(dpsm.XMAX, np.full(5, 0.1))
+            self.assertFails(dpsm.ERR_UNKNOWN_ENUM, g.set_side_levels, 4, [0.0] * 5)
+            self.assertFails(dpsm.ERR_UNKNOWN_ENUM, g.get_side_outflow, -1)
+            self.assertFails(dpsm.ERR_INVALID_SIZE, g.set_side_levels, dpsm.XMIN, [0.0] * 12)
+            e = self.assertFails(dpsm.ERR_INVALID_VALUE, g.set_side_levels, dpsm.YMAX, [0.0] * 11 + [float("nan")])
+            self.assertIn("levels[11]", e.message)
+        with dpsm.Grid.create_1d(6, 0.1) as line:
+            line.set_side_levels(dpsm.XMAX, [0.2])
+            self.assertFails(dpsm.ERR_NOT_APPLICABLE, line.set_side_levels, dpsm.YMIN, [0.2])
+            self.assertFails(dpsm.ERR_NOT_APPLICABLE, line.get_side_outflow, dpsm.YMAX)
+        with dpsm.Grid.create_axisymmetric(6, 0.1) as disk:
+            self.assertFails(dpsm.ERR_NOT_APPLICABLE, disk.set_side_levels, dpsm.XMIN, [0.2])
+            self.assertEqual(disk.get_side_outflow(dpsm.XMAX), 0.0)
+
+    def test_face_fluxes_2d(self):
+        """Shapes (ny, nx+1) and (ny+1, nx); a cell's faces bring what its height gained."""
+        nx, ny, d = 6, 4, 0.5
+        with dpsm.Grid.create_2d(nx, ny, d, d) as g:
+            self.assertFails(dpsm.ERR_NOT_APPLICABLE, g.get_face_fluxes)
+            self.assertFails(dpsm.ERR_INVALID_VALUE, g.set_face_flux_recording, 2)
+            g.set_face_flux_recording(True)
+            h = [[0.0] * nx for _ in range(ny)]
+            h[2][3] = 3.0
+            g.set_heights(h)
+            g.step(0.1)
+            fx, fy = g.get_face_fluxes()
+            fx, fy = as_list(fx), as_list(fy)
+            self.assertEqual((len(fx), len(fx[0]), len(fy), len(fy[0])), (ny, nx + 1, ny + 1, nx))
+            after = as_list(g.get_heights())
+            for j in range(ny):
+                for i in range(nx):
+                    brought = fx[j][i] - fx[j][i + 1] + fy[j][i] - fy[j + 1][i]
+                    self.assertAlmostEqual(brought, (after[j][i] - h[j][i]) * d * d, delta=1e-15)
+            self.assertGreater(fx[2][4], 0.0)  # the pile's east face carries sand east
+            out_x, out_y = array.array("d", [0.0]) * (ny * (nx + 1)), array.array("d", [0.0]) * ((ny + 1) * nx)
+            got_x, got_y = g.get_face_fluxes(out_x=out_x, out_y=out_y)
+            self.assertIs(got_x, out_x)
+            self.assertIs(got_y, out_y)
+            self.assertEqual(list(out_x), flat(fx))
+            self.assertFails(dpsm.ERR_INVALID_SIZE, g.get_face_fluxes, out_x=array.array("d", [0.0]) * 3)
+            g.set_face_flux_recording(0)
+            self.assertFails(dpsm.ERR_NOT_APPLICABLE, g.get_face_fluxes)
+
+    def test_face_fluxes_1d(self):
+        """On a line and on a disk: nx+1 faces and no fy; an out_y is refused."""
+        for create in (dpsm.Grid.create_1d, dpsm.Grid.create_axisymmetric):
+            with create(5, 0.2) as g:
+                g.set_face_flux_recording(1)
+                g.set_heights([0.0, 0.0, 2.0, 0.0, 0.0])
+                g.set_boundary(dpsm.XMAX, dpsm.OPEN)
+                g.step(50.0)
+                fx, fy = g.get_face_fluxes()
+                self.assertIsNone(fy)
+                self.assertEqual(len(as_list(fx)), 6)
+                self.assertEqual(as_list(fx)[0], 0.0)  # the axis, or a wall
+                self.assertFails(dpsm.ERR_INVALID_VALUE, g.get_face_fluxes, out_y=array.array("d", [0.0]) * 10)
+
+    def test_bed_before_the_sand(self):
+        """A bed set on a fresh grid lifts the surface to it, booked as external mass."""
+        with dpsm.Grid.create_1d(4, 0.5) as g:
+            g.set_bedrock([1.0, 2.0, 0.5, -1.0])
+            self.assertEqual(flat(g.get_heights()), [1.0, 2.0, 0.5, 0.0])
+            self.assertAlmostEqual(g.get_mass(dpsm.MASS_EXTERNAL), 3.5 * 0.5, delta=1e-15)
+            g.set_heights([1.5, 2.0, 0.5, 0.0])
+            self.assertLedger(g)
 
 
 class TestRestart(LedgerMixin, unittest.TestCase):

@@ -33,6 +33,7 @@ void stress_worst_reset(stress_worst_t *w) {
     w->new_max_pairwise = w->new_min_pairwise = -INFINITY;
     w->new_max_isotropic = w->new_min_isotropic = -INFINITY;
     w->rest_slope = -INFINITY;
+    w->fluxes = -INFINITY;
 }
 
 static void note(double *worst, char *where, double value, const char *name) {
@@ -51,6 +52,7 @@ void stress_worst_merge(const stress_worst_t *w) {
     stress_worst.new_max_isotropic = fmax(stress_worst.new_max_isotropic, w->new_max_isotropic);
     stress_worst.new_min_isotropic = fmax(stress_worst.new_min_isotropic, w->new_min_isotropic);
     note(&stress_worst.rest_slope, stress_worst.rest_where, w->rest_slope, w->rest_where);
+    note(&stress_worst.fluxes, stress_worst.fluxes_where, w->fluxes, w->fluxes_where);
     stress_worst.nonfinite += w->nonfinite;
     stress_worst.checks += w->checks;
     stress_worst.rest_checks += w->rest_checks;
@@ -75,6 +77,7 @@ void stress_worst_print(const char *title, const stress_worst_t *w) {
     print_message("  worst new max / min, isotropic 2D         %s / %s  [%s]\n", fig(c, w->new_max_isotropic),
                   fig(d, w->new_min_isotropic), w->iso_where);
     print_message("  worst slope at rest / (tan(theta)(1+tol)) - 1: %s  [%s]\n", fig(e, w->rest_slope), w->rest_where);
+    print_message("  worst face-flux balance of a cell (relative): %s  [%s]\n", fig(a, w->fluxes), w->fluxes_where);
     print_message("  (new max/min: relative to the largest |height|; <= 0 means none)\n");
 }
 
@@ -107,7 +110,9 @@ static double cell_area(const scene_t *s, int64_t c) {
     return s->dx * s->dy;
 }
 
-static int any_side_open(const scene_t *s) { return s->open[0] || s->open[1] || s->open[2] || s->open[3]; }
+/* The faces along a side and the level beyond face k of it. */
+static int64_t faces_along(const scene_t *s, int side) { return side <= DPSM_XMAX ? s->ny : s->nx; }
+static double level_at(const scene_t *s, int side, int64_t k) { return s->levels[side] ? s->levels[side][k] : 0.0; }
 
 void scene_create(scene_t *s, const char *name, int geom, int64_t nx, int64_t ny, double dx, double dy) {
     memset(s, 0, sizeof *s);
@@ -133,6 +138,11 @@ void scene_create(scene_t *s, const char *name, int geom, int64_t nx, int64_t ny
     s->h = calloc((size_t)s->n, sizeof(double));
     s->held = calloc((size_t)s->n, sizeof(double));
     REQUIRE(s->kinds && s->h && s->held, "out of memory");
+    /* Every second scene records its face fluxes (the others keep the
+     * kernels' in-place visits under stress). */
+    static unsigned scenes_made;
+    s->record = scenes_made++ % 2;
+    if (s->record) OK(s, dpsm_set_face_flux_recording(s->g, 1));
 }
 
 void scene_destroy(scene_t *s) {
@@ -142,6 +152,8 @@ void scene_destroy(scene_t *s) {
     free(s->held);
     free(s->bed);
     free(s->tan_field);
+    free(s->q);
+    for (int side = 0; side < 4; ++side) free(s->levels[side]);
     memset(s, 0, sizeof *s);
 }
 
@@ -199,22 +211,36 @@ void scene_set_heights(scene_t *s, const double *h) {
     refresh_held(s);
 }
 
+/* A copy of n values (NULL for NULL). */
+static double *copy_of(const double *values, int64_t n) {
+    if (!values) return NULL;
+    double *copy = malloc(sizeof(double) * (size_t)n);
+    REQUIRE(copy != NULL, "out of memory");
+    memcpy(copy, values, sizeof(double) * (size_t)n);
+    return copy;
+}
+
 void scene_set_source(scene_t *s, const double *q) {
     OK(s, dpsm_set_source(s->g, q));
     s->source = 0;
     if (q)
         for (int64_t c = 0; c < s->n; ++c)
             if (s->kinds[c] == DPSM_CELL_SAND && q[c] != 0.0) s->source = 1;
+    free(s->q);
+    s->q = copy_of(q, s->n);
+}
+
+void scene_set_side_levels(scene_t *s, int side, const double *levels) {
+    OK(s, dpsm_set_side_levels(s->g, side, levels));
+    free(s->levels[side]);
+    s->levels[side] = copy_of(levels, faces_along(s, side));
 }
 
 void scene_set_bed(scene_t *s, const double *zb) {
     OK(s, dpsm_set_bedrock(s->g, zb));
     free(s->bed);
-    s->bed = NULL;
-    if (!zb) return;
-    s->bed = malloc(sizeof(double) * (size_t)s->n);
-    REQUIRE(s->bed != NULL, "out of memory");
-    memcpy(s->bed, zb, sizeof(double) * (size_t)s->n);
+    s->bed = copy_of(zb, s->n);
+    refresh_held(s); /* a bed above a cell lifts it, held cells too */
 }
 
 void scene_set_angle_field(scene_t *s, const double *theta) {
@@ -276,11 +302,11 @@ static double rest_excess(const scene_t *s, int64_t *where) {
     const double film = s->tol * smallest_tan * spacing * (1.0 + 1e-9);
     const double *h = s->h;
     const uint8_t *k = s->kinds;
-    /* face between cells a and b (b < 0: the outside of an open side, at 0) */
-#define FACE(a, b, d)                                                                                  \
+    /* face between cells a and b (b < 0: the outside of an open side, held at `outside`) */
+#define FACE(a, b, d, outside)                                                                         \
     do {                                                                                               \
         const int64_t a_ = (a), b_ = (b);                                                              \
-        const double hb_ = b_ < 0 ? 0.0 : h[b_];                                                      \
+        const double hb_ = b_ < 0 ? (outside) : h[b_];                                                \
         const int kb_ = b_ < 0 ? DPSM_CELL_OPEN : k[b_];                                              \
         if (k[a_] == DPSM_CELL_WALL || kb_ == DPSM_CELL_WALL) break;                                  \
         if (k[a_] != DPSM_CELL_SAND && kb_ != DPSM_CELL_SAND) break;                                  \
@@ -298,12 +324,13 @@ static double rest_excess(const scene_t *s, int64_t *where) {
     for (int64_t j = 0; j < s->ny; ++j)
         for (int64_t i = 0; i < s->nx; ++i) {
             const int64_t c = i + s->nx * j;
-            if (i + 1 < s->nx) FACE(c, c + 1, s->dx);
-            if (j + 1 < s->ny) FACE(c, c + s->nx, s->dy);
-            if (i == 0 && s->open[DPSM_XMIN] && s->geom != GEOM_AXI) FACE(c, -1, s->dx);
-            if (i == s->nx - 1 && s->open[DPSM_XMAX]) FACE(c, -1, s->dx);
-            if (s->geom == GEOM_2D && j == 0 && s->open[DPSM_YMIN]) FACE(c, -1, s->dy);
-            if (s->geom == GEOM_2D && j == s->ny - 1 && s->open[DPSM_YMAX]) FACE(c, -1, s->dy);
+            if (i + 1 < s->nx) FACE(c, c + 1, s->dx, 0.0);
+            if (j + 1 < s->ny) FACE(c, c + s->nx, s->dy, 0.0);
+            if (i == 0 && s->open[DPSM_XMIN] && s->geom != GEOM_AXI) FACE(c, -1, s->dx, level_at(s, DPSM_XMIN, j));
+            if (i == s->nx - 1 && s->open[DPSM_XMAX]) FACE(c, -1, s->dx, level_at(s, DPSM_XMAX, j));
+            if (s->geom == GEOM_2D && j == 0 && s->open[DPSM_YMIN]) FACE(c, -1, s->dy, level_at(s, DPSM_YMIN, i));
+            if (s->geom == GEOM_2D && j == s->ny - 1 && s->open[DPSM_YMAX])
+                FACE(c, -1, s->dy, level_at(s, DPSM_YMAX, i));
         }
 #undef FACE
     return worst;
@@ -375,37 +402,154 @@ static void check_state(scene_t *s, stress_worst_t *w, int stepped, double hi, d
     }
 }
 
+/* Calls held(level) for every level the scene holds: open cells' heights and
+ * the levels beyond open sides; stops at the first that returns nonzero. */
+static int for_held_levels(const scene_t *s, int (*held)(double level, void *state), void *state) {
+    for (int side = 0; side < 4; ++side)
+        if (s->open[side])
+            for (int64_t k = 0; k < faces_along(s, side); ++k)
+                if (held(level_at(s, side, k), state)) return 1;
+    for (int64_t c = 0; c < s->n; ++c)
+        if (s->kinds[c] == DPSM_CELL_OPEN && held(s->h[c], state)) return 1;
+    return 0;
+}
+
+typedef struct {
+    int have;
+    double level, lo, hi;
+} held_range_t;
+
+static int differs(double level, void *state) {
+    held_range_t *r = state;
+    if (r->have && level != r->level) return 1;
+    r->level = level;
+    r->have = 1;
+    return 0;
+}
+
+static int widen(double level, void *state) {
+    held_range_t *r = state;
+    r->hi = fmax(r->hi, level);
+    r->lo = fmin(r->lo, level);
+    return 0;
+}
+
 int scene_driven(const scene_t *s) {
     if (s->source) return 1;
-    int have = any_side_open(s);
-    double level = 0.0;
-    for (int64_t c = 0; c < s->n; ++c) {
-        if (s->kinds[c] != DPSM_CELL_OPEN) continue;
-        if (have && s->h[c] != level) return 1;
-        level = s->h[c];
-        have = 1;
-    }
-    return 0;
+    held_range_t range = {0, 0.0, 0.0, 0.0};
+    return for_held_levels(s, differs, &range);
 }
 
 void scene_check(scene_t *s, stress_worst_t *w) { check_state(s, w, 0, 0.0, 0.0); }
 
+/* What the face fluxes are checked against: the ledger's figures and each
+ * side's account. */
+typedef struct {
+    double sourced, outflow, side[4];
+} accounts_t;
+
+static accounts_t accounts_of(const scene_t *s) {
+    accounts_t a = {0.0, 0.0, {0.0, 0.0, 0.0, 0.0}};
+    OK(s, dpsm_get_mass(s->g, DPSM_MASS_SOURCED, &a.sourced));
+    OK(s, dpsm_get_mass(s->g, DPSM_MASS_OUTFLOW, &a.outflow));
+    for (int side = 0; side < 4; ++side)
+        if (dpsm_get_side_outflow(s->g, side, &a.side[side]) != DPSM_OK) a.side[side] = 0.0;
+    return a;
+}
+
+/* The step that took the scene from h0 (and the accounts `before`) to s->h:
+ * its fluxes against every sand cell, the walls, the sides and the outflow
+ * (stress_support.h). */
+static void check_fluxes(const scene_t *s, const double *h0, const accounts_t *before, stress_worst_t *w) {
+    const accounts_t after = accounts_of(s);
+    double time = 0.0, substeps = 0.0;
+    OK(s, dpsm_get_step_info(s->g, DPSM_INFO_TIME_INTEGRATED, &time));
+    OK(s, dpsm_get_step_info(s->g, DPSM_INFO_SUBSTEPS, &substeps));
+    const double rel = 1e-11 + 16.0 * DBL_EPSILON * fmax(substeps, 1.0);
+    const int64_t nfx = (s->nx + 1) * s->ny, nfy = s->geom == GEOM_2D ? s->nx * (s->ny + 1) : 0;
+    double *fx = malloc(sizeof(double) * (size_t)nfx), *fy = malloc(sizeof(double) * (size_t)(nfy + 1));
+    REQUIRE(fx && fy, "out of memory");
+    OK(s, dpsm_get_face_fluxes(s->g, fx, nfy ? fy : NULL));
+    double applied = 0.0, scale_all = fabs(before->sourced) + fabs(before->outflow) + fabs(after.outflow);
+    double into_open = 0.0;
+    for (int64_t j = 0; j < s->ny; ++j)
+        for (int64_t i = 0; i < s->nx; ++i) {
+            const int64_t c = i + s->nx * j, x = i + (s->nx + 1) * j, y = i + s->nx * j;
+            double in = fx[x] - fx[x + 1], gross = fabs(fx[x]) + fabs(fx[x + 1]);
+            if (nfy) {
+                in += fy[y] - fy[y + s->nx];
+                gross += fabs(fy[y]) + fabs(fy[y + s->nx]);
+            }
+            if (s->kinds[c] == DPSM_CELL_WALL) {
+                REQUIRE(gross == 0.0, "[%s] the faces of wall cell %lld carried %g", s->name, (long long)c, gross);
+                continue;
+            }
+            scale_all += gross;
+            if (s->kinds[c] == DPSM_CELL_OPEN) {
+                into_open += in;
+                continue;
+            }
+            const double area = cell_area(s, c), q = s->q ? s->q[c] : 0.0;
+            const double source = (s->h[c] - h0[c]) * area - in, want = q * time * area;
+            const double scale = (fabs(h0[c]) + fabs(s->h[c])) * area + gross + fabs(want);
+            const double tol = rel * scale + DBL_MIN;
+            applied += source;
+            scale_all += scale;
+            if (s->bed && q < 0.0)
+                REQUIRE(source >= want - tol && source <= tol,
+                        "[%s] cell %lld on its bed lost %.17g to erosion that asked %.17g", s->name, (long long)c,
+                        source, want);
+            else {
+                note(&w->fluxes, w->fluxes_where, fabs(source - want) / (scale + DBL_MIN), s->name);
+                REQUIRE(fabs(source - want) <= tol,
+                        "[%s] cell %lld changed by %.17g, its faces brought %.17g, its source %.17g (off by %.3g of %.3g)",
+                        s->name, (long long)c, (s->h[c] - h0[c]) * area, in, want, source - want, scale);
+            }
+        }
+    REQUIRE(fabs(applied - (after.sourced - before->sourced)) <= rel * scale_all + DBL_MIN,
+            "[%s] the cells took %.17g from their sources, SOURCED grew by %.17g", s->name, applied,
+            after.sourced - before->sourced);
+    double sides = 0.0;
+    for (int side = 0; side < 4; ++side) {
+        double out = 0.0, gross = 0.0;
+        for (int64_t k = 0; k < (side <= DPSM_XMAX || nfy ? faces_along(s, side) : 0); ++k) {
+            const double v = side == DPSM_XMIN   ? -fx[(s->nx + 1) * k]
+                             : side == DPSM_XMAX ? fx[s->nx + (s->nx + 1) * k]
+                             : side == DPSM_YMIN ? -fy[k]
+                                                 : fy[k + s->nx * s->ny];
+            out += v;
+            gross += fabs(v);
+        }
+        const double booked = after.side[side] - before->side[side];
+        REQUIRE(s->open[side] || (gross == 0.0 && booked == 0.0), "[%s] wall side %d: faces %g, account %g", s->name,
+                side, gross, booked);
+        REQUIRE(fabs(out - booked) <= rel * (gross + fabs(before->side[side]) + fabs(after.side[side])) + DBL_MIN,
+                "[%s] side %d: its faces carried %.17g out, its account took %.17g", s->name, side, out, booked);
+        sides += booked;
+        scale_all += gross + fabs(before->side[side]) + fabs(after.side[side]);
+    }
+    REQUIRE(fabs(after.outflow - before->outflow - sides - into_open) <= rel * scale_all + DBL_MIN,
+            "[%s] OUTFLOW grew by %.17g; the sides took %.17g, the open cells %.17g", s->name,
+            after.outflow - before->outflow, sides, into_open);
+    free(fx);
+    free(fy);
+}
+
 int scene_step(scene_t *s, double dt, stress_worst_t *w) {
     /* The bounds of the maximum principle, from the state before the step. */
-    double hi = -INFINITY, lo = INFINITY;
+    held_range_t range = {0, 0.0, INFINITY, -INFINITY};
     for (int64_t c = 0; c < s->n; ++c)
-        if (s->kinds[c] != DPSM_CELL_WALL) {
-            hi = fmax(hi, s->h[c]);
-            lo = fmin(lo, s->h[c]);
-        }
-    if (any_side_open(s)) {
-        hi = fmax(hi, 0.0);
-        lo = fmin(lo, 0.0);
-    }
+        if (s->kinds[c] != DPSM_CELL_WALL) widen(s->h[c], &range);
+    for_held_levels(s, widen, &range);
+    const double hi = range.hi, lo = range.lo;
+    double *h0 = s->record ? copy_of(s->h, s->n) : NULL;
+    const accounts_t before = s->record ? accounts_of(s) : (accounts_t){0.0, 0.0, {0.0, 0.0, 0.0, 0.0}};
     const int st = dpsm_step(s->g, dt);
     REQUIRE(st == DPSM_OK, "[%s] dpsm_step(%g) returned %s: %s", s->name, dt, dpsm_status_string(st),
             dpsm_last_error(s->g));
     check_state(s, w, 1, hi, lo);
+    if (s->record) check_fluxes(s, h0, &before, w);
+    free(h0);
     double at_rest = 0.0;
     OK(s, dpsm_get_step_info(s->g, DPSM_INFO_AT_REST, &at_rest));
     /* A driven scene may stand still while sand runs through it (2D reports

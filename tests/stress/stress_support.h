@@ -7,13 +7,20 @@
  *    most 1e-12 of the largest figure or gross mass (scene_ledger_residual);
  *  - without a source, no new extremum: a step's highest sand cell is no
  *    higher, and its lowest no lower, than the highest and lowest of the sand
- *    cells, the held levels of open cells and 0 when a side is open before it;
+ *    cells, the held levels of open cells and the levels beyond open sides
+ *    (0 unless set) before it;
  *  - wall and open cells keep their heights;
  *  - no sand cell below the bed, when there is one;
  *  - when the step reports the surface at rest and nothing drives it (no
  *    source, every held level the same), no face is steeper than
  *    tan(theta) * (1 + tol) along an axis (sand-sand and sand-open faces, and
- *    an edge cell against the 0 beyond an open side).
+ *    an edge cell against the level beyond an open side);
+ *  - on every second scene, which records its face fluxes: each sand cell's
+ *    faces bring its change of height times its area less what its source
+ *    added (with a bed: erosion takes at most what it asked), walls' faces
+ *    carry nothing, each side's faces what its account took, and the sides
+ *    and the open cells make up the outflow, to the round-off of the step's
+ *    sub-steps.
  *
  * Each check records its worst figure (stress_worst) so that the tests can
  * print them. */
@@ -44,6 +51,9 @@ typedef struct {
     double *bed;       /* no sand cell below it, ever */
     double *tan_field; /* tan of each cell's angle of repose */
     double tan_static; /* hysteresis */
+    double *q;         /* the source as set; NULL: none */
+    double *levels[4]; /* beyond each side, as set; NULL: 0 */
+    int record;        /* face fluxes recorded and checked (every second scene) */
 } scene_t;
 
 /* The worst figures seen so far (over every scene of the process). */
@@ -54,10 +64,11 @@ typedef struct {
     double new_max_isotropic; /* the same for the isotropic scheme (2D) */
     double new_min_isotropic;
     double rest_slope; /* face slope at rest over tan(theta) * (1 + tol), minus 1 */
+    double fluxes;     /* a sand cell's change against its faces and source, relative to its figures */
     long nonfinite;    /* heights found NaN or infinite */
     long checks;       /* states checked */
     long rest_checks;  /* states at rest checked */
-    char ledger_where[160], max_where[160], min_where[160], iso_where[160], rest_where[160];
+    char ledger_where[160], max_where[160], min_where[160], iso_where[160], rest_where[160], fluxes_where[160];
 } stress_worst_t;
 extern stress_worst_t stress_worst;
 void stress_worst_reset(stress_worst_t *w);
@@ -95,6 +106,9 @@ void scene_set_bed(scene_t *s, const double *zb);
 void scene_set_angle_field(scene_t *s, const double *theta);
 void scene_set_static_angle(scene_t *s, double theta);
 void scene_set_flux_exponent(scene_t *s, double p);
+/* The levels beyond `side`, one per face (ny for the x sides, nx for the y
+ * sides, one on 1D and axisymmetric grids); NULL: back to 0. */
+void scene_set_side_levels(scene_t *s, int side, const double *levels);
 
 /* Steps dt (must succeed) and checks every invariant against w. Returns 1 if
  * the step reported the surface at rest. */
@@ -103,7 +117,7 @@ int scene_step(scene_t *s, double dt, stress_worst_t *w);
  * the test if it does not get there. */
 void scene_run_to_rest(scene_t *s, double dt, int max_calls, stress_worst_t *w);
 /* Whether the scene may flow forever: a source acts, or held levels differ
- * (open cells, and 0 beyond an open side, when there are open cells). */
+ * (open cells, and the levels beyond open sides). */
 int scene_driven(const scene_t *s);
 /* Checks every invariant of the current state (no step: max principle not
  * applied). */

@@ -12,9 +12,12 @@
  *   walls, obstacles, open cells and sources mixed;
  *   requests no method can finish in bounded work (DPSM_ERR_WORK_LIMIT, the
  *   grid unchanged);
+ *   levels beyond the sides from 1e-3 to 1e6, above and below the sand,
+ *   varying face by face, a bed set before the sand;
  *   100 000 small steps.
  *
- * Each test prints its worst figures; the last prints the worst over all.
+ * Every second scene records its face fluxes and checks them after every
+ * step. Each test prints its worst figures; the last prints the worst over all.
  * DPSM_STRESS_SCALE (environment, default from the build: 1, smaller under
  * sanitizers) scales the grid sizes and step counts. */
 #include <float.h>
@@ -378,6 +381,63 @@ static void test_rough_terrains(void **state) {
     finish_test("rough terrains", &w);
 }
 
+/* Levels beyond the sides, face by face at random within +-amp of a base
+ * (amp from 1e-3 to 1e6, the base above or below the sand), on open sides and
+ * on a wall side; a bed set before the sand on some scenes. Driven by the
+ * levels that differ: bounded steps; then, where amp is small enough for sand
+ * to get there in a few million sub-steps (the flux of a face is at most nu),
+ * every level at the same base and no open cell: it must come to rest. */
+static void test_side_levels(void **state) {
+    (void)state;
+    stress_worst_t w;
+    stress_worst_reset(&w);
+    const int64_t n1 = scaled(80, 10), n2 = scaled(40, 8);
+    const double amps[] = {1e-3, 1.0, 30.0, 1e6};
+    for (int f = 0; f < NFLAVOURS; ++f)
+        for (int a = 0; a < 4; ++a)
+            for (int below = 0; below < 2; ++below) {
+                const flavour_t *fl = &kFlavours[f];
+                const int64_t nx = fl->geom == GEOM_2D ? n2 : n1, ny = fl->geom == GEOM_2D ? n2 + 7 : 1;
+                const double amp = amps[a], base = below ? -3.0 * amp : 2.0 * amp;
+                scene_t s;
+                make_scene(&s, fl, nx, ny, 0.5, "side levels +-%g around %g%s", amp, base,
+                           a == 2 ? ", a bed set first" : "");
+                uint64_t r = 777u + (uint64_t)(a + 10 * below + 100 * f);
+                double *h = terrain(&s, 0.0, amp, 2.0 * amp, r);
+                if (a == 2) { /* the bed first, on the fresh grid: it lifts the surface */
+                    double *zb = malloc(sizeof(double) * (size_t)s.n);
+                    REQUIRE(zb != NULL, "out of memory");
+                    for (int64_t c = 0; c < s.n; ++c) {
+                        zb[c] = h[c] - amp * rng_uniform(&r);
+                        h[c] = fmax(h[c], zb[c]);
+                    }
+                    scene_set_bed(&s, zb);
+                    free(zb);
+                }
+                scene_set_heights(&s, h);
+                const int64_t longest = nx > ny ? nx : ny;
+                double *levels = malloc(sizeof(double) * (size_t)longest);
+                REQUIRE(levels != NULL, "out of memory");
+                for (int side = DPSM_XMIN; side <= (fl->geom == GEOM_2D ? DPSM_YMAX : DPSM_XMAX); ++side) {
+                    if (fl->geom == GEOM_AXI && side == DPSM_XMIN) continue;
+                    for (int64_t k = 0; k < longest; ++k) levels[k] = base + amp * (2.0 * rng_uniform(&r) - 1.0);
+                    scene_set_side_levels(&s, side, levels);
+                    scene_set_side(&s, side, side != DPSM_XMAX || fl->geom == GEOM_AXI); /* XMAX a wall off disks */
+                }
+                const double dt = stable(&s);
+                for (int k = 0; k < 15; ++k) scene_step(&s, dt * (k % 3 == 0 ? 1.0 : k % 3 == 1 ? 7.0 : 50.0), &w);
+                for (int64_t k = 0; k < longest; ++k) levels[k] = base;
+                for (int side = DPSM_XMIN; side <= (fl->geom == GEOM_2D ? DPSM_YMAX : DPSM_XMAX); ++side)
+                    if (!(fl->geom == GEOM_AXI && side == DPSM_XMIN)) scene_set_side_levels(&s, side, levels);
+                if (amp <= 1.0 && (fl->geom != GEOM_2D || fl->scheme == DPSM_SCHEME_PAIRWISE))
+                    scene_run_to_rest(&s, 1e12, 2, &w);
+                free(levels);
+                free(h);
+                scene_destroy(&s);
+            }
+    finish_test("side levels", &w);
+}
+
 /* 1x1, 1xN, Nx1, 2xN, long thin grids, tile edges (64), each side open or
  * not, with a pile to collapse, then a few steps with a source. */
 static void test_grid_shapes(void **state) {
@@ -496,8 +556,12 @@ static void test_work_limit(void **state) {
                 double *h = terrain(&s, 1.0, 0.5, 2.0, 5u + k);
                 scene_set_heights(&s, h);
                 if (driver == 0) {
+                    /* A source raises the sand above the open side's level:
+                     * it makes a face steep (a source that cannot is applied
+                     * in closed form and is not limited). */
                     for (int64_t c = 0; c < s.n; ++c) h[c] = 1e-3;
                     scene_set_source(&s, h);
+                    scene_set_side(&s, DPSM_XMAX, 1);
                 } else {
                     uint8_t *kinds = calloc((size_t)s.n, 1);
                     if (driver == 1 && s.n >= 2) {
@@ -575,6 +639,7 @@ int main(int argc, char **argv) {
         cmocka_unit_test(test_repose_angles),  cmocka_unit_test(test_rough_terrains),
         cmocka_unit_test(test_grid_shapes),    cmocka_unit_test(test_masks_and_sources),
         cmocka_unit_test(test_physics_extremes), cmocka_unit_test(test_work_limit),     cmocka_unit_test(test_many_small_steps),
+        cmocka_unit_test(test_side_levels),
         cmocka_unit_test(test_summary),
     };
     return cmocka_run_group_tests_name("stress", tests, NULL, NULL);

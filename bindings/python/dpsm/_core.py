@@ -286,8 +286,8 @@ class Grid:
         self._call(f, _c_int(scheme, "scheme", f, C.DPSM_ERR_UNKNOWN_ENUM))
 
     def set_relaxation(self, relaxation):
-        """``dpsm_set_relaxation``: ``RELAX_AUTO`` (the default: ``RELAX_TO_REST`` where the scene allows it,
-        else ``RELAX_TIME_ACCURATE``), ``RELAX_TO_REST`` (each ``step`` brings the surface to rest in few flux
+        """``dpsm_set_relaxation``: ``RELAX_AUTO`` (the default: sub-steps over ``dt``, as
+        ``RELAX_TIME_ACCURATE``), ``RELAX_TO_REST`` (each ``step`` brings the surface to rest in few flux
         evaluations, without a time scale) or ``RELAX_TIME_ACCURATE`` (sub-steps over ``dt``)."""
         f = "dpsm_set_relaxation"
         self._call(f, _c_int(relaxation, "relaxation", f, C.DPSM_ERR_UNKNOWN_ENUM))
@@ -296,6 +296,28 @@ class Grid:
         """``dpsm_set_boundary``: side ``XMIN``, ``XMAX``, ``YMIN`` or ``YMAX``; kind ``OPEN`` or ``WALL``."""
         f = "dpsm_set_boundary"
         self._call(f, _c_int(side, "side", f, C.DPSM_ERR_UNKNOWN_ENUM), _c_int(kind, "kind", f, C.DPSM_ERR_UNKNOWN_ENUM))
+
+    def _faces_along(self, side):
+        """The faces along ``side``: ``ny`` for the x sides, ``nx`` for the y sides, 1 on 1D grids;
+        None for a side the library will refuse anyway."""
+        if self.kind != "2d":
+            return 1 if side in (C.DPSM_XMIN, C.DPSM_XMAX) else None
+        return {C.DPSM_XMIN: self.ny, C.DPSM_XMAX: self.ny, C.DPSM_YMIN: self.nx, C.DPSM_YMAX: self.nx}.get(side)
+
+    def set_side_levels(self, side, levels=None):
+        """``dpsm_set_side_levels``: the surface level beyond the open side ``side``, one value per
+        boundary face (``ny`` values for ``XMIN`` and ``XMAX``, ``nx`` for ``YMIN`` and ``YMAX``; one on
+        1D and axisymmetric grids); ``None`` returns the side to 0. Sand comes in from a higher level."""
+        f = "dpsm_set_side_levels"
+        side = _c_int(side, "side", f, C.DPSM_ERR_UNKNOWN_ENUM)
+        faces = self._faces_along(side)
+        if levels is None or faces is None:
+            # No levels, or a side the library refuses before it reads any.
+            self._call(f, side, None if levels is None else (ctypes.c_double * 1)())
+            return
+        pointer, keep = self._doubles_in(levels, (faces,), "levels", f)
+        self._call(f, side, pointer)
+        del keep
 
     def set_rest_tolerance(self, tol):
         """``dpsm_set_rest_tolerance``: finite and positive."""
@@ -419,7 +441,7 @@ class Grid:
 
     def set_bedrock(self, zb=None):
         """``dpsm_set_bedrock``: a bed the sand cannot erode, an array of
-        ``shape`` at or below the heights; ``None`` removes it."""
+        ``shape`` (a cell below it is lifted to it); ``None`` removes it."""
         self._set_field("dpsm_set_bedrock", zb, "zb")
 
     def set_repose_angle_field(self, theta_radians=None):
@@ -499,6 +521,37 @@ class Grid:
         value = ctypes.c_double()
         self._call(f, _c_int(item, "item", f, C.DPSM_ERR_UNKNOWN_ENUM), ctypes.byref(value))
         return value.value
+
+    def get_side_outflow(self, side):
+        """``dpsm_get_side_outflow``: the net mass that has left through ``side`` since the grid was made
+        (negative where more came in)."""
+        f = "dpsm_get_side_outflow"
+        value = ctypes.c_double()
+        self._call(f, _c_int(side, "side", f, C.DPSM_ERR_UNKNOWN_ENUM), ctypes.byref(value))
+        return value.value
+
+    def set_face_flux_recording(self, on):
+        """``dpsm_set_face_flux_recording``: 1 (or True) to keep the volume each face carries in every
+        step, 0 (or False) to stop."""
+        f = "dpsm_set_face_flux_recording"
+        self._call(f, _c_int(on, "on", f, C.DPSM_ERR_INVALID_VALUE))
+
+    def get_face_fluxes(self, out_x=None, out_y=None):
+        """``dpsm_get_face_fluxes``: ``(fx, fy)``, the volume each face carried in the last step,
+        positive towards increasing x (y). In 2D ``fx`` has shape ``(ny, nx+1)`` (``fx[j, i]`` is the
+        face on the low side of cell ``(i, j)``) and ``fy`` shape ``(ny+1, nx)``; on 1D and
+        axisymmetric grids ``fx`` has ``nx+1`` values and ``fy`` is None. ``out_x`` and ``out_y``
+        are filled and returned instead, as ``out`` of ``get_heights``."""
+        f = "dpsm_get_face_fluxes"
+        two_d = self.kind == "2d"
+        x_shape = (self.ny, self.nx + 1) if two_d else (self.nx + 1,)
+        x_pointer, x_result, x_finish = self._doubles_out(x_shape, out_x, "fx", f)
+        if two_d:
+            y_pointer, y_result, y_finish = self._doubles_out((self.ny + 1, self.nx), out_y, "fy", f)
+        else:  # an out_y here is refused by the library, before it writes anything
+            y_pointer, y_result, y_finish = (None if out_y is None else (ctypes.c_double * 1)()), None, None
+        self._call(f, x_pointer, y_pointer)
+        return (x_finish() if x_finish else x_result), (y_finish() if y_finish else y_result)
 
     def get_shape(self):
         """``dpsm_get_shape``: ``(nx, ny)``, as C gives them (``ny`` is 1 on 1D grids)."""
