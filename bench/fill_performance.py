@@ -49,8 +49,8 @@ def speed_table(data):
         rs = ref.get(r["tolerance"])
         met = "yes" if s <= 0.02 and abs(err) <= 0.5 else f"no: {s / 0.02:.1f} x too slow" if abs(err) <= 0.5 else "no"
         fast = r["method"] == "dpsm-to-rest"
-        how = "relaxed to rest (the default here, as DPSM_RELAX_TO_REST)" if fast else \
-            "to rest by time-accurate sub-steps (DPSM_RELAX_TIME_ACCURATE)"
+        how = "relaxed to rest (DPSM_RELAX_TO_REST)" if fast else \
+            "to rest by time-accurate sub-steps (the default)"
         work = "flux evaluations" if fast else "sub-steps"
         out.append(f"| cone 101^2 {how} at 33 deg, tolerance {r['tolerance']}: seconds, top ({float(r['top']):.3f}, "
                    f"exact 22.89) | {s:.3f} s, {err:+.2f} % ({r['substeps']} {work}) | "
@@ -59,15 +59,32 @@ def speed_table(data):
         dep = rows(data, "deposits")
         for rounds in sorted({r.get("rounds", "1") for r in dep}, key=int):
             by = {r["method"]: r for r in dep if r.get("rounds", "1") == rounds}
-            timed, auto = by.get("dpsm-time-accurate"), by.get("dpsm-auto")
-            if not (timed and auto):
+            timed, relaxed = by.get("dpsm-default"), by.get("dpsm-to-rest")
+            if not (timed and relaxed):
                 continue
-            what = (f"{auto['deposits']} heaps of 10^2 cells dropped one by one on {auto['n']}^2"
+            what = (f"{timed['deposits']} heaps of 10^2 cells dropped one by one on {timed['n']}^2"
                     if rounds == "1" else
-                    f"{int(auto['deposits']) * int(rounds)} such heaps on {auto['deposits']} growing piles")
-            out.append(f"| {what}, each stepped to rest: seconds by the default (relaxed to rest) / "
-                       f"time-accurate | {float(auto['seconds']):.3f} s ({auto['substeps']} flux evaluations and sub-steps) / "
-                       f"{float(timed['seconds']):.3f} s ({timed['substeps']} sub-steps) | | | | |")
+                    f"{int(timed['deposits']) * int(rounds)} such heaps on {timed['deposits']} growing piles")
+            out.append(f"| {what}, each stepped to rest: seconds by the default (time-accurate) / relaxed to rest | "
+                       f"{float(timed['seconds']):.3f} s ({timed['substeps']} sub-steps) / "
+                       f"{float(relaxed['seconds']):.3f} s ({relaxed['substeps']} flux evaluations) | | | | |")
+    if os.path.exists(os.path.join(data, "speed_wind.csv")):
+        w = rows(data, "wind")[0]
+        ratio, with_source = float(w["ratio"]), float(w["ratio_with_source"])
+        out.append(f"| wind {w['n']}^2: a dune field, a source on every cell, {100 * float(w['slip_face_fraction']):.1f} % "
+                   f"of cells on slip faces; a call of {w['substeps']} sub-steps against as many fully active ones "
+                   f"({100 * float(w['cells_visited_fraction']):.1f} % of cells visited per sub-step; with "
+                   f"dpsm_set_source before it) | {100 * ratio:.1f} % ({100 * with_source:.1f} %) | "
+                   f"{100 * float(w['ratio_to_reference']):.2f} % of the reference's sub-steps | | 5 % | "
+                   f"{'yes' if ratio <= 0.05 else 'no'} |")
+    if os.path.exists(os.path.join(data, "speed_short.csv")):
+        for r in rows(data, "short"):
+            short, auto = float(r["short_over_long"]), float(r["default_over_time_accurate"])
+            out.append(f"| short calls {r['n']}^2, {r['threads']} thread(s): Mcells/s of calls of one sub-step / of a "
+                       f"call of 58 (time-accurate / default) | {float(r['short_mcells_per_s']):.0f} / "
+                       f"{float(r['long_mcells_per_s']):.0f} / {float(r['default_long_mcells_per_s']):.0f} "
+                       f"(short {short:.2f} x, default {auto:.2f} x) | {float(r['reference_mcells_per_s']):.1f} | | "
+                       f"1.2 x, 1.25 x | {'yes' if short <= 1.2 else 'no'}, {'yes' if auto <= 1.25 else 'no'} |")
     return out
 
 

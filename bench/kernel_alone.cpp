@@ -5,16 +5,21 @@
 // thread. It links the static library and calls its internal kernel
 // selection (src/tile_kernel.hpp), so it times the very code a sweep runs.
 //
-//   dpsm-bench-kernel [visits [rounds]]     (defaults 20000, 7: the best round)
+//   dpsm-bench-kernel [visits [rounds [variant]]]   (defaults 20000, 7: the best round; every variant)
 //
 // CSV: lanes,variant,mcells_per_s,ns_per_cell,checksum. Cells are the tile's
 // (4 x 64 x 64 per visit); the halo the sub-steps also compute is the
 // kernel's own overhead and counts against it. The checksum (sum of the
 // heights after the last round) shows that two builds computed the same.
+// The variants with physics (a bed 100 below, a uniform angle field, flux
+// exponents, a static angle below the plane's slopes) flow as the plain one
+// does: their cost is the physics' alone.
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 
 #include "active_set.hpp"
 #include "tile_kernel.hpp"
@@ -24,7 +29,15 @@ namespace {
 constexpr int kLevels = dpsm::ActiveSet::kMaxLevels, kTile = dpsm::ActiveSet::kTile;
 constexpr int kSide = kTile + 2 * (kLevels + 1);
 
-double run(dpsm::TileKernel kernel, int visits, int rounds, double *checksum) {
+struct Variant {
+    const char *name;
+    bool masked, isotropic, source;
+    bool bed = false, angle_field = false;
+    double flux_exponent = 1.0, static_angle_degrees = 0.0;
+    bool physics() const { return bed || angle_field || flux_exponent != 1.0 || static_angle_degrees > 0.0; }
+};
+
+double run(const Variant &v, int visits, int rounds, double *checksum) {
     dpsm::TileBuffers b;
     b.resize(kSide, kSide);
     // The steep rippled plane of dpsm-bench throughput: every face flows.
@@ -35,6 +48,19 @@ double run(dpsm::TileKernel kernel, int visits, int rounds, double *checksum) {
     dpsm::TileLevelParams p{1.0, std::tan(theta), 1.0, 1.0, 1.0, 1.0, 0.5, 0.5, 1.0 / (4.0 * std::cos(theta)), 1.0, 1.0};
     p.rest_factor = 1.0 + 1e-6;
     p.track_excess = false;
+    if (v.physics()) {
+        b.resize_physics();
+        std::fill(b.bed.begin(), b.bed.end(), -100.0);
+        std::fill(b.tan_theta.begin(), b.tan_theta.end(), std::tan(theta));
+        p.bed = v.bed;
+        p.bed_film = 1e-6 * std::tan(theta);
+        p.angle_field = v.angle_field;
+        p.flux_exponent = v.flux_exponent;
+        p.hysteresis = v.static_angle_degrees > 0.0;
+        p.tan_static = std::tan(v.static_angle_degrees * 3.14159265358979323846 / 180.0);
+    }
+    const dpsm::TileKernel kernel =
+        dpsm::select_tile_kernel(v.masked, v.isotropic, v.source, false, false, dpsm::physics_kind(p, v.physics()));
     const dpsm::TileRect tile{kLevels + 1, kSide - kLevels - 1, kLevels + 1, kSide - kLevels - 1};
     double best = INFINITY;
     for (int round = 0; round < rounds; ++round) {
@@ -62,21 +88,27 @@ int main(int argc, char **argv) {
     const int visits = argc > 1 ? std::atoi(argv[1]) : 20000;
     const int rounds = argc > 2 ? std::atoi(argv[2]) : 7;
     if (visits < 1 || rounds < 1) {
-        std::fprintf(stderr, "usage: dpsm-bench-kernel [visits [rounds]] (both at least 1)\n");
+        std::fprintf(stderr, "usage: dpsm-bench-kernel [visits [rounds [variant]]] (both at least 1)\n");
         return 2;
     }
     std::printf("lanes,variant,mcells_per_s,ns_per_cell,checksum\n");
     const double cells = 4.0 * kTile * kTile * visits;
-    struct Variant {
-        const char *name;
-        bool masked, isotropic, source;
-    } variants[] = {{"isotropic", false, true, false},
-                    {"isotropic-masked", true, true, false},
-                    {"isotropic-source", false, true, true},
-                    {"pairwise", false, false, false}};
+    const Variant variants[] = {{"isotropic", false, true, false},
+                                {"isotropic-masked", true, true, false},
+                                {"isotropic-source", false, true, true},
+                                {"pairwise", false, false, false},
+                                {"isotropic-bed", false, true, false, true},
+                                {"isotropic-masked-bed", true, true, false, true},
+                                {"pairwise-bed", false, false, false, true},
+                                {"isotropic-angle-field", false, true, false, false, true},
+                                {"isotropic-exponent-1.5", false, true, false, false, false, 1.5},
+                                {"isotropic-exponent-2", false, true, false, false, false, 2.0},
+                                {"isotropic-static-angle", false, true, false, false, false, 1.0, 35.0}};
+    const char *only = argc > 3 ? argv[3] : nullptr;
     for (const Variant &v : variants) {
+        if (only && std::strcmp(only, v.name) != 0) continue;
         double checksum = 0.0;
-        const double seconds = run(dpsm::select_tile_kernel(v.masked, v.isotropic, v.source), visits, rounds, &checksum);
+        const double seconds = run(v, visits, rounds, &checksum);
         std::printf("%d,%s,%.1f,%.3f,%.15e\n", dpsm::tile_kernel_lanes(), v.name, cells / seconds / 1e6,
                     seconds / cells * 1e9, checksum);
         std::fflush(stdout);

@@ -52,17 +52,20 @@ static double flux(const reference_grid *r, double normal, double transverse, do
     return r->nu * (g - r->tan_theta) / sqrt(1.0 + g * g) * normal / g;
 }
 
+double reference_flux_x(const reference_grid *r, int64_t i, int64_t j, double *excess) {
+    return flux(r, (AT(r, r->h, i - 1, j) - AT(r, r->h, i, j)) / r->dx,
+                0.5 * (slope_y(r, i - 1, j) + slope_y(r, i, j)), excess);
+}
+
+double reference_flux_y(const reference_grid *r, int64_t i, int64_t j, double *excess) {
+    return flux(r, (AT(r, r->h, i, j - 1) - AT(r, r->h, i, j)) / r->dy,
+                0.5 * (slope_x(r, i, j - 1) + slope_x(r, i, j)), excess);
+}
+
 /* dh/dt of cell (i, j): the fluxes of its four faces. */
 static double cell_rate(const reference_grid *r, int64_t i, int64_t j, double *excess) {
-    const double hc = AT(r, r->h, i, j);
-    const double west = flux(r, (AT(r, r->h, i - 1, j) - hc) / r->dx, 0.5 * (slope_y(r, i - 1, j) + slope_y(r, i, j)),
-                             excess);
-    const double east = flux(r, (hc - AT(r, r->h, i + 1, j)) / r->dx, 0.5 * (slope_y(r, i, j) + slope_y(r, i + 1, j)),
-                             excess);
-    const double south = flux(r, (AT(r, r->h, i, j - 1) - hc) / r->dy, 0.5 * (slope_x(r, i, j - 1) + slope_x(r, i, j)),
-                              excess);
-    const double north = flux(r, (hc - AT(r, r->h, i, j + 1)) / r->dy, 0.5 * (slope_x(r, i, j) + slope_x(r, i, j + 1)),
-                              excess);
+    const double west = reference_flux_x(r, i, j, excess), east = reference_flux_x(r, i + 1, j, excess);
+    const double south = reference_flux_y(r, i, j, excess), north = reference_flux_y(r, i, j + 1, excess);
     return (west - east) / r->dx + (south - north) / r->dy;
 }
 

@@ -25,5 +25,11 @@ void reference_set_height(reference_grid *r, int64_t i, int64_t j, double h);
 /* dh/dt of every cell (nx*ny, x fastest) at the present heights; returns the
  * largest slope excess over faces that carried sand. */
 double reference_rates(const reference_grid *r, double *rate);
+/* The flux (per unit face length, nu included) across the face between cells
+ * (i - 1, j) and (i, j), i in [0, nx], positive towards +x; and across the
+ * face between (i, j - 1) and (i, j), j in [0, ny], positive towards +y.
+ * Raises *excess to the face's slope excess over tan(theta) if it carries sand. */
+double reference_flux_x(const reference_grid *r, int64_t i, int64_t j, double *excess);
+double reference_flux_y(const reference_grid *r, int64_t i, int64_t j, double *excess);
 
 #endif

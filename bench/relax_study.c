@@ -37,6 +37,7 @@
 
 #include "bench_util.h"
 #include "reference.h"
+#include "relax_study.h"
 
 static const double kPi = 3.14159265358979323846;
 
@@ -49,7 +50,7 @@ typedef struct {
     int momentum_only; /* run only the explicit scheme and the methods with momentum (whose path differs) */
 } scene;
 
-static void fill_cone(double *h, int64_t n, double dx) {
+void fill_cone(double *h, int64_t n, double dx) {
     (void)dx;
     for (int64_t j = 0; j < n; ++j)
         for (int64_t i = 0; i < n; ++i) h[i + n * j] = fmax(0.0, 40.0 - 1.5 * hypot((double)(i - n / 2), (double)(j - n / 2)));
@@ -83,7 +84,7 @@ static void fill_cones(double *h, int64_t n, double dx) {
     }
 }
 
-static double top_of(const double *h, int64_t cells) {
+double top_of(const double *h, int64_t cells) {
     double t = 0.0;
     for (int64_t c = 0; c < cells; ++c) t = fmax(t, h[c]);
     return t;
@@ -141,15 +142,7 @@ static int64_t relax(double *h, int64_t n, double dx, double theta, double toler
     return sweeps;
 }
 
-/* The coefficients of a second-order Runge-Kutta-Chebyshev step of s stages
- * (Sommeijer, Shampine and Verwer 1997; damping 2/13), s <= 63. */
-typedef struct {
-    int s;
-    double w0, w1, beta; /* beta: the step's stable length in units of 1 / lambda_max */
-    double T[64], b[64];
-} rkc_coefficients;
-
-static void rkc_setup(rkc_coefficients *k, int s) {
+void rkc_setup(rkc_coefficients *k, int s) {
     double dT[64], ddT[64];
     k->s = s;
     k->w0 = 1.0 + (2.0 / 13.0) / ((double)s * s);
@@ -742,7 +735,7 @@ static void cascade_to_rest(double *h, int64_t n, double dx, double theta, doubl
  * tan(theta) with the volume of the cone 40 high of slope 1.5) and the
  * column's (a truncated cone of height 0.5 whose foot lies at
  * r_f = (a + sqrt(4 alpha^2 - a^2 / 3)) / (2 alpha), a = 0.5, radius 1). */
-static double exact_cone(double r, double theta) {
+double exact_cone(double r, double theta) {
     const double alpha = tan(theta), foot = (40.0 / 1.5) * cbrt(1.5 / alpha);
     return fmax(0.0, alpha * (foot - r));
 }

@@ -1,10 +1,11 @@
 #!/usr/bin/env bash
 # Regenerates the figures behind docs/performance.md: builds dpsm-bench, runs
-# the speed benchmarks (throughput, sparse, idle, cone, steps, and the tile
-# kernel alone) into docs/data/speed_*.csv and plots the throughput into
-# docs/figures/.
+# the speed benchmarks (throughput, sparse, idle, cone, deposits, wind,
+# short calls, the modes on the column collapse, the physics of real scenes,
+# steps, and the tile kernel alone) into docs/data/speed_*.csv and plots the
+# throughput into docs/figures/.
 #
-#   bash bench/run_speed.sh        # about 3 minutes on 2 cores (the steps study takes 1-2), on a quiet machine
+#   bash bench/run_speed.sh        # about 6 minutes on 2 cores (the steps study takes 1-2), on a quiet machine
 #
 # BUILD_DIR (default build-bench) is the build tree; PYTHON (default
 # /usr/bin/python3) runs the plot, which needs python3-matplotlib.
@@ -31,7 +32,7 @@ mkdir -p "$data" "$figures"
   echo "compiler: $(${CXX:-c++} --version 2>/dev/null | head -1)"
 } > "$data/speed_provenance.txt"
 
-for what in throughput sparse idle cone deposits steps; do
+for what in throughput sparse idle cone deposits wind short modes physics steps; do
   echo ">> dpsm-bench $what"
   "$bench" "$what" > "$data/speed_$what.csv" 2> "$data/speed_$what.log"
   cat "$data/speed_$what.csv"
