@@ -3,7 +3,7 @@
 // a fully active interior tile: four sub-steps of a 64 x 64 tile with its
 // halo in the buffer, the region shrinking by a cell per sub-step, one
 // thread. It links the static library and calls its internal kernel
-// selection (src/tile_kernel.hpp), so it times the very code a sweep runs.
+// selection (src/structured/tile_kernel.hpp), so it times the very code a sweep runs.
 //
 //   dpsm-bench-kernel [visits [rounds [variant]]]   (defaults 20000, 7: the best round; every variant)
 //
@@ -21,8 +21,8 @@
 #include <cstdlib>
 #include <cstring>
 
-#include "active_set.hpp"
-#include "tile_kernel.hpp"
+#include "structured/active_set.hpp"
+#include "structured/tile_kernel.hpp"
 
 namespace {
 

@@ -1,5 +1,5 @@
 /* The physics of real scenes on the vectorised tile kernels against the
- * scalar reference kernel (src/tile_kernel_physics.cpp, the specification),
+ * scalar reference kernel (src/structured/tile_kernel_physics.cpp, the specification),
  * which DPSM_SCALAR_PHYSICS=1 chooses; the library reads it at every sweep,
  * so one process steps the same scene both ways. Each feature alone and in
  * combinations, on scenes with walls, open cells, open sides, deposition and
@@ -111,7 +111,7 @@ static double relative_difference(double a, double b) { return fabs(a - b) / fma
  * ledger's figures, after some hundreds of sub-steps). The kernels differ in
  * the last bits of a face's flux (the order of operations, the exponent's
  * power in lanes): 4e-16 seen. The AVX-512 kernels also take 1/sqrt(1 +
- * |grad h|^2) from a hardware estimate refined to 6e-9 (src/simd.hpp), which
+ * |grad h|^2) from a hardware estimate refined to 6e-9 (src/structured/simd.hpp), which
  * a steep face's flux carries: 1.2e-9 seen. The library runs them where the
  * CPU has AVX-512 (F, BW, VL, DQ) unless DPSM_NO_AVX512=1. A face on its
  * threshold would tell the kernels apart by a dead-zone decision; none of

@@ -1,4 +1,4 @@
-/* Sources in closed form (tiled_sweep.hpp, "Lazy sources"): a source that
+/* Sources in closed form (src/structured/tiled_sweep.hpp, "Lazy sources"): a source that
  * cannot make a face steep within a step is applied as h + q dt, which must
  * give the heights that sub-stepping gives. Sub-stepping is what a host gets
  * by calling dpsm_step once per stable sub-step: each call is then a single

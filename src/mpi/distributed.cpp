@@ -1,6 +1,6 @@
 // The MPI component: a 2D grid as one rank's block of a grid distributed over
 // a communicator (include/dpsm/dpsm_mpi.h). The core runs the block as it runs
-// any grid; this file is its Decomposition (decomposition.hpp):
+// any grid; this file is its Decomposition (mpi/decomposition.hpp):
 //
 //  - the halo: every cell within kHaloDepth (the most a sweep reads beyond a
 //    tile) of the block that another rank owns. Whoever owns it sends it: one
@@ -39,17 +39,17 @@
 #include <string>
 #include <vector>
 
-#include "active_set.hpp"
-#include "decomposition.hpp"
+#include "structured/active_set.hpp"
+#include "mpi/decomposition.hpp"
 #include "dpsm/dpsm.h"
 #include "dpsm/dpsm_mpi.h"
-#include "error.hpp"
-#include "limits.hpp"
-#include "grid.hpp"
-#include "handle.hpp"
-#include "ledger.hpp"
-#include "restart.hpp"
-#include "tiled_sweep.hpp"
+#include "model/error.hpp"
+#include "model/limits.hpp"
+#include "model/grid.hpp"
+#include "api/handle.hpp"
+#include "model/ledger.hpp"
+#include "io/restart.hpp"
+#include "structured/tiled_sweep.hpp"
 
 namespace dpsm {
 namespace {
@@ -197,7 +197,7 @@ public:
         if (v[8] != 0.0) assemble_side_levels(grid);
         StepAgreement state;
         state.source_active = v[0] != 0.0;
-        // Lazy sources (tiled_sweep.hpp): the halo carries each cell's clock.
+        // Lazy sources (structured/tiled_sweep.hpp): the halo carries each cell's clock.
         lazy_sources_ = state.source_active && !grid.uses_physics();
         state.has_open_cells = v[1] != 0.0;
         state.may_move = v[2] != 0.0;
@@ -286,17 +286,17 @@ public:
         active.set_remote_activity(remote_hot_, remote_sources_);
     }
 
-    void after_sweep(std::vector<LevelSummary> &levels) override {
+    void after_sweep(std::vector<SubstepSummary> &levels) override {
         std::vector<double> v;
-        for (const LevelSummary &level : levels) {
+        for (const SubstepSummary &level : levels) {
             v.push_back(level.moved ? 1.0 : 0.0);
-            v.push_back(level.max_excess);
+            v.push_back(level.max_excess_slope);
         }
         check_mpi(MPI_Allreduce(MPI_IN_PLACE, v.data(), static_cast<int>(v.size()), MPI_DOUBLE, MPI_MAX, comm_),
                   "MPI_Allreduce after a sweep");
         for (std::size_t s = 0; s < levels.size(); ++s) {
             levels[s].moved = v[2 * s] != 0.0;
-            levels[s].max_excess = v[2 * s + 1];
+            levels[s].max_excess_slope = v[2 * s + 1];
         }
     }
 

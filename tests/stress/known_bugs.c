@@ -62,7 +62,7 @@ static void within(unsigned seconds, void (*body)(void), const char *what) {
 /* 1. A face slope whose square overflows (|dh|/d above ~1.3e154) on a 2D grid:
  * the AVX-512 kernel (rsqrt of +inf refined by Newton steps) gives NaN
  * heights; the generic one (DPSM_NO_AVX512=1) computes a flux of 0 and reports
- * the surface at rest with a slope of 1e160. src/tile_kernel_impl.hpp,
+ * the surface at rest with a slope of 1e160. src/structured/tile_kernel_impl.hpp,
  * face_flux: u = gn*gn + gt*gt overflows. */
 static void test_2d_slope_square_overflows(void **state) {
     (void)state;
@@ -81,7 +81,7 @@ static void test_2d_slope_square_overflows(void **state) {
     dpsm_destroy(g);
 }
 
-/* 2. The same in 1D (src/closure.hpp, slide_flux: (s - tan) / sqrt(1 + s*s)
+/* 2. The same in 1D (src/model/flux_law.hpp, slide_flux: (s - tan) / sqrt(1 + s*s)
  * is 0 once s*s overflows): nothing moves, yet every sub-step counts as
  * motion, so the surface never rests. */
 static void test_1d_slope_square_overflows(void **state) {
@@ -132,7 +132,7 @@ static void test_1d_height_difference_overflows(void **state) {
 }
 
 /* 4. A spacing whose square underflows (dx = 1e-160): stable_dt is 0 and the
- * 2D step writes NaN (src/stepper.cpp, stable_dt; dt / 0 sub-steps). Either
+ * 2D step writes NaN (src/stepping/stepper.cpp, stable_dt; dt / 0 sub-steps). Either
  * dpsm_create_2d refuses such a spacing or the step stays finite. */
 static void test_2d_tiny_spacing(void **state) {
     (void)state;
@@ -165,7 +165,7 @@ static void test_1d_tiny_spacing_hangs(void **state) {
 }
 
 /* 6. A spacing whose cell area overflows (2D, dx = dy = 1e200): the ledger
- * reads NaN (0 * inf) as soon as heights are set (src/grid.cpp, cell_area). */
+ * reads NaN (0 * inf) as soon as heights are set (src/model/grid.cpp, cell_area). */
 static void test_2d_huge_spacing_mass(void **state) {
     (void)state;
     dpsm_grid *g = NULL;
@@ -183,7 +183,7 @@ static void test_2d_huge_spacing_mass(void **state) {
  * ramp steeper than the angle of repose: the step reports rest and the active
  * set goes cold, so every later step, of any dt, does nothing; the ramp stays
  * supercritical for good. 1D and axisymmetric grids move on. The 2D sweep
- * takes "no cell changed" for "no face carried sand" (src/tile_kernel_impl.hpp:
+ * takes "no cell changed" for "no face carried sand" (src/structured/tile_kernel_impl.hpp:
  * moved/hot from increment != 0). */
 static void test_2d_denormal_dt_freezes_the_surface(void **state) {
     (void)state;

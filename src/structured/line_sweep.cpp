@@ -1,13 +1,13 @@
-#include "kernels.hpp"
+#include "structured/line_sweep.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <limits>
 
-#include "closure.hpp"
-#include "ledger.hpp"
-#include "tiled_sweep.hpp"
+#include "model/flux_law.hpp"
+#include "model/ledger.hpp"
+#include "structured/tiled_sweep.hpp"
 
 namespace dpsm {
 
@@ -81,7 +81,7 @@ public:
         if (!moving_next_.empty()) grid_.moving_for_stepping().swap(moving_next_);
     }
 
-    SweepResult result;
+    SubstepSummary result;
 
 private:
     // Flux per unit length from a to b (negative when b is the higher); b < 0
@@ -208,7 +208,7 @@ void apply_source_1d(Grid &grid, double substeps, double dt) {
         if (kind[c] == kSand && q[c] != 0.0) add_with_residual(h[c], residual[c], source_lag(q[c], dt, substeps));
 }
 
-SweepResult slide_rates_1d(Grid &grid, double dt, bool record) {
+SubstepSummary slide_rates_1d(Grid &grid, double dt, bool record) {
     const Geometry &geo = grid.geometry();
     const std::int64_t nx = geo.nx;
     std::vector<double> &rate = grid.rate_workspace();

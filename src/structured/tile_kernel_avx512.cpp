@@ -1,6 +1,6 @@
 // The tile kernel for CPUs with AVX-512: built with -mavx512f and friends,
 // called only after select_tile_kernel has checked the CPU.
-#include "tile_kernel_impl.hpp"
+#include "structured/tile_kernel_impl.hpp"
 
 namespace dpsm {
 

@@ -2,7 +2,7 @@
 // when the surface is at rest, and books sources and outflow in the ledger.
 #pragma once
 
-#include "grid.hpp"
+#include "model/grid.hpp"
 
 namespace dpsm {
 
@@ -11,7 +11,7 @@ namespace dpsm {
 double stable_dt(const Grid &grid);
 
 // dpsm_step: relaxes to rest or advances in time, as the grid's relaxation
-// asks (grid.hpp).
+// asks (model/grid.hpp).
 void step(Grid &grid, double dt);
 
 // Advances exactly dt (or until rest) by time-accurate sub-steps; a dt of

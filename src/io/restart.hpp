@@ -1,12 +1,12 @@
 // Restart files (dpsm_save, dpsm_load): a grid's geometry and state in a
 // versioned, portable binary format with checksums. The layout is documented
 // in docs/guide_restart.md and written by one function, read by another, in
-// the same order (restart.cpp).
+// the same order (io/restart.cpp).
 #pragma once
 
 #include <cstdint>
 
-#include "grid.hpp"
+#include "model/grid.hpp"
 
 namespace dpsm {
 

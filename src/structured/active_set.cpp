@@ -1,9 +1,9 @@
-#include "active_set.hpp"
+#include "structured/active_set.hpp"
 
 #include <algorithm>
 #include <cstdlib>
 
-#include "grid.hpp"
+#include "model/grid.hpp"
 
 namespace dpsm {
 

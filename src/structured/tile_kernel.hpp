@@ -1,7 +1,7 @@
 // The 2D sweep on one tile: a private copy of the tile and a halo of `levels`
 // cells (plus one ring of ghosts) is advanced `levels` sub-steps in cache,
 // shrinking by one cell a level, and only the tile itself is kept. Faces are
-// computed once per level; the flux law is the dead-zone form of closure.hpp
+// computed once per level; the flux law is the dead-zone form of model/flux_law.hpp
 // (no flux up to the rest threshold tan(theta) (1 + tol)), so a tile whose
 // faces are all below it is exactly at rest and may be skipped.
 //
@@ -22,7 +22,7 @@ namespace dpsm {
 constexpr int kRowsAhead = 6;
 
 // The physics of real scenes, as every kernel with physics computes it
-// (tile_kernel_physics.cpp is the specification): a face takes at most a
+// (structured/tile_kernel_physics.cpp is the specification): a face takes at most a
 // quarter of the sand its upstream cell has above the bed after the cell's
 // own erosion, and on the isotropic scheme a face between two cells level to
 // within kLevelWithinRounding of their heights carries nothing.
@@ -75,7 +75,7 @@ struct TileLevelStats {
 struct TileBuffers {
     int width = 0, height = 0;  // of the buffer, cells
     std::vector<double> h[2], residual[2], source;
-    // Lazy sources (tiled_sweep.hpp): per cell, the sub-step of the step
+    // Lazy sources (structured/tiled_sweep.hpp): per cell, the sub-step of the step
     // after which its stored height h is current; and, per level, the height
     // now (true_h, what faces see) and what its source added since (lag).
     std::vector<double> since[2], true_h, lag;
@@ -160,7 +160,7 @@ using TileKernel = void (*)(TileBuffers &buffers, const LevelCells &cells, const
 // changes only in a sub-step in which one of its faces carries sand: then it
 // takes its source since it was last current (lag) and for this sub-step,
 // and becomes current. Elsewhere it keeps its stored height, and what its
-// source adds is applied later in closed form (tiled_sweep.hpp), so the bits
+// source adds is applied later in closed form (structured/tiled_sweep.hpp), so the bits
 // of a cell do not depend on which sweeps visit it. With the physics of real
 // scenes the source is applied at every sub-step (a bed caps erosion).
 TileKernel select_tile_kernel(bool masked, bool isotropic, bool source, bool grid_in = false, bool grid_out = false,
@@ -175,7 +175,7 @@ int tile_kernel_lanes();
 bool tile_kernels_use_avx512();
 
 // The reference kernel of a grid that uses a bed, an angle field, a flux
-// exponent or hysteresis (tile_kernel_physics.cpp): plain scalar code, the
+// exponent or hysteresis (structured/tile_kernel_physics.cpp): plain scalar code, the
 // specification of the physics, which the vectorised kernels with physics
 // compute to round-off. DPSM_SCALAR_PHYSICS=1 steps such grids with it, for
 // every tile (it reads cell kinds always), so that every face of the grid is

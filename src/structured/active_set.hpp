@@ -1,7 +1,7 @@
 // The active set of a 2D grid: which tiles of 64 x 64 cells can move. A
 // tile's hot box holds the cells that carried sand in its last sweep (or that
 // the host changed since); its driven box, during a step, the cells whose
-// faces a source may make steep within the step (tiled_sweep.hpp: a source
+// faces a source may make steep within the step (structured/tiled_sweep.hpp: a source
 // elsewhere is applied in closed form). A sweep visits a tile when a hot or
 // driven box lies near enough to reach it within the sweep. Everything else
 // is exactly at rest under the dead-zone flux law, so skipping it changes no
@@ -103,7 +103,7 @@ public:
         return has_source_[t] != 0 || (!remote_source_.empty() && remote_source_[t] != 0);
     }
 
-    // A distributed grid's view of its neighbours (decomposition.hpp): boxes of
+    // A distributed grid's view of its neighbours (mpi/decomposition.hpp): boxes of
     // cells beyond this block, in its coordinates, that may move in the coming
     // sweep (their hot and driven boxes) or hold a source. Tiles the first
     // reach are visited, and tiles the second reach see those sources, as if

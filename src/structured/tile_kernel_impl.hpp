@@ -1,5 +1,5 @@
-// The tile kernel, written once over a lane type (simd.hpp). Included by
-// tile_kernel_generic.cpp, tile_kernel_avx2.cpp and tile_kernel_avx512.cpp,
+// The tile kernel, written once over a lane type (structured/simd.hpp). Included by
+// structured/tile_kernel_generic.cpp, structured/tile_kernel_avx2.cpp and structured/tile_kernel_avx512.cpp,
 // each of which compiles it for its own CPU.
 //
 // One pass over the rows of the region does everything for a row: the
@@ -18,7 +18,7 @@
 // count for nothing and are never stored into the heights.
 //
 // Kernels with physics carry the physics of real scenes in the same pass, as
-// tile_kernel_physics.cpp (the specification) does in three: a face's own
+// structured/tile_kernel_physics.cpp (the specification) does in three: a face's own
 // angle from its cells' (angle field) and, between two cells at rest, the
 // static angle's threshold (hysteresis); the flux exponent; the bed, which
 // caps a face at a quarter of what its upstream sand cell may give (its sand
@@ -26,7 +26,7 @@
 // each cell, with the y faces towards its row, and kept in a row of scratch
 // for its x faces and its y faces towards the next row; and lifts a drained
 // cell that rounding left below it. Which of them a kernel carries is its PhysicsKind
-// (tile_kernel.hpp): none (the plain scene's kernels, free of them all), the
+// (structured/tile_kernel.hpp): none (the plain scene's kernels, free of them all), the
 // bed alone (compiled in), or any, each a runtime flag, the same for every
 // face of a sweep, so that each branch on one always goes the same way.
 #pragma once
@@ -38,9 +38,9 @@
 #include <type_traits>
 #include <utility>
 
-#include "grid.hpp"
-#include "simd.hpp"
-#include "tile_kernel.hpp"
+#include "model/grid.hpp"
+#include "structured/simd.hpp"
+#include "structured/tile_kernel.hpp"
 
 #if defined(__GNUC__) || defined(__clang__)
 // Everything the kernel calls is inlined into it, so its constants and row
@@ -532,7 +532,7 @@ DPSM_KERNEL_FLATTEN void advance_tile_level(TileBuffers &b, const LevelCells &io
                 }
             }
             // A visit that records its faces takes the masked kernel and works in
-            // the buffer (tiled_sweep.cpp): the branch costs the others 2-10 %.
+            // the buffer (structured/tiled_sweep.cpp): the branch costs the others 2-10 %.
             if constexpr (Masked && !GridIn && !GridOut) {
                 if (p.record) {
                     // Each face once: the west and south faces of every cell, the
@@ -629,11 +629,11 @@ TileKernel with_physics(PhysicsKind kind, F &&f) {
 
 template <class V>
 TileKernel tile_kernel_for(bool masked, bool isotropic, bool source, bool grid_in, bool grid_out, PhysicsKind physics) {
-    // Masked kernels read the buffer only (tile_kernel.hpp).
+    // Masked kernels read the buffer only (structured/tile_kernel.hpp).
     auto choose = [&](auto masked_, auto isotropic_, auto source_, auto physics_) -> TileKernel {
         constexpr bool Mk = decltype(masked_)::value, I = decltype(isotropic_)::value, S = decltype(source_)::value;
         constexpr PhysicsKind P = decltype(physics_)::value;
-        // Kernels with a lazy source work in the buffer only (tile_kernel.hpp).
+        // Kernels with a lazy source work in the buffer only (structured/tile_kernel.hpp).
         if constexpr (S && P == PhysicsKind::none) {
             return advance_tile_level<V, Mk, I, S, false, false, P>;
         } else {

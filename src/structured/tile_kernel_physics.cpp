@@ -1,6 +1,6 @@
 // The tile kernel of scenes that use the physics of real scenes: a bed that
 // cannot erode, an angle of repose per cell, a flux exponent, hysteresis.
-// Same contract as tile_kernel_impl.hpp (one level of a region, from slot
+// Same contract as structured/tile_kernel_impl.hpp (one level of a region, from slot
 // `in` to slot 1 - in, statistics over `tile`), but plain scalar code in three
 // passes, because the bed's cap on a face needs its upstream cell's erosion
 // before any face: (1) each cell's applied source and the sand it can give,
@@ -8,9 +8,9 @@
 #include <algorithm>
 #include <cmath>
 
-#include "closure.hpp"
-#include "grid.hpp"
-#include "tile_kernel.hpp"
+#include "model/flux_law.hpp"
+#include "model/grid.hpp"
+#include "structured/tile_kernel.hpp"
 
 namespace dpsm {
 

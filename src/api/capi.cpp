@@ -11,14 +11,14 @@
 #include <string>
 #include <utility>
 
-#include "decomposition.hpp"
+#include "mpi/decomposition.hpp"
 #include "dpsm/dpsm.h"
-#include "error.hpp"
-#include "limits.hpp"
-#include "grid.hpp"
-#include "restart.hpp"
-#include "handle.hpp"
-#include "stepper.hpp"
+#include "model/error.hpp"
+#include "model/limits.hpp"
+#include "model/grid.hpp"
+#include "io/restart.hpp"
+#include "api/handle.hpp"
+#include "stepping/stepper.hpp"
 
 namespace {
 

@@ -1,4 +1,4 @@
-// The one exception type of the core. The C boundary (capi.cpp) turns it into a
+// The one exception type of the core. The C boundary (api/capi.cpp) turns it into a
 // status code and a per-handle message; nothing else may cross that boundary.
 #pragma once
 

@@ -1,14 +1,14 @@
-#include "grid.hpp"
+#include "model/grid.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <utility>
 
-#include "decomposition.hpp"
+#include "mpi/decomposition.hpp"
 #include "dpsm/dpsm.h"
-#include "relax_to_rest.hpp"
-#include "tiled_sweep.hpp"
+#include "structured/relax_to_rest.hpp"
+#include "structured/tiled_sweep.hpp"
 
 namespace dpsm {
 

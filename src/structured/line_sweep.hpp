@@ -1,6 +1,6 @@
 // One explicit sweep of the slide fluxes on a 1D or axisymmetric grid (2D
-// grids use tiled_sweep.hpp). Every face between two cells carries one flux
-// by the law in closure.hpp, which one cell loses and the other gains, so mass
+// grids use structured/tiled_sweep.hpp). Every face between two cells carries one flux
+// by the law in model/flux_law.hpp, which one cell loses and the other gains, so mass
 // is conserved face by face: the paper's pairwise exchange (its Eq. 12).
 // Faces no steeper than the rest threshold tan(theta) (1 + tol) carry nothing,
 // as in the 2D kernel, so a surface at rest is exactly at rest.
@@ -9,18 +9,10 @@
 
 #include <vector>
 
-#include "grid.hpp"
+#include "model/grid.hpp"
+#include "stepping/engine.hpp"
 
 namespace dpsm {
-
-struct SweepResult {
-    bool moved = false;             // some face carried sand
-    double max_excess_slope = 0.0;  // max over faces that carried sand of |slope| - tan(theta)
-    double outflow_rate = 0.0;      // mass per unit time leaving through open sides and cells
-    double side_outflow_rate[4] = {};  // the part of it that left through each side
-    double unmet_mass = 0.0;        // erosion asked for in this sub-step where no sand lay above the bed
-    double sourced_mass = 0.0;      // with a bed: what the source put on (or took from) the sand
-};
 
 // Fills the grid's rate workspace with dh/dt from the slide fluxes for every
 // sand cell, 0 for wall and open cells, for a sub-step of dt. Sources are not
@@ -28,7 +20,7 @@ struct SweepResult {
 // source that finds sand. Updates which cells are moving (hysteresis).
 // With record, adds the volume each face carries in the sub-step to the
 // grid's face fluxes.
-SweepResult slide_rates_1d(Grid &grid, double dt, bool record = false);
+SubstepSummary slide_rates_1d(Grid &grid, double dt, bool record = false);
 
 // h += dt * (rate + q) on sand cells.
 void apply_rates(Grid &grid, double dt);
@@ -39,7 +31,7 @@ void apply_rates(Grid &grid, double dt);
 // linearly, so where it is not steep now, nor then, it is not in between:
 // once a sub-step has moved nothing and this says no, the rest of the step
 // is the source in closed form, apply_source_1d over `substeps` sub-steps of
-// dt (source_lag, tiled_sweep.hpp).
+// dt (source_lag, structured/tiled_sweep.hpp).
 bool source_may_steepen_1d(const Grid &grid, double T);
 void apply_source_1d(Grid &grid, double substeps, double dt);
 

@@ -1,6 +1,6 @@
 // The state of one granular surface: geometry, parameters, masks, source,
 // heights and the mass ledger. Grid keeps the ledger consistent with every
-// change the host makes; the arguments reach it already checked by capi.cpp.
+// change the host makes; the arguments reach it already checked by api/capi.cpp.
 #pragma once
 
 #include <array>
@@ -8,10 +8,10 @@
 #include <memory>
 #include <vector>
 
-#include "active_set.hpp"
-#include "face_fluxes.hpp"
-#include "ledger.hpp"
-#include "side_levels.hpp"
+#include "structured/active_set.hpp"
+#include "model/face_fluxes.hpp"
+#include "model/ledger.hpp"
+#include "model/side_levels.hpp"
 
 namespace dpsm {
 
@@ -66,7 +66,7 @@ struct StepInfo {
 };
 
 // Everything of a grid besides its geometry that later results depend on, as
-// a restart file holds it (restart.cpp); what Grid derives from these fields
+// a restart file holds it (io/restart.cpp); what Grid derives from these fields
 // (tangents, counts, summaries, the active set) is not in it.
 struct GridState {
     double repose_angle = 0.0, mobility = 0.0, rest_tolerance = 0.0;
@@ -159,7 +159,7 @@ public:
     }
 
     // How dpsm_step moves the surface: time-accurate sub-steps, the fast
-    // relaxation to rest (relax_to_rest.hpp), or the second where it applies.
+    // relaxation to rest (structured/relax_to_rest.hpp), or the second where it applies.
     Relaxation relaxation() const { return relaxation_; }
     void set_relaxation(Relaxation relaxation) { relaxation_ = relaxation; }
 
@@ -177,7 +177,7 @@ public:
     const std::vector<double> &side_levels(int side) const { return side_levels_[side]; }  // empty: all 0
     void set_side_levels(int side, const double *levels);                                     // NULL: all 0
     // The level of the cell (i, j) beyond the domain that a sweep reads as
-    // the outside of the sides (side_levels.hpp).
+    // the outside of the sides (model/side_levels.hpp).
     double outside_level(std::int64_t i, std::int64_t j) const;
     // The lowest and highest level held beyond the open sides (0 and 0 when
     // no side is open or none has levels).
@@ -217,7 +217,7 @@ public:
     double open_level_min() const { return open_level_min_; }
     double open_level_max() const { return open_level_max_; }
     bool source_active() const { return source_rate_nonzero_; }
-    // Sources applied lazily (tiled_sweep.hpp), as on 2D grids without the
+    // Sources applied lazily (structured/tiled_sweep.hpp), as on 2D grids without the
     // physics of real scenes: per cell, the sub-steps counted since the grid
     // began after which a source cell's stored height is current, where that
     // is later than clock_base(), the count at the start of the present step
@@ -243,7 +243,7 @@ public:
     // new grid of the same geometry. Unlike the setters it books nothing in
     // the ledger (the state carries its ledger); it recomputes what is derived.
     void restore(GridState &&state);
-    // The relaxation to rest (relax_to_rest.cpp) between its sweeps: every
+    // The relaxation to rest (structured/relax_to_rest.cpp) between its sweeps: every
     // height becomes y's and every residual 0, where y may differ from the
     // heights only within the box. Only the cells that change are looked at
     // again, as after a host's edit, but nothing is booked.
@@ -278,6 +278,7 @@ public:
     std::vector<double> &rate_workspace() { return rate_; }
     // The 2D sweep's active set and scratch (2D grids only).
     ActiveSet &active_set() { return *active_; }
+    const ActiveSet &active_set() const { return *active_; }
     TiledWorkspace &tiled_workspace();
     // The relaxation to rest's arrays (2D grids only), allocated on first use.
     RelaxWorkspace &relax_workspace();
@@ -285,7 +286,7 @@ public:
     StepInfo &last_step() { return last_step_; }
     const StepInfo &last_step() const { return last_step_; }
 
-    // The grid's place in a distributed grid (decomposition.hpp); null on a
+    // The grid's place in a distributed grid (mpi/decomposition.hpp); null on a
     // serial grid, which never pays for any of it.
     Decomposition *decomposition() const { return decomposition_.get(); }
     void set_decomposition(std::unique_ptr<Decomposition> decomposition);

@@ -3,7 +3,7 @@
 // reaches any of this; the core only calls it at the few points where the
 // ranks must agree or see each other's cells:
 //
-//  - after gather() (tiled_sweep.cpp) has copied a tile at the block's edge,
+//  - after gather() (structured/tiled_sweep.cpp) has copied a tile at the block's edge,
 //    gather_halo() fills its cells beyond the block from the HaloStore:
 //    heights and residuals of the neighbours' cells as they were at the start
 //    of the sweep, their kinds and sources as the host last set them;
@@ -24,12 +24,12 @@
 #include <cstdint>
 #include <vector>
 
-#include "side_levels.hpp"
+#include "model/side_levels.hpp"
 
 namespace dpsm {
 
 class Grid;
-struct LevelSummary;
+struct SubstepSummary;
 
 // The cells within `depth` of a block that lie outside it, in four strips:
 // below (rows -depth .. -1, columns -depth .. nx+depth-1), above (rows ny ..
@@ -115,8 +115,8 @@ public:
     // Collective, before each sweep: refreshes the halo's heights and
     // residuals and the active set's view of the neighbours' activity.
     virtual void before_sweep(Grid &grid) = 0;
-    // Collective, after each sweep: moved and max_excess of every level over all ranks.
-    virtual void after_sweep(std::vector<LevelSummary> &levels) = 0;
+    // Collective, after each sweep: moved and max_excess_slope of every level over all ranks.
+    virtual void after_sweep(std::vector<SubstepSummary> &levels) = 0;
     // Collective: the sum over all ranks, the same on every rank.
     virtual double sum(double local) const = 0;
     // Collective: as sum(), for a call that a rank may have refused (its

@@ -17,7 +17,7 @@
 // flux law, the masks and the sides stay in one place. Each stage is a
 // combination of states of one mass; what leaves through open sides and cells
 // is booked as outflow, as the difference of the mass before and after.
-#include "relax_to_rest.hpp"
+#include "structured/relax_to_rest.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -28,11 +28,11 @@
 #include <vector>
 
 #include "dpsm/dpsm.h"
-#include "error.hpp"
-#include "ledger.hpp"
-#include "stepper.hpp"
-#include "tile_kernel.hpp"
-#include "tiled_sweep.hpp"
+#include "model/error.hpp"
+#include "model/ledger.hpp"
+#include "structured/structured_engine.hpp"
+#include "structured/tile_kernel.hpp"
+#include "structured/tiled_sweep.hpp"
 
 namespace dpsm {
 namespace {
@@ -73,7 +73,7 @@ struct RkcStep {
 
 // The arithmetic on the cells of one row, [c0, c1), after every evaluation.
 // Where the kernels run in AVX-512 so do these, 8 cells at a time instead of
-// 2 (copies built for it; chosen by a test of the CPU, as in tiled_sweep.cpp).
+// 2 (copies built for it; chosen by a test of the CPU, as in structured/tiled_sweep.cpp).
 // Neither copy has fused multiply-adds, so both round alike.
 struct StageWeights {
     double mu, nu, mut_tau, gamt_tau;
@@ -211,7 +211,7 @@ public:
     double *state(int k) { return ws_.states[k].get(); }
     double *rates() { return ws_.rates.get(); }
 
-    LevelSummary evaluate(const double *y) {
+    SubstepSummary evaluate(const double *y) {
         // The active set then computes only the cells that y moved or that
         // touch a moving face, as in any sub-step.
         for (const std::int64_t t : ws_.live_tiles) grid_.copy_heights_between_sweeps(y, ws_.live[t]);
@@ -219,7 +219,7 @@ public:
                                                         /*residuals=*/false));
         visited_ += last_visited_;
         // The sweep leaves the heights from before it in its scratch
-        // (tiled_sweep.hpp): y in the live boxes, the start elsewhere.
+        // (structured/tiled_sweep.hpp): y in the live boxes, the start elsewhere.
         const TiledWorkspace &ws = grid_.tiled_workspace();
         const double *next = grid_.heights().data(), *before = ws.heights.data();
         bool new_tiles = false;
@@ -363,7 +363,7 @@ private:
     std::int64_t nx_;
     RelaxWorkspace &ws_;
     Grid::SavedResiduals residuals_;  // as they were before the relaxation
-    std::vector<LevelSummary> levels_;
+    std::vector<SubstepSummary> levels_;
     std::int64_t evaluations_ = 0;
     double visited_ = 0.0, last_visited_ = 0.0;
 };
@@ -415,7 +415,7 @@ struct SideMass {
     }
     SideMass minus(const SideMass &o) const { return plus(-1.0, o); }
 };
-SideMass side_mass_of(const LevelSummary &evaluation, double dt) {
+SideMass side_mass_of(const SubstepSummary &evaluation, double dt) {
     SideMass m;
     for (int k = 0; k < 4; ++k) m.side[k] = evaluation.side_outflow_rate[k] * dt;
     return m;
@@ -436,7 +436,7 @@ bool relax_to_rest(Grid &grid, std::int64_t budget, double &cells_visited) {
         return true;
     }
     // All the memory first: an allocation that fails leaves the grid as it was.
-    const double dt = stable_dt(grid);
+    const double dt = structured_stable_dt(grid);
     Evaluator rates(grid, dt);
     // The states change roles by swapping these pointers; the evaluator only
     // needs to know which arrays they are, not which is which.
@@ -450,14 +450,14 @@ bool relax_to_rest(Grid &grid, std::int64_t budget, double &cells_visited) {
     bool rested = false, switched = false;
     double last_excess = 0.0;
     for (int k = 0; rates.evaluations() < budget; ++k) {
-        const LevelSummary start = rates.evaluate(y0);
+        const SubstepSummary start = rates.evaluate(y0);
         out_f0 = side_mass_of(start, dt);
-        last_excess = start.max_excess;
+        last_excess = start.max_excess_slope;
         if (!start.moved) {
             rested = true;
             break;
         }
-        if (start.max_excess < switch_excess) {
+        if (start.max_excess_slope < switch_excess) {
             switched = true;
             break;
         }
@@ -514,9 +514,9 @@ bool relax_to_rest(Grid &grid, std::int64_t budget, double &cells_visited) {
         const double beta = static_cast<double>(k) / static_cast<double>(k + 3);
         rates.for_rows([&](std::size_t c0, std::size_t c1) { loops.extrapolate(c0, c1, x, x_prev, beta, y); });
         out_y = out_x.plus(beta, out_x.minus(out_x_prev));
-        const LevelSummary at = rates.evaluate(y);
+        const SubstepSummary at = rates.evaluate(y);
         const double *next = rates.next();
-        last_excess = at.max_excess;
+        last_excess = at.max_excess_slope;
         if (!at.moved) {
             copy(x, y);
             copy(x_prev, y);

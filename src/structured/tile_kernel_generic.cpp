@@ -1,7 +1,7 @@
 // The tile kernel for any CPU, and the choice of kernel at run time.
 #include <cstdlib>
 
-#include "tile_kernel_impl.hpp"
+#include "structured/tile_kernel_impl.hpp"
 
 namespace dpsm {
 

@@ -1,5 +1,5 @@
 // The supported range (dpsm.h), in one place for every part that checks input:
-// the C boundary (capi.cpp), restart files (restart.cpp) and distributed grids
+// the C boundary (api/capi.cpp), restart files (io/restart.cpp) and distributed grids
 // (mpi/distributed.cpp).
 #pragma once
 

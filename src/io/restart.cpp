@@ -5,7 +5,7 @@
 // every bit it had. Two CRC-32 checksums guard the file: one over the fixed
 // header, so that its sizes can be trusted before anything is allocated from
 // them, and one over the whole file.
-#include "restart.hpp"
+#include "io/restart.hpp"
 
 #include <array>
 #include <cerrno>
@@ -23,8 +23,8 @@
 #endif
 
 #include "dpsm/dpsm.h"
-#include "error.hpp"
-#include "limits.hpp"
+#include "model/error.hpp"
+#include "model/limits.hpp"
 
 namespace dpsm {
 

@@ -1,4 +1,4 @@
-#include "tiled_sweep.hpp"
+#include "structured/tiled_sweep.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -10,11 +10,11 @@
 #include <omp.h>
 #endif
 
-#include "active_set.hpp"
-#include "decomposition.hpp"
-#include "grid.hpp"
-#include "ledger.hpp"
-#include "simd.hpp"
+#include "structured/active_set.hpp"
+#include "mpi/decomposition.hpp"
+#include "model/grid.hpp"
+#include "model/ledger.hpp"
+#include "structured/simd.hpp"
 
 namespace dpsm {
 
@@ -218,7 +218,7 @@ void gather(const Grid &grid, TileBuffers &b, std::int64_t gi0, std::int64_t gj0
 // the bed and angles (those the grid has) and, with `moving_flags`, which
 // cells are moving (hysteresis); ghost cells are never moving and have no
 // bed or angle. On a block of a distributed grid, the cells beyond the block
-// that lie in the global domain come from the halo store (decomposition.hpp).
+// that lie in the global domain come from the halo store (mpi/decomposition.hpp).
 void gather_physics(const Grid &grid, const HaloStore *halo, TileBuffers &b, std::int64_t gi0, std::int64_t gj0,
                     bool moving_flags) {
     const Geometry &geo = grid.geometry();
@@ -253,7 +253,7 @@ void gather_physics(const Grid &grid, const HaloStore *halo, TileBuffers &b, std
 
 // On a block of a distributed grid, replaces what gather() put in the buffer
 // for the cells beyond the block: the neighbours' cells come from the halo
-// store (decomposition.hpp), the cells beyond the global domain are ghosts of
+// store (mpi/decomposition.hpp), the cells beyond the global domain are ghosts of
 // its sides. The block's own cells are left as gather() copied them.
 void gather_halo(const Grid &grid, const HaloStore &halo, TileBuffers &b, std::int64_t gi0, std::int64_t gj0,
                  bool masked, bool source) {
@@ -459,7 +459,7 @@ void prepare_tiled_sweep(Grid &grid, int threads) {
     ws.origin.reserve(2 * tiles);
 }
 
-std::int64_t tiled_sweep(Grid &grid, int levels, double dt, std::vector<LevelSummary> &summaries, bool find_excess,
+std::int64_t tiled_sweep(Grid &grid, int levels, double dt, std::vector<SubstepSummary> &summaries, bool find_excess,
                          bool residuals, double first_substep) {
     const Geometry &geo = grid.geometry();
     ActiveSet &active = grid.active_set();
@@ -479,7 +479,7 @@ std::int64_t tiled_sweep(Grid &grid, int levels, double dt, std::vector<LevelSum
     const bool clocks = !physics && grid.source_clock().size() == static_cast<std::size_t>(geo.cells());
     const double clock_base = grid.clock_base();
     // DPSM_SCALAR_PHYSICS=1 steps a grid with physics by the scalar reference
-    // kernel (tile_kernel_physics.cpp), in the buffer, on every tile; read at
+    // kernel (structured/tile_kernel_physics.cpp), in the buffer, on every tile; read at
     // every sweep, so that a test can compare the two within one process.
     const bool scalar_physics = physics && environment_flag("DPSM_SCALAR_PHYSICS");
     residuals = residuals || physics;  // kernels with physics always carry them
@@ -706,18 +706,18 @@ std::int64_t tiled_sweep(Grid &grid, int levels, double dt, std::vector<LevelSum
 
     // New hot boxes: the cells touching moving faces in any level, grown by the
     // one cell a last move can make steep. Sums in tile order, whatever the threads.
-    summaries.assign(static_cast<std::size_t>(levels), LevelSummary{});
+    summaries.assign(static_cast<std::size_t>(levels), SubstepSummary{});
     for (std::int64_t k = 0; k < visits; ++k) {
         CellBox moved;
         for (int s = 0; s < levels; ++s) {
             const TileLevelStats &st = ws.stats[static_cast<std::size_t>(k) * levels + s];
-            LevelSummary &sum = summaries[static_cast<std::size_t>(s)];
+            SubstepSummary &sum = summaries[static_cast<std::size_t>(s)];
             sum.moved = sum.moved || st.moved;
             sum.outflow_rate += st.outflow_rate;
             for (int side = 0; side < 4; ++side) sum.side_outflow_rate[side] += st.side_outflow_rate[side];
             sum.unmet_mass += st.unmet_mass;
             sum.sourced_mass += st.sourced_mass;
-            sum.max_excess = std::max(sum.max_excess, st.max_excess);
+            sum.max_excess_slope = std::max(sum.max_excess_slope, st.max_excess);
             if (st.hot_r0 < st.hot_r1)
                 moved.add(ws.origin[2 * k] + st.hot_c0 - 1, ws.origin[2 * k] + st.hot_c1 + 1,
                           ws.origin[2 * k + 1] + st.hot_r0 - 1, ws.origin[2 * k + 1] + st.hot_r1 + 1);

@@ -1,10 +1,10 @@
 // The handle behind the C API's dpsm_grid, shared by the C boundary
-// (capi.cpp) and the optional MPI component's constructor (src/mpi/).
+// (api/capi.cpp) and the optional MPI component's constructor (src/mpi/).
 #pragma once
 
 #include <string>
 
-#include "grid.hpp"
+#include "model/grid.hpp"
 
 struct dpsm_grid {
     explicit dpsm_grid(const dpsm::Geometry &geometry) : core(geometry) {}

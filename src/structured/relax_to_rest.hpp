@@ -10,13 +10,13 @@
 #include <memory>
 #include <vector>
 
-#include "grid.hpp"
+#include "model/grid.hpp"
 
 namespace dpsm {
 
 // The relaxation's arrays, kept by the grid between steps so that each step
 // touches only the pages of the tiles where sand moves, not fresh ones
-// (relax_to_rest.cpp). Outside a step every box is empty.
+// (structured/relax_to_rest.cpp). Outside a step every box is empty.
 struct RelaxWorkspace {
     RelaxWorkspace(std::size_t cells, std::size_t tiles);
     static constexpr int kStates = 4;

@@ -1,5 +1,5 @@
-// The 2D sweep: visits the tiles of the active set (active_set.hpp) and runs
-// the tile kernel (tile_kernel.hpp) on each, in parallel with OpenMP. Every
+// The 2D sweep: visits the tiles of the active set (structured/active_set.hpp) and runs
+// the tile kernel (structured/tile_kernel.hpp) on each, in parallel with OpenMP. Every
 // tile reads the heights at the start of the sweep and writes its own cells
 // to a separate output, so results do not depend on the order of tiles or the
 // number of threads; sums over tiles are taken in tile order.
@@ -23,21 +23,13 @@
 #include <cstdint>
 #include <vector>
 
-#include "active_set.hpp"
-#include "tile_kernel.hpp"
+#include "stepping/engine.hpp"
+#include "structured/active_set.hpp"
+#include "structured/tile_kernel.hpp"
 
 namespace dpsm {
 
 class Grid;
-
-struct LevelSummary {
-    bool moved = false;         // some face carried sand in this sub-step
-    double outflow_rate = 0.0;  // mass per unit time into sinks
-    double side_outflow_rate[4] = {};  // the part of it that left through each side
-    double max_excess = 0.0;    // largest |grad h| - tan(theta) over faces that carried sand (if found: tiled_sweep)
-    double unmet_mass = 0.0;    // erosion asked for where no sand lay above the bed
-    double sourced_mass = 0.0;  // with a bed: what the source put on (or took from) the sand
-};
 
 // Scratch of the 2D sweep, kept by the grid between steps. A sweep writes
 // the visited cells into heights (residuals, moving) and then swaps them with
@@ -102,7 +94,7 @@ double catch_up_sources(Grid &grid, double substeps, double dt);
 // excess slope costs a little on every face, so it is found on the last
 // level only, and only with find_excess (elsewhere it is 0). first_substep:
 // the index in the step of the sweep's first sub-step (lazy sources).
-std::int64_t tiled_sweep(Grid &grid, int levels, double dt, std::vector<LevelSummary> &summaries,
+std::int64_t tiled_sweep(Grid &grid, int levels, double dt, std::vector<SubstepSummary> &summaries,
                          bool find_excess, bool residuals = true, double first_substep = 0.0);
 
 }  // namespace dpsm

@@ -1,0 +1,84 @@
+// The one interface between the stepping policy (stepper.cpp) and an engine,
+// the code that evaluates fluxes and advances heights over one kind of
+// geometry: the structured engine for 1D, 2D and axisymmetric grids
+// (src/structured/), a mesh engine later. The stepper splits dt into
+// sub-steps, decides when the surface rests, refuses work it cannot bound
+// and books the ledger; an engine only does what is asked over its own
+// cells, keeps its own active set, and reports what each sub-step did. A new
+// engine implements this class and is chosen in engine_for(); nothing in the
+// C boundary or the stepper changes.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+
+namespace dpsm {
+
+class Grid;
+struct StepInfo;
+
+// What one sub-step did over the engine's cells (on a block of a distributed
+// grid: over all blocks, once the decomposition has summed it).
+struct SubstepSummary {
+    bool moved = false;                // some face carried sand
+    double outflow_rate = 0.0;         // mass per unit time into sinks (open sides and open cells)
+    double side_outflow_rate[4] = {};  // the part of it that left through each side
+    double max_excess_slope = 0.0;     // largest |grad h| - tan(theta) over faces that carried sand, where found
+    double unmet_mass = 0.0;           // erosion asked for where no sand lay above the bed
+    double sourced_mass = 0.0;         // with a bed: what the source put on (or took from) the sand
+};
+
+// Books one sub-step in the ledger; false once the surface is found at rest
+// (the engine then takes no further sub-step).
+using BookSubstep = std::function<bool(const SubstepSummary &)>;
+
+// How the stepper asks for a step of `substeps` sub-steps of sub_dt.
+struct SubstepPlan {
+    std::int64_t substeps = 0;
+    double sub_dt = 0.0;
+    // Sources applied in closed form where they cannot make a face steep
+    // (src/structured/tiled_sweep.hpp, "Lazy sources").
+    bool lazy_sources = false;
+    // Some cell may move: a source keeps a face steep, or the engine said
+    // may_move() before the step.
+    bool something_may_move = false;
+};
+
+class Engine {
+public:
+    virtual ~Engine() = default;
+
+    // The largest sub-step at which explicit Euler is monotone for the flux
+    // law on this geometry (dpsm_stable_dt).
+    virtual double stable_dt(const Grid &grid) const = 0;
+    // Allocates what a step needs; called before anything changes, so that
+    // running out of memory leaves the grid as it was.
+    virtual void prepare(Grid &grid) const = 0;
+    // Whether anything can move with no source acting (an engine without an
+    // active set answers true).
+    virtual bool may_move(const Grid &grid) const = 0;
+    // At the start of a step of dt in sub-steps of sub_dt with sources on:
+    // marks what the sources may make steep and returns whether a source
+    // keeps some face steep at the end of the step (it may then flow for
+    // ever). Without lazy sources every source cell is marked and the answer
+    // is true.
+    virtual bool drive_sources(Grid &grid, double dt, double sub_dt, bool lazy) const = 0;
+    // Undoes drive_sources for a step that is refused.
+    virtual void forget_driven(Grid &grid) const = 0;
+    // Advances the plan's sub-steps, calling book after each, until book
+    // says rest; adds the cells it visited to info.cell_updates, sets
+    // info.at_rest and info.max_excess_slope, and leaves every cell current
+    // (lazy sources caught up) at the end.
+    virtual void advance(Grid &grid, const SubstepPlan &plan, const BookSubstep &book, StepInfo &info) const = 0;
+
+    // The relaxation to rest (DPSM_RELAX_TO_REST), with the contract of
+    // src/structured/relax_to_rest.hpp: true at rest, false with the grid as
+    // it was where the stepper must step in time instead; throws
+    // Error(DPSM_ERR_NOT_APPLICABLE) for a scene it does not support.
+    virtual bool relax_to_rest(Grid &grid, std::int64_t budget, double &cells_visited) const = 0;
+};
+
+// The engine that steps this grid.
+const Engine &engine_for(const Grid &grid);
+
+}  // namespace dpsm

@@ -1,0 +1,126 @@
+#include "structured/structured_engine.hpp"
+
+#include <algorithm>
+#include <vector>
+
+#include "model/flux_law.hpp"
+#include "model/grid.hpp"
+#include "structured/line_sweep.hpp"
+#include "structured/relax_to_rest.hpp"
+#include "structured/tiled_sweep.hpp"
+
+namespace dpsm {
+
+double structured_stable_dt(const Grid &grid) {
+    const Geometry &geo = grid.geometry();
+    const double stiffness =
+        slide_flux_max_derivative(grid.mobility(), grid.min_repose_angle(), grid.flux_exponent());
+    // No face may take more than its share of the excess: a cell's faces
+    // together at most all of it (monotone), a pair at most what brings it to
+    // the angle of repose (the paper's bound). On the axisymmetric grid the
+    // first ring is small next to its outer face, which tightens the pair
+    // bound to 3 dr^2 / (8 nu cos(theta)).
+    if (geo.axisymmetric) return 3.0 * geo.dx * geo.dx / (8.0 * stiffness);
+    double inverse_spacing2 = 1.0 / (geo.dx * geo.dx);
+    if (geo.dim == 2) inverse_spacing2 += 1.0 / (geo.dy * geo.dy);
+    return 1.0 / (2.0 * stiffness * inverse_spacing2);
+}
+
+namespace {
+
+// 2D grids: tiles of the active set, swept up to ActiveSet::kMaxLevels
+// sub-steps at a time (structured/tiled_sweep.hpp).
+class TiledEngine final : public Engine {
+public:
+    double stable_dt(const Grid &grid) const override { return structured_stable_dt(grid); }
+    void prepare(Grid &grid) const override { prepare_tiled_sweep(grid, grid.threads()); }
+    bool may_move(const Grid &grid) const override { return grid.active_set().may_move(); }
+
+    bool drive_sources(Grid &grid, double dt, double sub_dt, bool lazy) const override {
+        if (lazy) return dpsm::drive_sources(grid, dt, sub_dt);
+        grid.active_set().drive_every_source();
+        return true;
+    }
+    void forget_driven(Grid &grid) const override { grid.active_set().forget_driven(); }
+
+    void advance(Grid &grid, const SubstepPlan &plan, const BookSubstep &book, StepInfo &info) const override {
+        if (plan.something_may_move) {
+            std::vector<SubstepSummary> levels;
+            for (std::int64_t k = 0; k < plan.substeps && !info.at_rest; k += ActiveSet::kMaxLevels) {
+                const int count = static_cast<int>(std::min<std::int64_t>(ActiveSet::kMaxLevels, plan.substeps - k));
+                // The step reports the largest excess slope of its last sub-step.
+                const bool last_sweep = k + count >= plan.substeps;
+                const double visited = static_cast<double>(
+                    tiled_sweep(grid, count, plan.sub_dt, levels, last_sweep, true, static_cast<double>(k)));
+                for (const SubstepSummary &level : levels) {
+                    if (!book(level)) break;
+                    info.cell_updates += visited;
+                }
+            }
+        } else {
+            info.at_rest = true;  // idle: no tile can move and no source can make a face steep
+        }
+        if (plan.lazy_sources) {
+            const double substeps = static_cast<double>(plan.substeps);
+            info.cell_updates += catch_up_sources(grid, substeps, plan.sub_dt);
+            grid.set_clock_base(grid.clock_base() + substeps);
+        }
+        grid.active_set().end_of_step();
+    }
+
+    bool relax_to_rest(Grid &grid, std::int64_t budget, double &cells_visited) const override {
+        return dpsm::relax_to_rest(grid, budget, cells_visited);
+    }
+};
+
+// 1D and axisymmetric grids: every face every sub-step (structured/line_sweep.hpp).
+class LineEngine final : public Engine {
+public:
+    double stable_dt(const Grid &grid) const override { return structured_stable_dt(grid); }
+    void prepare(Grid &) const override {}
+    bool may_move(const Grid &) const override { return true; }
+
+    bool drive_sources(Grid &grid, double dt, double, bool lazy) const override {
+        return lazy ? source_may_steepen_1d(grid, dt) : true;
+    }
+    void forget_driven(Grid &) const override {}
+
+    void advance(Grid &grid, const SubstepPlan &plan, const BookSubstep &book, StepInfo &info) const override {
+        const double cells = static_cast<double>(grid.geometry().cells());
+        for (std::int64_t k = 0; k < plan.substeps; ++k) {
+            const SubstepSummary sweep = slide_rates_1d(grid, plan.sub_dt, grid.records_face_fluxes());
+            // Once nothing moves, a source that cannot make a face steep by the
+            // end of the step is the rest of it, in closed form.
+            const double left = static_cast<double>(plan.substeps - k);
+            if (!sweep.moved && plan.lazy_sources && !source_may_steepen_1d(grid, left * plan.sub_dt)) {
+                apply_source_1d(grid, left, plan.sub_dt);
+                info.cell_updates += cells;
+                info.max_excess_slope = 0.0;
+                info.at_rest = true;
+                break;
+            }
+            if (!book(sweep)) break;
+            apply_rates(grid, plan.sub_dt);
+            info.cell_updates += cells;
+        }
+    }
+
+    // Refuses with the reason (relax_to_rest.hpp): 1D and axisymmetric grids step in time.
+    bool relax_to_rest(Grid &grid, std::int64_t budget, double &cells_visited) const override {
+        return dpsm::relax_to_rest(grid, budget, cells_visited);
+    }
+};
+
+}  // namespace
+
+const Engine &tiled_engine() {
+    static const TiledEngine engine;
+    return engine;
+}
+
+const Engine &line_engine() {
+    static const LineEngine engine;
+    return engine;
+}
+
+}  // namespace dpsm
