@@ -298,8 +298,11 @@ static int source_active(const slot_t *s) {
 
 /* As dpsm_step documents: a source acts, or held levels differ (open cells,
  * and the levels beyond open sides). */
-static int driven(const slot_t *s, const double *h) {
-    if (source_active(s)) return 1;
+static int driven_without_source(const slot_t *s, const double *h);
+static int driven(const slot_t *s, const double *h) { return source_active(s) || driven_without_source(s, h); }
+
+/* Held levels that differ. */
+static int driven_without_source(const slot_t *s, const double *h) {
     int have = 0;
     double level = 0.0;
 #define HELD_AT(v)                                  \
@@ -315,6 +318,60 @@ static int driven(const slot_t *s, const double *h) {
         if (s->kinds[c] == DPSM_CELL_OPEN) HELD_AT(h[c]);
 #undef HELD_AT
     return 0;
+}
+
+/* On a grid without the physics of real scenes and a step of bounded length,
+ * a source is applied in closed form where it cannot make a face steep
+ * (dpsm_step), and only a face that is steep at the end of the step under
+ * the sources alone, beside a source, drives the step. Returns 1 where such
+ * a face surely is steep, 0 where none surely is, and -1 where the library's
+ * margins for rounding leave it open. */
+static int source_steep_at_end(const slot_t *s, const double *h, double T) {
+    const double tan_theta = tan(s->theta), threshold = tan_theta * (1.0 + s->tol);
+    int surely = 0;
+    double largest = 0.0, magnitude = 0.0; /* of the heights; of any face's slope, now or at T */
+#define LATER(c) (s->kinds[c] == DPSM_CELL_SAND && s->source ? h[c] + s->source[c] * T : h[c])
+#define SOURCED(c) (s->kinds[c] == DPSM_CELL_SAND && s->source && s->source[c] != 0.0)
+    for (int64_t c = 0; c < s->n; ++c) largest = fmax(largest, fmax(fabs(h[c]), fabs(LATER(c))));
+    if (!isfinite(largest)) return -1;
+    /* A face between cells a and b (b < 0: the level `outside` beyond a side), d apart. */
+#define FACE(a, b, outside, d)                                                                            \
+    do {                                                                                                  \
+        const int64_t a_ = (a), b_ = (b);                                                                 \
+        if (s->kinds[a_] == DPSM_CELL_WALL || (b_ >= 0 && s->kinds[b_] == DPSM_CELL_WALL)) break;         \
+        const double now_ = fabs(h[a_] - (b_ >= 0 ? h[b_] : (outside))) / (d);                            \
+        const double later_ = fabs(LATER(a_) - (b_ >= 0 ? LATER(b_) : (outside))) / (d);                  \
+        magnitude = fmax(magnitude, fmax(now_, later_));                                                  \
+        if ((SOURCED(a_) || (b_ >= 0 && SOURCED(b_))) && later_ > threshold * (1.0 + 1e-9) + 1e-300) \
+            surely = 1;                                                                                   \
+    } while (0)
+    const int two_d = s->geom == GEOM_2D;
+    for (int64_t j = 0; j < s->ny; ++j)
+        for (int64_t i = 0; i < s->nx; ++i) {
+            const int64_t c = i + s->nx * j;
+            if (i + 1 < s->nx) FACE(c, c + 1, 0.0, s->dx);
+            if (two_d && j + 1 < s->ny) FACE(c, c + s->nx, 0.0, s->dy);
+        }
+    for (int64_t k = 0; k < s->ny; ++k) {
+        if (s->open[DPSM_XMIN] && has_side(s, DPSM_XMIN)) FACE(s->nx * k, -1, level_at(s, DPSM_XMIN, k), s->dx);
+        if (s->open[DPSM_XMAX]) FACE(s->nx - 1 + s->nx * k, -1, level_at(s, DPSM_XMAX, k), s->dx);
+    }
+    for (int64_t k = 0; two_d && k < s->nx; ++k) {
+        if (s->open[DPSM_YMIN]) FACE(k, -1, level_at(s, DPSM_YMIN, k), s->dy);
+        if (s->open[DPSM_YMAX]) FACE(k + s->nx * (s->ny - 1), -1, level_at(s, DPSM_YMAX, k), s->dy);
+    }
+#undef FACE
+#undef SOURCED
+#undef LATER
+    if (surely) return 1;
+    /* No face surely steep; none can be where every slope lies below the lowest threshold the library may take
+     * (half of tan(theta)), the isotropic scheme's transverse part included. Beyond two open sides (a corner)
+     * the transverse part reads levels this does not model. */
+    const int corner = two_d && (s->open[DPSM_XMIN] || s->open[DPSM_XMAX]) && (s->open[DPSM_YMIN] || s->open[DPSM_YMAX]);
+    const double bound = two_d && s->scheme == DPSM_SCHEME_ISOTROPIC ? sqrt(2.0) * magnitude : magnitude;
+    if (!corner && bound < 0.5 * tan_theta * (1.0 - 1e-9) && 64.0 * DBL_EPSILON * largest < 0.25 * tan_theta * fmin(s->dx, s->dy))
+        return 0;
+    return -1;
 }
 
 /* The invariants of any state. */
@@ -944,8 +1001,17 @@ static void op_step(reader_t *r) {
     } else {
         needed = ceil(dt / before.stable_dt);
         const double limit = (double)s->max_substeps;
-        if (drives && (needed > 9007199254740992.0 || needed > limit)) want = DPSM_ERR_WORK_LIMIT;
-        if (drives && fabs(needed - limit) <= 1.0) either = 1; /* rounding of dt / stable_dt */
+        const int bounded = needed <= 9007199254740992.0;
+        int limited = drives;
+        /* A source alone drives only where it keeps a face steep to the end of the step. */
+        if (drives && source_active(s) && bounded && !driven_without_source(s, before.h) && !s->bed && !s->tan_field &&
+            s->exponent == 1.0 && s->tan_static == 0.0) {
+            const int steep = source_steep_at_end(s, before.h, dt);
+            limited = steep != 0;
+            if (steep < 0 && needed > limit) either = 1;
+        }
+        if (limited && (!bounded || needed > limit)) want = DPSM_ERR_WORK_LIMIT;
+        if (limited && fabs(needed - limit) <= 1.0) either = 1; /* rounding of dt / stable_dt */
         /* Bounded work: a scene at rest by itself stops early, but how early
          * depends on the scene; keep to steps whose sub-steps we can afford. */
         const double cost = fmin(needed, 1e18) * (double)s->n;

@@ -138,6 +138,9 @@ for geom, n in (("1d", 9), ("axi", 9), ("2d", 9)):
          step(0, 1.0), step(0, 100.0), source(0, 0, 0, 0, none=True), step(0, 1000.0))
     seed(f"work_limit_{geom}", create(0, geom, n, n), source(0, 0, 1e-3, 0.0), step_abs(0, 1e12),
          step_abs(0, 1e300), [MAX_SUBSTEPS, 0, 1], step(0, 2.0), step(0, 0.5), step_abs(0, "max"))
+    # A source beside a face that stays steep drives the step (held to the limit); one on a flat bed does not.
+    seed(f"work_limit_steep_{geom}", create(0, geom, n, n), heights(0, 2, 10.0, 0.0), source(0, 0, 1e-3, 0.0),
+         [MAX_SUBSTEPS, 0, 1], step(0, 100.0), step(0, 2.0), heights(0, 0, 1.0, 0.0), step(0, 100.0))
     cells = n * n if geom == "2d" else n
     seed(f"masks_{geom}", create(0, geom, n, n),
          heights(0, 4, 3.0, 0.0, per_cell=([4, 1, 5, 0, 14, 16, 2, 13, 4] * 9)[:cells]),
