@@ -68,7 +68,9 @@ public:
     // Advances the plan's sub-steps, calling book after each, until book
     // says rest; adds the cells it visited to info.cell_updates, sets
     // info.at_rest and info.max_excess_slope, and leaves every cell current
-    // (lazy sources caught up) at the end.
+    // (lazy sources caught up) at the end. A grid that records face fluxes
+    // reads, after it, the volume each face carried in this step and 0 on
+    // faces that carried nothing.
     virtual void advance(Grid &grid, const SubstepPlan &plan, const BookSubstep &book, StepInfo &info) const = 0;
 
     // The relaxation to rest (DPSM_RELAX_TO_REST), with the contract of

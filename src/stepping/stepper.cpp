@@ -16,13 +16,12 @@ double stable_dt(const Grid &grid) { return engine_for(grid).stable_dt(grid); }
 
 namespace {
 
-// A step that records face fluxes starts from none: a 2D grid's tiles are
-// cleared as the step first visits them (structured/tiled_sweep.cpp), a line's faces here.
+// A step that records face fluxes starts from none: the engine clears the
+// faces it will write (Engine::advance), this numbers the step.
 void begin_face_fluxes(Grid &grid) {
     FaceFluxes &fluxes = grid.face_fluxes();
     ++fluxes.step;
     fluxes.available = true;
-    if (grid.geometry().dim == 1) std::fill(fluxes.x.begin(), fluxes.x.end(), 0.0);
 }
 
 // Without a source that makes a face steep (`driven`), the slide flux only

@@ -87,6 +87,10 @@ public:
 
     void advance(Grid &grid, const SubstepPlan &plan, const BookSubstep &book, StepInfo &info) const override {
         const double cells = static_cast<double>(grid.geometry().cells());
+        if (grid.records_face_fluxes()) {
+            std::vector<double> &faces = grid.face_fluxes().x;
+            std::fill(faces.begin(), faces.end(), 0.0);
+        }
         for (std::int64_t k = 0; k < plan.substeps; ++k) {
             const SubstepSummary sweep = slide_rates_1d(grid, plan.sub_dt, grid.records_face_fluxes());
             // Once nothing moves, a source that cannot make a face steep by the
