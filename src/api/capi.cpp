@@ -84,19 +84,29 @@ void require_positive(double value, const char *function, const char *name) {
 
 const char *describe(double value) { return std::isnan(value) ? "NaN" : value > 0 ? "+Inf" : "-Inf"; }
 
+// Names the first value that is not finite or lies beyond the supported
+// range by its index and `where(k)`, the place it stands for.
+template <class Where>
+void require_in_range(const double *values, std::int64_t n, const char *function, const char *name, Where &&where) {
+    for (std::int64_t k = 0; k < n; ++k) {
+        if (std::isfinite(values[k]) && std::fabs(values[k]) <= kMaxMagnitude) continue;
+        if (!std::isfinite(values[k]))
+            fail(DPSM_ERR_INVALID_VALUE, function, name, "[", k, "] (", where(k), ") is ", describe(values[k]));
+        fail(DPSM_ERR_INVALID_VALUE, function, name, "[", k, "] (", where(k), ") = ", values[k],
+             " is outside the supported range [-1e50, 1e50]");
+    }
+}
+
+std::string cell_name(std::int64_t i, std::int64_t j) {
+    return "cell i = " + std::to_string(i) + ", j = " + std::to_string(j);
+}
+
 // Names the first non-finite element by its index and cell.
 void require_finite_array(const dpsm_grid *g, const double *values, const char *function, const char *name) {
     require_pointer(values, function, name);
     const dpsm::Geometry &geo = g->core.geometry();
-    const std::int64_t n = geo.cells();
-    for (std::int64_t c = 0; c < n; ++c) {
-        if (!std::isfinite(values[c]))
-            fail(DPSM_ERR_INVALID_VALUE, function, name, "[", c, "] (cell i = ", c % geo.nx, ", j = ", c / geo.nx,
-                 ") is ", describe(values[c]));
-        if (!(std::fabs(values[c]) <= kMaxMagnitude))
-            fail(DPSM_ERR_INVALID_VALUE, function, name, "[", c, "] (cell i = ", c % geo.nx, ", j = ", c / geo.nx,
-                 ") = ", values[c], " is outside the supported range [-1e50, 1e50]");
-    }
+    require_in_range(values, geo.cells(), function, name,
+                     [&](std::int64_t c) { return cell_name(c % geo.nx, c / geo.nx); });
 }
 
 void require_size(std::int64_t n, const char *function, const char *name) {
@@ -121,14 +131,8 @@ dpsm::Grid::Block require_block(const dpsm_grid *g, std::int64_t i0, std::int64_
 // Names the first non-finite value of a block by its index and cell.
 void require_finite_block(const double *values, const dpsm::Grid::Block &b, const char *function, const char *name) {
     require_pointer(values, function, name);
-    for (std::int64_t k = 0; k < b.ni * b.nj; ++k) {
-        if (!std::isfinite(values[k]))
-            fail(DPSM_ERR_INVALID_VALUE, function, name, "[", k, "] (cell i = ", b.i0 + k % b.ni, ", j = ", b.j0 + k / b.ni,
-                 ") is ", describe(values[k]));
-        if (!(std::fabs(values[k]) <= kMaxMagnitude))
-            fail(DPSM_ERR_INVALID_VALUE, function, name, "[", k, "] (cell i = ", b.i0 + k % b.ni, ", j = ", b.j0 + k / b.ni,
-                 ") = ", values[k], " is outside the supported range [-1e50, 1e50]");
-    }
+    require_in_range(values, b.ni * b.nj, function, name,
+                     [&](std::int64_t k) { return cell_name(b.i0 + k % b.ni, b.j0 + k / b.ni); });
 }
 
 void require_scale(double value, const char *function, const char *name) {
@@ -576,15 +580,10 @@ int dpsm_set_side_levels(dpsm_grid *g, int side, const double *levels) {
         if (levels) {
             const dpsm::Geometry &geo = g->core.geometry();
             const bool x_side = side <= DPSM_XMAX;
-            const std::int64_t n = x_side ? geo.ny : geo.nx;
-            for (std::int64_t k = 0; k < n; ++k) {
-                if (std::isfinite(levels[k]) && std::fabs(levels[k]) <= kMaxMagnitude) continue;
-                if (!std::isfinite(levels[k]))
-                    fail(DPSM_ERR_INVALID_VALUE, fn, "levels[", k, "] (the face of cell ", x_side ? "j = " : "i = ", k,
-                         " on side ", side_name(side), ") is ", describe(levels[k]));
-                fail(DPSM_ERR_INVALID_VALUE, fn, "levels[", k, "] (the face of cell ", x_side ? "j = " : "i = ", k,
-                     " on side ", side_name(side), ") = ", levels[k], " is outside the supported range [-1e50, 1e50]");
-            }
+            require_in_range(levels, x_side ? geo.ny : geo.nx, fn, "levels", [&](std::int64_t k) {
+                return std::string("the face of cell ") + (x_side ? "j = " : "i = ") + std::to_string(k) + " on side " +
+                       side_name(side);
+            });
         }
         g->core.set_side_levels(side, levels);
     });

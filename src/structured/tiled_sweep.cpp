@@ -147,6 +147,13 @@ RowSpan inside_of_row(const Geometry &geo, std::int64_t gi0, std::int64_t j, int
     return {c0, static_cast<int>(std::clamp<std::int64_t>(geo.nx - gi0, c0, width))};
 }
 
+// Calls f(c) for the columns of a buffer row of `width` cells outside `span`.
+template <class F>
+void for_columns_outside(const RowSpan &span, int width, F &&f) {
+    for (int c = 0; c < span.c0; ++c) f(c);
+    for (int c = span.c1; c < width; ++c) f(c);
+}
+
 // Copies a tile and its halo into the buffers, ghosts beyond the edge: the
 // heights (and residuals) unless `heights` is false, the kinds of masked
 // tiles, the sources of tiles that have them (those in `sources`, the box of
@@ -237,9 +244,7 @@ void gather_physics(const Grid &grid, const HaloStore *halo, TileBuffers &b, std
             if (angles) std::memcpy(b.tan_theta.data() + row + c_in0, tan_theta.data() + at, sizeof(double) * count);
             if (flags) std::memcpy(b.moving[0].data() + row + c_in0, moving.data() + at, count);
         }
-        for (int c = 0; c < b.width; ++c) {
-            if (c == c_in0) c = c_in1;  // past the span copied
-            if (c >= b.width) break;
+        for_columns_outside({c_in0, c_in1}, b.width, [&](int c) {
             const std::int64_t i = gi0 + c;
             const std::size_t at = row + static_cast<std::size_t>(c);
             const bool from_halo = halo && halo->in_domain(i, j);
@@ -247,7 +252,7 @@ void gather_physics(const Grid &grid, const HaloStore *halo, TileBuffers &b, std
             if (bed) b.bed[at] = from_halo ? halo->bed[k] : 0.0;
             if (angles) b.tan_theta[at] = from_halo ? halo->tan_theta[k] : 0.0;
             if (flags) b.moving[0][at] = from_halo ? halo->moving[k] : 0;
-        }
+        });
     }
 }
 
@@ -262,10 +267,7 @@ void gather_halo(const Grid &grid, const HaloStore &halo, TileBuffers &b, std::i
         const std::int64_t j = gj0 + r;
         const std::size_t row = static_cast<std::size_t>(r) * b.width;
         // The block's own columns of this row, [own0, own1) in the buffer (none off the block's rows).
-        const auto [own0, own1] = inside_of_row(geo, gi0, j, b.width);
-        for (int c = 0; c < b.width; ++c) {
-            if (c == own0) c = own1;
-            if (c >= b.width) break;
+        for_columns_outside(inside_of_row(geo, gi0, j, b.width), b.width, [&](int c) {
             const std::int64_t i = gi0 + c;
             const std::size_t at = row + static_cast<std::size_t>(c);
             if (halo.in_domain(i, j)) {
@@ -280,7 +282,7 @@ void gather_halo(const Grid &grid, const HaloStore &halo, TileBuffers &b, std::i
                 if (masked) b.kind[at] = ghost_kind(grid, i + halo.i0, j + halo.j0, halo.global_nx, halo.global_ny);
                 if (source) b.source[at] = 0.0;
             }
-        }
+        });
     }
 }
 
@@ -295,19 +297,15 @@ void gather_since(const Grid &grid, const HaloStore *halo, TileBuffers &b, std::
         const std::int64_t j = gj0 + r;
         double *__restrict since = b.since[0].data() + static_cast<std::size_t>(r) * b.width;
         // The row's cells in the domain are one span; the rest lie beyond it.
-        const bool row_in = j >= 0 && j < geo.ny;
-        const int c0 = row_in ? static_cast<int>(std::clamp<std::int64_t>(-gi0, 0, b.width)) : b.width;
-        const int c1 = row_in ? static_cast<int>(std::clamp<std::int64_t>(geo.nx - gi0, c0, b.width)) : b.width;
+        const RowSpan span = inside_of_row(geo, gi0, j, b.width);
         const double *from = clock + (j * geo.nx + gi0);
-        if (r + kRowsAhead < b.height && j + kRowsAhead < geo.ny && c0 < c1)
-            simd::prefetch<false>(from + c0 + kRowsAhead * geo.nx, c1 - c0);
-        for (int c = c0; c < c1; ++c) since[c] = (from[c] > base ? from[c] : base) - base;
-        for (int c = 0; c < b.width; ++c) {
-            if (c == c0) c = c1;
-            if (c >= b.width) break;
+        if (r + kRowsAhead < b.height && j + kRowsAhead < geo.ny && span.c0 < span.c1)
+            simd::prefetch<false>(from + span.c0 + kRowsAhead * geo.nx, span.c1 - span.c0);
+        for (int c = span.c0; c < span.c1; ++c) since[c] = (from[c] > base ? from[c] : base) - base;
+        for_columns_outside(span, b.width, [&](int c) {
             const std::int64_t i = gi0 + c;
             since[c] = halo && halo->in_domain(i, j) ? halo->since[halo->index(i, j)] : 0.0;
-        }
+        });
     }
 }
 
