@@ -268,6 +268,12 @@ static const command kCommands[] = {
      "[n [runs [scene]]]  the fully active n^2 (2048^2) surface plain and with a bed, an angle field, flux exponents, a"
      " static angle; 1 and 2 threads, best of runs (3); cost against the plain scene (DPSM_SCALAR_PHYSICS=1: the scalar"
      " kernel); a scene named: that one alone"},
+    {"mesh", cmd_mesh,
+     "[n [runs]]  2 n^2 (n = 708: 1,002,528) jittered triangles: a fully active sub-step on 1 and 2 threads against the"
+     " plain face loop; ridges on ~1 % of cells and a mesh at rest against a fully active sub-step"},
+    {"mesh-accuracy", cmd_mesh_accuracy,
+     "[threads [levels [mesh]]]  column collapse (a = 0.5, 30 deg) to rest on quadrilaterals, jittered triangles, hexagons and"
+     " the median dual at about 4,000, 16,000, 65,000 cells: L1 error, order, runout; the cone on triangles"},
     {"steps", cmd_steps, "explicit sub-steps against the bounded exchange at dt -> infinity: time and error to rest"},
     {"sts", cmd_sts, "time-accurate super-time-stepping against forward Euler: cone, column per call, steep plane"},
     {"work-precision", cmd_work_precision,

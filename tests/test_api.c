@@ -2127,11 +2127,14 @@ static void test_bad_mobility(void **state) {
 
 static void test_bad_boundary(void **state) {
     fixture_t *fx = *state;
-    const int bad_sides[] = {-1, 4, 5, 255, INT_MAX, INT_MIN};
+    const int bad_sides[] = {-1, 5, 255, INT_MAX, INT_MIN};
     for (size_t k = 0; k < sizeof bad_sides / sizeof *bad_sides; ++k)
         for (int kind = DPSM_OPEN; kind <= DPSM_WALL; ++kind)
             EXPECT_FAIL(fx, dpsm_set_boundary(fx->g, bad_sides[k], kind), DPSM_ERR_UNKNOWN_ENUM, "dpsm_set_boundary",
                         "side");
+    /* The edge of a mesh is a side a grid does not have. */
+    EXPECT_FAIL(fx, dpsm_set_boundary(fx->g, DPSM_MESH_EDGE, DPSM_OPEN), DPSM_ERR_NOT_APPLICABLE, "dpsm_set_boundary",
+                "DPSM_MESH_EDGE");
     const int bad_kinds[] = {-1, 2, 3, 255, INT_MAX, INT_MIN};
     for (size_t k = 0; k < sizeof bad_kinds / sizeof *bad_kinds; ++k)
         EXPECT_FAIL(fx, dpsm_set_boundary(fx->g, DPSM_XMIN, bad_kinds[k]), DPSM_ERR_UNKNOWN_ENUM, "dpsm_set_boundary",
@@ -2447,11 +2450,12 @@ static void test_bad_side_levels(void **state) {
     const char *fn = "dpsm_set_side_levels";
     double levels[MAX_CELLS];
     for (int k = 0; k < MAX_CELLS; ++k) levels[k] = 0.7 + 0.01 * k;
-    const int bad_sides[] = {-1, 4, 5, 255, INT_MAX, INT_MIN};
+    const int bad_sides[] = {-1, 5, 255, INT_MAX, INT_MIN};
     for (size_t k = 0; k < sizeof bad_sides / sizeof *bad_sides; ++k) {
         EXPECT_FAIL(fx, dpsm_set_side_levels(fx->g, bad_sides[k], levels), DPSM_ERR_UNKNOWN_ENUM, fn, "side");
         EXPECT_FAIL(fx, dpsm_set_side_levels(fx->g, bad_sides[k], NULL), DPSM_ERR_UNKNOWN_ENUM, fn, "side");
     }
+    EXPECT_FAIL(fx, dpsm_set_side_levels(fx->g, DPSM_MESH_EDGE, levels), DPSM_ERR_NOT_APPLICABLE, fn, "DPSM_MESH_EDGE");
     const double bad[] = {NAN, INFINITY, -INFINITY, 2e50, -2e50};
     char detail[32];
     for (int side = DPSM_XMIN; side <= DPSM_YMAX; ++side) {
@@ -2486,9 +2490,10 @@ static void test_bad_side_outflow(void **state) {
     fixture_t *fx = *state;
     const char *fn = "dpsm_get_side_outflow";
     double v = 0.0;
-    const int bad_sides[] = {-1, 4, 5, 255, INT_MAX, INT_MIN};
+    const int bad_sides[] = {-1, 5, 255, INT_MAX, INT_MIN};
     for (size_t k = 0; k < sizeof bad_sides / sizeof *bad_sides; ++k)
         EXPECT_FAIL(fx, dpsm_get_side_outflow(fx->g, bad_sides[k], &v), DPSM_ERR_UNKNOWN_ENUM, fn, "side");
+    EXPECT_FAIL(fx, dpsm_get_side_outflow(fx->g, DPSM_MESH_EDGE, &v), DPSM_ERR_NOT_APPLICABLE, fn, "DPSM_MESH_EDGE");
     for (int side = DPSM_XMIN; side <= DPSM_YMAX; ++side) {
         if (fixture_has_side(fx, side))
             EXPECT_FAIL(fx, dpsm_get_side_outflow(fx->g, side, NULL), DPSM_ERR_NULL_POINTER, fn, "value");

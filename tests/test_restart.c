@@ -552,10 +552,10 @@ static void test_values_are_checked_behind_the_checksum(void **state) {
     REQUIRE(get_u32(good + kOffsetVersion) == 1, "the small file is of version %u, not 1",
             get_u32(good + kOffsetVersion));
     memcpy(bytes, good, size);
-    put_u32(bytes + kOffsetVersion, 5);
+    put_u32(bytes + kOffsetVersion, 6);
     reseal(bytes, size);
     write_file(bad, bytes, size);
-    require_refused(bad, "written by a newer dpsm, version 5", "version 5");
+    require_refused(bad, "written by a newer dpsm, version 6", "version 6");
 
     /* The relaxations' flags: DPSM_RELAX_AUTO's needs version 3, and a file
      * cannot ask for both. */

@@ -3,7 +3,8 @@
 !> One hand-written module over iso_c_binding:
 !>
 !>  - type(dpsm_grid) holds the C handle (a private type(c_ptr)); a grid is made
-!>    by dpsm_create_1d / dpsm_create_2d / dpsm_create_axisymmetric and released
+!>    by dpsm_create_1d / dpsm_create_2d / dpsm_create_axisymmetric (a mesh by
+!>    dpsm_create_mesh / dpsm_create_graph / dpsm_create_dual_mesh) and released
 !>    by dpsm_destroy, explicitly (there is no finalizer: copies of a
 !>    type(dpsm_grid) share one handle, as copies of a C pointer do).
 !>  - Every C function has a subroutine of the same name taking the C arguments
@@ -20,6 +21,14 @@
 !>    axisymmetric grids), real(c_double); cell kinds integer(c_int8_t). Their
 !>    shape is checked against the grid (dpsm_get_shape) before C is called; a
 !>    mismatch fails with DPSM_ERR_INVALID_SIZE and a message naming both shapes.
+!>  - Meshes: the constructors take node and cell indices 1-based, as Fortran
+!>    hosts hold them (0 for the domain edge in face_cells), and pass C 0-based
+!>    copies; dpsm_get_mesh_faces returns them 1-based. Pairs and triples are
+!>    columns: node_xy(2, nnodes), face_cells(2, nfaces), triangle_nodes(3,
+!>    ntriangles). On a mesh every per-cell array is h(ncells) (or
+!>    h(ncells, 1)), face arrays (dpsm_get_face_fluxes' fx, dpsm_set_edge_kinds'
+!>    kinds, the levels of DPSM_MESH_EDGE) hold nfaces values. Messages of the
+!>    C library count from 0 (see "meshes" below).
 !>  - Paths (dpsm_save, dpsm_load) are default character strings; trailing
 !>    blanks are dropped, so a path held in a longer variable may be passed.
 !>  - Every #define constant of dpsm.h is a parameter of the same name.
@@ -50,6 +59,7 @@ module dpsm
   integer(c_int), parameter, public :: DPSM_XMAX = 1
   integer(c_int), parameter, public :: DPSM_YMIN = 2
   integer(c_int), parameter, public :: DPSM_YMAX = 3
+  integer(c_int), parameter, public :: DPSM_MESH_EDGE = 4
   ! Boundary kinds.
   integer(c_int), parameter, public :: DPSM_OPEN = 0
   integer(c_int), parameter, public :: DPSM_WALL = 1
@@ -97,6 +107,16 @@ module dpsm
     character(len=:), allocatable :: message
   end type grid_state
 
+  !> Messages of failures found on the Fortran side when there is no grid to
+  !> keep them (a mesh constructor given arrays of the wrong size), for
+  !> dpsm_last_error() without a grid. no_grid_snapshot is what C's
+  !> dpsm_last_error(NULL) said at that moment: once C reports another
+  !> failure without a grid, that newer message is the one returned. Unlike
+  !> C's, which is kept per thread, these are shared by the threads of a
+  !> program: read the message in the thread that failed, before another
+  !> thread fails a create.
+  character(len=:), allocatable :: no_grid_message, no_grid_snapshot
+
   !> A dpsm grid: the C handle. Default-initialized to no grid (C's NULL).
   type, public :: dpsm_grid
     private
@@ -115,6 +135,8 @@ module dpsm
   public :: dpsm_set_side_levels, dpsm_get_side_outflow, dpsm_set_face_flux_recording, dpsm_get_face_fluxes
   public :: dpsm_save, dpsm_load
   public :: dpsm_last_error, dpsm_status_string, dpsm_version_string, dpsm_version_number
+  public :: dpsm_create_mesh, dpsm_create_graph, dpsm_create_dual_mesh
+  public :: dpsm_get_face_count, dpsm_get_mesh_faces, dpsm_set_edge_kinds
   ! Not in C: .true. when g holds a grid (its handle is not NULL).
   public :: dpsm_associated
   ! Not in C: for companion modules (dpsm_mpi) whose own C constructors make
@@ -130,6 +152,24 @@ module dpsm
   interface dpsm_create_axisymmetric
     module procedure create_axisymmetric_i64, create_axisymmetric_i32
   end interface dpsm_create_axisymmetric
+  interface dpsm_create_mesh
+    module procedure create_mesh_i64, create_mesh_i32
+  end interface dpsm_create_mesh
+  interface dpsm_create_graph
+    module procedure create_graph_i64, create_graph_i32
+  end interface dpsm_create_graph
+  interface dpsm_create_dual_mesh
+    module procedure create_dual_mesh_i64, create_dual_mesh_i32
+  end interface dpsm_create_dual_mesh
+  interface dpsm_get_face_count
+    module procedure get_face_count_i64, get_face_count_i32
+  end interface dpsm_get_face_count
+  interface dpsm_get_mesh_faces
+    module procedure get_mesh_faces_i64, get_mesh_faces_i32
+  end interface dpsm_get_mesh_faces
+  interface dpsm_set_edge_kinds
+    module procedure set_edge_kinds_r1, set_edge_kinds_none
+  end interface dpsm_set_edge_kinds
   interface dpsm_set_cell_kinds
     module procedure set_cell_kinds_r1, set_cell_kinds_r2, set_cell_kinds_none
   end interface dpsm_set_cell_kinds
@@ -195,6 +235,51 @@ module dpsm
       real(c_double), value :: dr
       type(c_ptr), intent(out) :: out
     end function c_dpsm_create_axisymmetric
+
+    integer(c_int) function c_dpsm_create_mesh(nnodes, node_xy, ncells, cell_start, cell_nodes, out) &
+        bind(C, name='dpsm_create_mesh')
+      import :: c_int, c_int64_t, c_double, c_ptr
+      integer(c_int64_t), value :: nnodes, ncells
+      real(c_double), intent(in) :: node_xy(*)
+      integer(c_int64_t), intent(in) :: cell_start(*), cell_nodes(*) ! 0-based
+      type(c_ptr), intent(out) :: out
+    end function c_dpsm_create_mesh
+
+    integer(c_int) function c_dpsm_create_graph(ncells, cell_xy, cell_area, nfaces, face_cells, face_xy, face_length, &
+                                                out) bind(C, name='dpsm_create_graph')
+      import :: c_int, c_int64_t, c_double, c_ptr
+      integer(c_int64_t), value :: ncells, nfaces
+      real(c_double), intent(in) :: cell_xy(*), cell_area(*), face_xy(*), face_length(*)
+      integer(c_int64_t), intent(in) :: face_cells(*) ! 0-based, -1 on the domain edge
+      type(c_ptr), intent(out) :: out
+    end function c_dpsm_create_graph
+
+    integer(c_int) function c_dpsm_create_dual_mesh(nnodes, node_xy, ntriangles, triangle_nodes, out) &
+        bind(C, name='dpsm_create_dual_mesh')
+      import :: c_int, c_int64_t, c_double, c_ptr
+      integer(c_int64_t), value :: nnodes, ntriangles
+      real(c_double), intent(in) :: node_xy(*)
+      integer(c_int64_t), intent(in) :: triangle_nodes(*) ! 0-based
+      type(c_ptr), intent(out) :: out
+    end function c_dpsm_create_dual_mesh
+
+    integer(c_int) function c_dpsm_get_face_count(g, nfaces) bind(C, name='dpsm_get_face_count')
+      import :: c_int, c_int64_t, c_ptr
+      type(c_ptr), value :: g
+      integer(c_int64_t), intent(out) :: nfaces
+    end function c_dpsm_get_face_count
+
+    integer(c_int) function c_dpsm_get_mesh_faces(g, face_cells) bind(C, name='dpsm_get_mesh_faces')
+      import :: c_int, c_int64_t, c_ptr
+      type(c_ptr), value :: g
+      integer(c_int64_t), intent(inout) :: face_cells(*) ! 0-based, -1 on the domain edge
+    end function c_dpsm_get_mesh_faces
+
+    integer(c_int) function c_dpsm_set_edge_kinds(g, kinds) bind(C, name='dpsm_set_edge_kinds')
+      import :: c_int, c_int8_t, c_ptr
+      type(c_ptr), value :: g
+      integer(c_int8_t), intent(in), optional :: kinds(*) ! absent: NULL
+    end function c_dpsm_set_edge_kinds
 
     subroutine c_dpsm_destroy(g) bind(C, name='dpsm_destroy')
       import :: c_ptr
@@ -685,6 +770,349 @@ contains
     if (present(ierr)) ierr = int(DPSM_OK)
   end subroutine dpsm_destroy
 
+  ! ==== meshes ===============================================================
+  !
+  ! The constructors take the host's arrays with 1-based node and cell
+  ! indices, as Fortran hosts hold them, and call C with 0-based copies:
+  ! cell_start(ncells+1) starts at 1 (cell c has the nodes
+  ! cell_nodes(cell_start(c) : cell_start(c+1)-1)), face_cells(2, nfaces) holds
+  ! 0 for the domain edge (C's -1), triangle_nodes(3, ntriangles). Coordinates
+  ! are node_xy(2, nnodes) (x in row 1, y in row 2: C's (x, y) pairs).
+  !
+  ! The sizes are checked against the arrays here (a mismatch fails with
+  ! DPSM_ERR_INVALID_SIZE and a message naming both, which dpsm_last_error()
+  ! returns); everything else is checked by C. C's messages name the 0-based
+  ! copies it was given, not the host's arrays: an index in brackets is the
+  ! Fortran position less 1 (cell_nodes[4] is cell_nodes(5), face_cells[2f+1]
+  ! is face_cells(2, f+1)), cell, node, face and triangle numbers count from 0,
+  ! and the values shown are the converted ones, one less than the host's (a
+  ! node index 10 on a mesh of 9 nodes reads "= 9 is not a node index in
+  ! [0, 8]"; a face_cells value of -3 reads -4, an edge cell 0 reads -1).
+  ! The routines that take or return face arrays (dpsm_get_mesh_faces,
+  ! dpsm_set_edge_kinds) number the faces from 1, as the other arrays.
+
+  !> Records a failure found on the Fortran side when there is no grid to
+  !> keep it, for dpsm_last_error().
+  subroutine set_no_grid_message(message)
+    character(len=*), intent(in) :: message
+    no_grid_message = message
+    no_grid_snapshot = from_c_string(c_dpsm_last_error(c_null_ptr))
+  end subroutine set_no_grid_message
+
+  !> dpsm_last_error(NULL): C's message, or a newer one of the Fortran side.
+  function last_error_without_grid() result(message)
+    character(len=:), allocatable :: message
+    message = from_c_string(c_dpsm_last_error(c_null_ptr))
+    if (allocated(no_grid_message) .and. allocated(no_grid_snapshot)) then
+      if (len(message) == len(no_grid_snapshot)) then
+        if (message == no_grid_snapshot) message = no_grid_message
+      end if
+    end if
+  end function last_error_without_grid
+
+  !> DPSM_OK when `array_shape` is (rows, n), else DPSM_ERR_INVALID_SIZE with
+  !> a message without a grid.
+  function check_columns(where, name, array_shape, rows, n, n_name) result(status)
+    character(len=*), intent(in) :: where, name, n_name
+    integer, intent(in) :: array_shape(:)
+    integer, intent(in) :: rows
+    integer(c_int64_t), intent(in) :: n
+    integer(c_int) :: status
+    status = DPSM_OK
+    if (size(array_shape) == 2) then
+      if (array_shape(1) == rows .and. int(array_shape(2), c_int64_t) == n) return
+    else
+      if (int(array_shape(1), c_int64_t) == n) return
+    end if
+    status = DPSM_ERR_INVALID_SIZE
+    if (size(array_shape) == 2) then
+      call set_no_grid_message(where//': '//name//' has shape '//shape_string(array_shape)//' but '//n_name//' = '// &
+                               itoa(n)//': pass '//name//'('//itoa(int(rows, c_int64_t))//', '//n_name//')')
+    else
+      call set_no_grid_message(where//': '//name//' has '//itoa(int(array_shape(1), c_int64_t))//' values but '// &
+                               n_name//' = '//itoa(n)//': pass '//name//'('//n_name//')')
+    end if
+  end function check_columns
+
+  !> dpsm_create_mesh(g, nnodes, node_xy, ncells, cell_start, cell_nodes[, ierr]):
+  !> a mesh of polygonal cells, node_xy(2, nnodes), cell_start(ncells+1) from 1,
+  !> cell_nodes(cell_start(ncells+1)-1) of 1-based node indices. Sizes and
+  !> indices are integer(c_int64_t) or all default integers.
+  subroutine create_mesh_i64(g, nnodes, node_xy, ncells, cell_start, cell_nodes, ierr)
+    type(dpsm_grid), intent(out) :: g
+    integer(c_int64_t), intent(in) :: nnodes
+    real(c_double), intent(in), contiguous :: node_xy(:, :)
+    integer(c_int64_t), intent(in) :: ncells
+    integer(c_int64_t), intent(in) :: cell_start(:), cell_nodes(:)
+    integer, intent(out), optional :: ierr
+    character(len=*), parameter :: fn = 'dpsm_create_mesh'
+    type(c_ptr) :: ptr
+    integer(c_int) :: status
+    integer(c_int64_t), allocatable :: start0(:), nodes0(:)
+    status = DPSM_OK
+    ! Counts below 1 are refused by C, with its message, before it reads an array.
+    if (nnodes >= 1 .and. ncells >= 1) then
+      status = check_columns(fn, 'node_xy', shape(node_xy), 2, nnodes, 'nnodes')
+      if (status == DPSM_OK) status = check_columns(fn, 'cell_start', shape(cell_start), 1, ncells + 1, 'ncells+1')
+      ! C reads cell_start(ncells+1)-1 node indices once cell_start(1) is 1
+      ! and every cell has at least 3 nodes; it refuses the others first.
+      if (status == DPSM_OK .and. cell_start(1) == 1) &
+        status = check_columns(fn, 'cell_nodes', shape(cell_nodes), 1, cell_start(ncells + 1) - 1, &
+                               'cell_start(ncells+1)-1')
+    end if
+    ptr = c_null_ptr
+    if (status == DPSM_OK) then
+      allocate (start0, source=cell_start - 1)
+      allocate (nodes0, source=cell_nodes - 1)
+      status = c_dpsm_create_mesh(nnodes, node_xy, ncells, start0, nodes0, ptr)
+    end if
+    call adopt(g, ptr, status)
+    call finish(status, ierr, fn)
+  end subroutine create_mesh_i64
+
+  subroutine create_mesh_i32(g, nnodes, node_xy, ncells, cell_start, cell_nodes, ierr)
+    type(dpsm_grid), intent(out) :: g
+    integer(c_int32_t), intent(in) :: nnodes
+    real(c_double), intent(in), contiguous :: node_xy(:, :)
+    integer(c_int32_t), intent(in) :: ncells
+    integer(c_int32_t), intent(in) :: cell_start(:), cell_nodes(:)
+    integer, intent(out), optional :: ierr
+    call create_mesh_i64(g, i64(nnodes), node_xy, i64(ncells), i64(cell_start), i64(cell_nodes), ierr)
+  end subroutine create_mesh_i32
+
+  !> dpsm_create_graph(g, ncells, cell_xy, cell_area, nfaces, face_cells, face_xy, face_length[, ierr]):
+  !> a mesh from a finite-volume graph: cell_xy(2, ncells) centres,
+  !> cell_area(ncells), face_cells(2, nfaces) the 1-based cells (a, b) of each
+  !> face, b = 0 on the domain edge, face_xy(2, nfaces) midpoints,
+  !> face_length(nfaces). Faces keep the host's order.
+  subroutine create_graph_i64(g, ncells, cell_xy, cell_area, nfaces, face_cells, face_xy, face_length, ierr)
+    type(dpsm_grid), intent(out) :: g
+    integer(c_int64_t), intent(in) :: ncells
+    real(c_double), intent(in), contiguous :: cell_xy(:, :), cell_area(:)
+    integer(c_int64_t), intent(in) :: nfaces
+    integer(c_int64_t), intent(in), contiguous :: face_cells(:, :)
+    real(c_double), intent(in), contiguous :: face_xy(:, :), face_length(:)
+    integer, intent(out), optional :: ierr
+    character(len=*), parameter :: fn = 'dpsm_create_graph'
+    type(c_ptr) :: ptr
+    integer(c_int) :: status
+    integer(c_int64_t), allocatable :: cells0(:, :)
+    status = DPSM_OK
+    if (ncells >= 1 .and. nfaces >= 1) then
+      status = check_columns(fn, 'cell_xy', shape(cell_xy), 2, ncells, 'ncells')
+      if (status == DPSM_OK) status = check_columns(fn, 'cell_area', shape(cell_area), 1, ncells, 'ncells')
+      if (status == DPSM_OK) status = check_columns(fn, 'face_cells', shape(face_cells), 2, nfaces, 'nfaces')
+      if (status == DPSM_OK) status = check_columns(fn, 'face_xy', shape(face_xy), 2, nfaces, 'nfaces')
+      if (status == DPSM_OK) status = check_columns(fn, 'face_length', shape(face_length), 1, nfaces, 'nfaces')
+    end if
+    ptr = c_null_ptr
+    if (status == DPSM_OK) then
+      allocate (cells0, source=face_cells - 1) ! the domain edge, 0, becomes C's -1
+      status = c_dpsm_create_graph(ncells, cell_xy, cell_area, nfaces, cells0, face_xy, face_length, ptr)
+    end if
+    call adopt(g, ptr, status)
+    call finish(status, ierr, fn)
+  end subroutine create_graph_i64
+
+  subroutine create_graph_i32(g, ncells, cell_xy, cell_area, nfaces, face_cells, face_xy, face_length, ierr)
+    type(dpsm_grid), intent(out) :: g
+    integer(c_int32_t), intent(in) :: ncells
+    real(c_double), intent(in), contiguous :: cell_xy(:, :), cell_area(:)
+    integer(c_int32_t), intent(in) :: nfaces
+    integer(c_int32_t), intent(in), contiguous :: face_cells(:, :)
+    real(c_double), intent(in), contiguous :: face_xy(:, :), face_length(:)
+    integer, intent(out), optional :: ierr
+    call create_graph_i64(g, i64(ncells), cell_xy, cell_area, i64(nfaces), i64(face_cells), face_xy, face_length, ierr)
+  end subroutine create_graph_i32
+
+  !> dpsm_create_dual_mesh(g, nnodes, node_xy, ntriangles, triangle_nodes[, ierr]):
+  !> the median dual of a triangle mesh, one cell per node: node_xy(2, nnodes),
+  !> triangle_nodes(3, ntriangles) of 1-based node indices.
+  subroutine create_dual_mesh_i64(g, nnodes, node_xy, ntriangles, triangle_nodes, ierr)
+    type(dpsm_grid), intent(out) :: g
+    integer(c_int64_t), intent(in) :: nnodes
+    real(c_double), intent(in), contiguous :: node_xy(:, :)
+    integer(c_int64_t), intent(in) :: ntriangles
+    integer(c_int64_t), intent(in), contiguous :: triangle_nodes(:, :)
+    integer, intent(out), optional :: ierr
+    character(len=*), parameter :: fn = 'dpsm_create_dual_mesh'
+    type(c_ptr) :: ptr
+    integer(c_int) :: status
+    integer(c_int64_t), allocatable :: nodes0(:, :)
+    status = DPSM_OK
+    if (nnodes >= 1 .and. ntriangles >= 1) then
+      status = check_columns(fn, 'node_xy', shape(node_xy), 2, nnodes, 'nnodes')
+      if (status == DPSM_OK) &
+        status = check_columns(fn, 'triangle_nodes', shape(triangle_nodes), 3, ntriangles, 'ntriangles')
+    end if
+    ptr = c_null_ptr
+    if (status == DPSM_OK) then
+      allocate (nodes0, source=triangle_nodes - 1)
+      status = c_dpsm_create_dual_mesh(nnodes, node_xy, ntriangles, nodes0, ptr)
+    end if
+    call adopt(g, ptr, status)
+    call finish(status, ierr, fn)
+  end subroutine create_dual_mesh_i64
+
+  subroutine create_dual_mesh_i32(g, nnodes, node_xy, ntriangles, triangle_nodes, ierr)
+    type(dpsm_grid), intent(out) :: g
+    integer(c_int32_t), intent(in) :: nnodes
+    real(c_double), intent(in), contiguous :: node_xy(:, :)
+    integer(c_int32_t), intent(in) :: ntriangles
+    integer(c_int32_t), intent(in), contiguous :: triangle_nodes(:, :)
+    integer, intent(out), optional :: ierr
+    call create_dual_mesh_i64(g, i64(nnodes), node_xy, i64(ntriangles), i64(triangle_nodes), ierr)
+  end subroutine create_dual_mesh_i32
+
+  !> dpsm_get_face_count(g, nfaces[, ierr]): the faces of a mesh, interior and
+  !> on the domain edge (DPSM_ERR_NOT_APPLICABLE on a grid).
+  subroutine get_face_count_i64(g, nfaces, ierr)
+    type(dpsm_grid), intent(in) :: g
+    integer(c_int64_t), intent(out) :: nfaces
+    integer, intent(out), optional :: ierr
+    call clear_message(g)
+    call finish(c_dpsm_get_face_count(g%ptr, nfaces), ierr, 'dpsm_get_face_count', g)
+  end subroutine get_face_count_i64
+
+  subroutine get_face_count_i32(g, nfaces, ierr)
+    type(dpsm_grid), intent(in) :: g
+    integer(c_int32_t), intent(out) :: nfaces
+    integer, intent(out), optional :: ierr
+    integer(c_int64_t) :: n64
+    integer(c_int) :: status
+    call clear_message(g)
+    nfaces = 0
+    status = c_dpsm_get_face_count(g%ptr, n64)
+    if (status == DPSM_OK) then
+      if (n64 > huge(nfaces)) then
+        status = DPSM_ERR_INVALID_SIZE
+        call set_message(g, 'dpsm_get_face_count: the mesh has nfaces = '//itoa(n64)// &
+                         ', too large for integer(c_int32_t): pass an integer(c_int64_t) variable')
+      else
+        nfaces = int(n64, c_int32_t)
+      end if
+    end if
+    call finish(status, ierr, 'dpsm_get_face_count', g)
+  end subroutine get_face_count_i32
+
+  !> The mesh's face count into nfaces (DPSM_OK), or the status of C's refusal
+  !> (DPSM_ERR_NOT_APPLICABLE on a grid, DPSM_ERR_NULL_POINTER without one).
+  function face_count(g, nfaces) result(status)
+    type(dpsm_grid), intent(in) :: g
+    integer(c_int64_t), intent(out) :: nfaces
+    integer(c_int) :: status
+    nfaces = 0
+    status = c_dpsm_get_face_count(g%ptr, nfaces)
+  end function face_count
+
+  !> As check_grid_shape, for an array of one value per face of a mesh:
+  !> a(nfaces) or a(nfaces, 1).
+  function check_face_shape(g, where, name, nfaces, array_shape) result(status)
+    type(dpsm_grid), intent(in) :: g
+    character(len=*), intent(in) :: where, name
+    integer(c_int64_t), intent(in) :: nfaces
+    integer, intent(in) :: array_shape(:)
+    integer(c_int) :: status
+    logical :: ok
+    status = DPSM_OK
+    if (size(array_shape) == 1) then
+      ok = int(array_shape(1), c_int64_t) == nfaces
+    else
+      ok = int(array_shape(1), c_int64_t) == nfaces .and. array_shape(2) == 1
+    end if
+    if (ok) return
+    status = DPSM_ERR_INVALID_SIZE
+    call set_message(g, where//': '//name//' has shape '//shape_string(array_shape)//' but the mesh has nfaces = '// &
+                     itoa(nfaces)//': pass '//name//'(nfaces)')
+  end function check_face_shape
+
+  !> dpsm_get_mesh_faces(g, face_cells[, ierr]): face_cells(2, nfaces), the
+  !> two cells (a, b) of every face, 1-based, b = 0 on the domain edge, in
+  !> the host's face order (that of dpsm_get_face_fluxes, dpsm_set_edge_kinds
+  !> and the levels of DPSM_MESH_EDGE). integer(c_int64_t) or default integers.
+  subroutine get_mesh_faces_i64(g, face_cells, ierr)
+    type(dpsm_grid), intent(in) :: g
+    integer(c_int64_t), intent(inout), contiguous :: face_cells(:, :)
+    integer, intent(out), optional :: ierr
+    integer(c_int64_t), allocatable :: cells0(:)
+    integer(c_int) :: status
+    call clear_message(g)
+    status = mesh_faces(g, shape(face_cells), cells0)
+    if (status == DPSM_OK) face_cells = reshape(cells0 + 1, shape(face_cells))
+    call finish(status, ierr, 'dpsm_get_mesh_faces', g)
+  end subroutine get_mesh_faces_i64
+
+  subroutine get_mesh_faces_i32(g, face_cells, ierr)
+    type(dpsm_grid), intent(in) :: g
+    integer(c_int32_t), intent(inout), contiguous :: face_cells(:, :)
+    integer, intent(out), optional :: ierr
+    integer(c_int64_t), allocatable :: cells0(:)
+    integer(c_int) :: status
+    call clear_message(g)
+    status = mesh_faces(g, shape(face_cells), cells0)
+    if (status == DPSM_OK) then
+      if (maxval(cells0) >= huge(face_cells)) then
+        status = DPSM_ERR_INVALID_SIZE
+        call set_message(g, 'dpsm_get_mesh_faces: the mesh has cells beyond huge(integer(c_int32_t)): '// &
+                         'pass an integer(c_int64_t) face_cells')
+      else
+        face_cells = reshape(int(cells0 + 1, c_int32_t), shape(face_cells))
+      end if
+    end if
+    call finish(status, ierr, 'dpsm_get_mesh_faces', g)
+  end subroutine get_mesh_faces_i32
+
+  !> The faces' cells as C gives them (0-based), after the shape check.
+  function mesh_faces(g, array_shape, cells0) result(status)
+    type(dpsm_grid), intent(in) :: g
+    integer, intent(in) :: array_shape(:)
+    integer(c_int64_t), allocatable, intent(out) :: cells0(:)
+    integer(c_int) :: status
+    integer(c_int64_t) :: nfaces
+    status = face_count(g, nfaces)
+    if (status /= DPSM_OK) then
+      ! C's message (a grid, not a mesh; no grid) comes with the call itself.
+      allocate (cells0(1))
+      status = c_dpsm_get_mesh_faces(g%ptr, cells0)
+      return
+    end if
+    if (array_shape(1) /= 2 .or. int(array_shape(2), c_int64_t) /= nfaces) then
+      status = DPSM_ERR_INVALID_SIZE
+      call set_message(g, 'dpsm_get_mesh_faces: face_cells has shape '//shape_string(array_shape)// &
+                       ' but the mesh has nfaces = '//itoa(nfaces)//': pass face_cells(2, nfaces)')
+      return
+    end if
+    allocate (cells0(2*nfaces))
+    status = c_dpsm_get_mesh_faces(g%ptr, cells0)
+  end function mesh_faces
+
+  !> dpsm_set_edge_kinds(g, kinds[, ierr]): kinds(nfaces) of DPSM_OPEN or
+  !> DPSM_WALL as integer(c_int8_t) (int(DPSM_OPEN, c_int8_t)), one per face,
+  !> those of interior faces ignored; without kinds every edge face is a wall.
+  subroutine set_edge_kinds_r1(g, kinds, ierr)
+    type(dpsm_grid), intent(in) :: g
+    integer(c_int8_t), intent(in), contiguous :: kinds(:)
+    integer, intent(out), optional :: ierr
+    integer(c_int) :: status
+    integer(c_int64_t) :: nfaces
+    call clear_message(g)
+    status = face_count(g, nfaces)
+    if (status == DPSM_OK) then
+      status = check_face_shape(g, 'dpsm_set_edge_kinds', 'kinds', nfaces, shape(kinds))
+      if (status == DPSM_OK) status = c_dpsm_set_edge_kinds(g%ptr, kinds)
+    else
+      status = c_dpsm_set_edge_kinds(g%ptr) ! refused by C (a grid; no grid), with its message
+    end if
+    call finish(status, ierr, 'dpsm_set_edge_kinds', g)
+  end subroutine set_edge_kinds_r1
+
+  subroutine set_edge_kinds_none(g, ierr)
+    type(dpsm_grid), intent(in) :: g
+    integer, intent(out), optional :: ierr
+    call clear_message(g)
+    call finish(c_dpsm_set_edge_kinds(g%ptr), ierr, 'dpsm_set_edge_kinds', g)
+  end subroutine set_edge_kinds_none
+
   ! ==== parameters ===========================================================
 
   !> dpsm_set_repose_angle(g, theta_radians[, ierr])
@@ -1169,26 +1597,39 @@ contains
   !> dpsm_set_side_levels(g, side, levels[, ierr]): the level beyond each face
   !> of `side`, levels(ny) for DPSM_XMIN and DPSM_XMAX, levels(nx) for
   !> DPSM_YMIN and DPSM_YMAX (levels(1) on 1D and axisymmetric grids); without
-  !> levels the side returns to 0.
+  !> levels the side returns to 0. On a mesh, side DPSM_MESH_EDGE takes
+  !> levels(nfaces), one per face (those of interior faces ignored).
   subroutine set_side_levels_r1(g, side, levels, ierr)
     type(dpsm_grid), intent(in) :: g
     integer(c_int), intent(in) :: side
     real(c_double), intent(in), contiguous :: levels(:)
     integer, intent(out), optional :: ierr
     integer(c_int) :: status
-    integer(c_int64_t) :: nx, ny, faces
+    integer(c_int64_t) :: nx, ny, faces, nfaces
+    logical :: mesh
     call clear_message(g)
     status = c_dpsm_get_shape(g%ptr, nx, ny)
     if (status == DPSM_OK) then
-      ! The C function refuses an unknown side before it reads any level.
+      ! The C function refuses an unknown side, or one the grid or mesh does
+      ! not have, before it reads any level.
+      mesh = face_count(g, nfaces) == DPSM_OK
       faces = size(levels, kind=c_int64_t)
-      if (side == DPSM_XMIN .or. side == DPSM_XMAX) faces = ny
-      if (side == DPSM_YMIN .or. side == DPSM_YMAX) faces = nx
+      if (mesh) then
+        if (side == DPSM_MESH_EDGE) faces = nfaces
+      else
+        if (side == DPSM_XMIN .or. side == DPSM_XMAX) faces = ny
+        if (side == DPSM_YMIN .or. side == DPSM_YMAX) faces = nx
+      end if
       if (size(levels, kind=c_int64_t) /= faces) then
         status = DPSM_ERR_INVALID_SIZE
-        call set_message(g, 'dpsm_set_side_levels: levels has '//itoa(size(levels, kind=c_int64_t))// &
-                         ' values but the side has '//itoa(faces)//' faces (ny for DPSM_XMIN and DPSM_XMAX, '// &
-                         'nx for DPSM_YMIN and DPSM_YMAX)')
+        if (mesh) then
+          call set_message(g, 'dpsm_set_side_levels: levels has '//itoa(size(levels, kind=c_int64_t))// &
+                           ' values but the mesh has '//itoa(faces)//' faces (one level per face for DPSM_MESH_EDGE)')
+        else
+          call set_message(g, 'dpsm_set_side_levels: levels has '//itoa(size(levels, kind=c_int64_t))// &
+                           ' values but the side has '//itoa(faces)//' faces (ny for DPSM_XMIN and DPSM_XMAX, '// &
+                           'nx for DPSM_YMIN and DPSM_YMAX)')
+        end if
       else
         status = c_dpsm_set_side_levels(g%ptr, side, levels)
       end if
@@ -1228,7 +1669,9 @@ contains
   !> dpsm_get_face_fluxes(g, fx[, fy][, ierr]): the volume each face carried in
   !> the last step, positive towards increasing x (y): fx(nx+1, ny) or
   !> fx((nx+1)*ny), fx(i, j) the face on the low side of cell (i, j); fy(nx, ny+1)
-  !> or fy(nx*(ny+1)) on 2D grids, left out on 1D and axisymmetric grids.
+  !> or fy(nx*(ny+1)) on 2D grids, left out on 1D and axisymmetric grids. On a
+  !> mesh fx(nfaces) holds every face, positive from face_cells(1, f) to
+  !> face_cells(2, f) of dpsm_get_mesh_faces, and fy is left out.
   subroutine get_face_fluxes_r1(g, fx, fy, ierr)
     type(dpsm_grid), intent(in) :: g
     real(c_double), intent(out), contiguous :: fx(:)
@@ -1263,7 +1706,15 @@ contains
     integer, intent(in), optional :: fy_shape(:)
     real(c_double), intent(out), optional :: fy(*)
     integer(c_int) :: status
+    integer(c_int64_t) :: nfaces
     call clear_message(g)
+    if (face_count(g, nfaces) == DPSM_OK) then
+      ! A mesh: fx holds every face; C refuses an fy before it writes anything.
+      status = check_face_shape(g, 'dpsm_get_face_fluxes', 'fx', nfaces, fx_shape)
+      if (status == DPSM_OK) status = c_dpsm_get_face_fluxes(g%ptr, fx, fy)
+      call finish(status, ierr, 'dpsm_get_face_fluxes', g)
+      return
+    end if
     status = check_grid_shape_plus(g, 'dpsm_get_face_fluxes', 'fx', 1, 0, fx_shape)
     if (status == DPSM_OK .and. present(fy_shape)) &
       status = check_grid_shape_plus(g, 'dpsm_get_face_fluxes', 'fy', 0, 1, fy_shape)
@@ -1313,7 +1764,7 @@ contains
     type(dpsm_grid), intent(in), optional :: g
     character(len=:), allocatable :: message
     if (.not. present(g)) then
-      message = from_c_string(c_dpsm_last_error(c_null_ptr))
+      message = last_error_without_grid()
       return
     end if
     if (associated(g%state)) then
@@ -1321,6 +1772,10 @@ contains
         message = g%state%message
         return
       end if
+    end if
+    if (.not. c_associated(g%ptr)) then
+      message = last_error_without_grid()
+      return
     end if
     message = from_c_string(c_dpsm_last_error(g%ptr))
   end function dpsm_last_error

@@ -88,6 +88,9 @@ typedef struct dpsm_grid dpsm_grid;
 #define DPSM_XMAX 1 /**< The side at x = nx*dx. */
 #define DPSM_YMIN 2 /**< The side at y = 0 (2D only). */
 #define DPSM_YMAX 3 /**< The side at y = ny*dy (2D only). */
+/** Every domain edge of a mesh at once (meshes only; dpsm_set_edge_kinds()
+ *  sets them face by face). */
+#define DPSM_MESH_EDGE 4
 /** @} */
 
 /** @name Boundary kinds
@@ -257,6 +260,123 @@ DPSM_API int dpsm_create_2d(int64_t nx, int64_t ny, double dx, double dy, dpsm_g
  * @return as dpsm_create_1d().
  */
 DPSM_API int dpsm_create_axisymmetric(int64_t nr, double dr, dpsm_grid **out);
+
+/**
+ * @brief Creates a mesh of polygonal cells over shared nodes (UGRID's
+ *        `face_node_connectivity` in CSR form).
+ *
+ * Cell `c` has the nodes `cell_nodes[cell_start[c] .. cell_start[c+1]-1]`,
+ * in either orientation. An edge of two cells is a face between them; an
+ * edge of one cell is a domain edge (a wall by default: see
+ * dpsm_set_boundary() with ::DPSM_MESH_EDGE and dpsm_set_edge_kinds()).
+ * Every array of the other functions then holds one value per cell, in this
+ * cell order; dpsm_get_shape() gives `(ncells, 1)`. The faces are numbered
+ * as they first appear, cell by cell, edge by edge in each cell's node
+ * order; dpsm_get_mesh_faces() lists their cells. The library renumbers
+ * cells inside for memory locality; the host never sees it.
+ *
+ * A face's slope is the two-point difference between its cells' centroids
+ * plus the part across it of their least-squares gradients (see
+ * `docs/guarantees.md`, "Meshes").
+ *
+ * @param nnodes      number of nodes, at least 1.
+ * @param node_xy     `2*nnodes` coordinates (x, y), finite.
+ * @param ncells      number of cells, at least 1.
+ * @param cell_start  `ncells+1` offsets into `cell_nodes`, `cell_start[0] == 0`,
+ *                    at least 3 nodes per cell.
+ * @param cell_nodes  node indices, from 0.
+ * @param out         receives the new mesh, or NULL on failure.
+ * @return ::DPSM_OK, ::DPSM_ERR_NULL_POINTER, ::DPSM_ERR_INVALID_SIZE,
+ *         ::DPSM_ERR_INVALID_VALUE (the message names the cell, node or edge:
+ *         an index out of range, fewer than 3 distinct nodes, zero area, an
+ *         edge of three or more cells, non-finite coordinates) or
+ *         ::DPSM_ERR_OUT_OF_MEMORY; read the message with `dpsm_last_error(NULL)`.
+ */
+DPSM_API int dpsm_create_mesh(int64_t nnodes, const double *node_xy, int64_t ncells, const int64_t *cell_start,
+                              const int64_t *cell_nodes, dpsm_grid **out);
+
+/**
+ * @brief Creates a mesh from cells as a finite-volume graph, as a host holds
+ *        it (Delft3D FM's links, lengths and areas; OpenFOAM's owner and
+ *        neighbour, centres and face areas).
+ *
+ * Face `f` joins cells `face_cells[2f]` and `face_cells[2f+1]`, or lies on
+ * the domain edge when the second is -1. Faces are taken as orthogonal to the
+ * line between their cells' centres (as these codes' meshes are built); on
+ * the domain edge the outside is the cell's mirror image across the face
+ * midpoint. Arrays of the other functions hold one value per cell, faces
+ * keep the host's order.
+ *
+ * @param ncells       number of cells, at least 1.
+ * @param cell_xy      `2*ncells` centres.
+ * @param cell_area    `ncells` positive areas.
+ * @param nfaces       number of faces, at least 1.
+ * @param face_cells   `2*nfaces` cell indices (a, b), b == -1 on the domain edge.
+ * @param face_xy      `2*nfaces` face midpoints.
+ * @param face_length  `nfaces` positive lengths.
+ * @param out          receives the new mesh, or NULL on failure.
+ * @return as dpsm_create_mesh(); also ::DPSM_ERR_INVALID_VALUE for a face
+ *         whose cells coincide and for a cell whose faces do not close it
+ *         (their midpoints leave half a turn or more around its centre).
+ */
+DPSM_API int dpsm_create_graph(int64_t ncells, const double *cell_xy, const double *cell_area, int64_t nfaces,
+                               const int64_t *face_cells, const double *face_xy, const double *face_length,
+                               dpsm_grid **out);
+
+/**
+ * @brief Creates the median dual of a triangle mesh: one cell around each
+ *        node, for hosts whose bed lives at the nodes (TELEMAC).
+ *
+ * Node `n`'s cell is bounded by the segments from the midpoints of its edges
+ * to the centroids of its triangles; its area is a third of theirs. Heights,
+ * sources and kinds are per node. The faces are the triangle edges, in order
+ * of their node pair (lower node first), then the halves of the boundary
+ * edges on the domain edge, in the same order, the lower node's half first.
+ *
+ * @param nnodes          number of nodes, at least 1; every node in some triangle.
+ * @param node_xy         `2*nnodes` coordinates.
+ * @param ntriangles      number of triangles, at least 1.
+ * @param triangle_nodes  `3*ntriangles` node indices, from 0.
+ * @param out             receives the new mesh, or NULL on failure.
+ * @return as dpsm_create_mesh().
+ */
+DPSM_API int dpsm_create_dual_mesh(int64_t nnodes, const double *node_xy, int64_t ntriangles,
+                                   const int64_t *triangle_nodes, dpsm_grid **out);
+
+/**
+ * @brief Reads the number of faces of a mesh (interior and domain edge).
+ * @param g       the mesh.
+ * @param nfaces  receives the count.
+ * @return ::DPSM_OK, ::DPSM_ERR_NULL_POINTER or ::DPSM_ERR_NOT_APPLICABLE (a grid).
+ */
+DPSM_API int dpsm_get_face_count(const dpsm_grid *g, int64_t *nfaces);
+
+/**
+ * @brief Reads the two cells of every face of a mesh, in the host's cell
+ *        and face order: what the values of dpsm_get_face_fluxes() and
+ *        dpsm_set_edge_kinds() stand for.
+ * @param g           the mesh.
+ * @param face_cells  room for `2*nfaces` indices (a, b); b == -1 on the domain edge.
+ * @return ::DPSM_OK, ::DPSM_ERR_NULL_POINTER or ::DPSM_ERR_NOT_APPLICABLE (a grid).
+ */
+DPSM_API int dpsm_get_mesh_faces(const dpsm_grid *g, int64_t *face_cells);
+
+/**
+ * @brief Sets which faces of a mesh's domain edge are open, face by face.
+ *
+ * An open face acts as an open side does on a grid (::DPSM_OPEN): the outside
+ * is held at the face's level (dpsm_set_side_levels() with ::DPSM_MESH_EDGE)
+ * and what leaves is booked as outflow of ::DPSM_MESH_EDGE
+ * (dpsm_get_side_outflow()). dpsm_set_boundary() with ::DPSM_MESH_EDGE sets
+ * every edge face at once and replaces these kinds.
+ *
+ * @param g      the mesh.
+ * @param kinds  one value per face, ::DPSM_OPEN or ::DPSM_WALL; the values of
+ *               faces between two cells are ignored. NULL: every edge a wall.
+ * @return ::DPSM_OK, ::DPSM_ERR_NULL_POINTER, ::DPSM_ERR_UNKNOWN_ENUM (the
+ *         message names the face) or ::DPSM_ERR_NOT_APPLICABLE (a grid).
+ */
+DPSM_API int dpsm_set_edge_kinds(dpsm_grid *g, const uint8_t *kinds);
 
 /**
  * @brief Releases a grid and everything it holds.
@@ -649,7 +769,10 @@ DPSM_API int dpsm_get_shape(const dpsm_grid *g, int64_t *nx, int64_t *ny);
  * The surface is at rest when no face slope exceeds `tan(theta) * (1 + tol)`.
  * Supercritical slopes relax exponentially, so a smaller tolerance costs a
  * little more time to rest; the final heights are off by at most about
- * `tol * tan(theta) * L` over a slope of length `L`.
+ * `tol * tan(theta) * L` over a slope of length `L`. On a mesh the tolerance
+ * is at least `1e-4`, and a face nearly parallel to the slope rests up to 1 %
+ * above the angle of repose: its slope comes from reconstructed gradients,
+ * whose error is of the order of the cell size (see `docs/guide_meshes.md`).
  *
  * @param g    the grid.
  * @param tol  finite and positive; default ::DPSM_DEFAULT_REST_TOLERANCE.

@@ -10,6 +10,7 @@
 #include <sstream>
 #include <string>
 #include <utility>
+#include <vector>
 
 #include "mpi/decomposition.hpp"
 #include "dpsm/dpsm.h"
@@ -101,12 +102,55 @@ std::string cell_name(std::int64_t i, std::int64_t j) {
     return "cell i = " + std::to_string(i) + ", j = " + std::to_string(j);
 }
 
+// A cell as the host numbers it: (i, j) on a grid, its index on a mesh.
+std::string host_cell_name(const dpsm_grid *g, std::int64_t c) {
+    const dpsm::Geometry &geo = g->core.geometry();
+    if (geo.is_mesh()) return "cell " + std::to_string(c);
+    return cell_name(c % geo.nx, c / geo.nx);
+}
+
 // Names the first non-finite element by its index and cell.
 void require_finite_array(const dpsm_grid *g, const double *values, const char *function, const char *name) {
     require_pointer(values, function, name);
-    const dpsm::Geometry &geo = g->core.geometry();
-    require_in_range(values, geo.cells(), function, name,
-                     [&](std::int64_t c) { return cell_name(c % geo.nx, c / geo.nx); });
+    require_in_range(values, g->core.geometry().cells(), function, name,
+                     [&](std::int64_t c) { return host_cell_name(g, c); });
+}
+
+const dpsm::Mesh *mesh_of(const dpsm_grid *g) { return g->core.geometry().mesh.get(); }
+
+// On a mesh the library keeps its cells in an order of its own
+// (mesh/mesh.hpp): a host's array goes through `buffer` into it, and comes
+// back out in the host's order. On a grid the orders agree.
+template <class T>
+const T *in_library_order(const dpsm_grid *g, const T *host, std::vector<T> &buffer) {
+    const dpsm::Mesh *mesh = mesh_of(g);
+    if (!mesh || !host) return host;
+    buffer.resize(static_cast<std::size_t>(mesh->cells));
+    for (std::int64_t c = 0; c < mesh->cells; ++c) buffer[c] = host[mesh->host_cell[c]];
+    return buffer.data();
+}
+
+void to_host_order(const dpsm_grid *g, const std::vector<double> &library, double *host) {
+    const dpsm::Mesh *mesh = mesh_of(g);
+    for (std::int64_t c = 0; c < mesh->cells; ++c) host[mesh->host_cell[c]] = library[c];
+}
+
+// Per face of a mesh, from the host's face order into the library's.
+template <class T>
+std::vector<T> faces_in_library_order(const dpsm::Mesh &mesh, const T *host) {
+    std::vector<T> library(static_cast<std::size_t>(mesh.faces));
+    for (std::int64_t f = 0; f < mesh.faces; ++f) library[f] = host[mesh.host_face[f]];
+    return library;
+}
+
+void require_grid_not_mesh(const dpsm_grid *g, const char *function) {
+    if (mesh_of(g))
+        fail(DPSM_ERR_NOT_APPLICABLE, function, "a mesh has no blocks of cells; set every cell with the function "
+             "without _region");
+}
+
+void require_mesh(const dpsm_grid *g, const char *function) {
+    if (!mesh_of(g)) fail(DPSM_ERR_NOT_APPLICABLE, function, "this grid is not a mesh");
 }
 
 void require_size(std::int64_t n, const char *function, const char *name) {
@@ -152,9 +196,12 @@ void require_above_bed(const dpsm_grid *g, const dpsm::Grid::Block &b, const dou
     for (std::int64_t k = 0; k < b.ni * b.nj; ++k) {
         const std::int64_t c = (b.i0 + k % b.ni) + nx * (b.j0 + k / b.ni);
         const double next = add ? h[c] + values[k] : values[k];
-        if (next < zb[c])
-            fail(DPSM_ERR_INVALID_VALUE, function, name, "[", k, "] puts cell i = ", c % nx, ", j = ", c / nx,
+        if (next < zb[c]) {
+            const dpsm::Mesh *mesh = mesh_of(g);
+            const std::int64_t host = mesh ? mesh->host_cell[c] : k;
+            fail(DPSM_ERR_INVALID_VALUE, function, name, "[", host, "] puts ", host_cell_name(g, mesh ? host : c),
                  " at ", next, ", below its bed zb = ", zb[c], " (see dpsm_set_bedrock)");
+        }
     }
 }
 
@@ -217,9 +264,17 @@ const char *side_name(int side) {
 // A side this grid has: the four of a 2D grid, the two of a line, the outer
 // one of an axisymmetric grid.
 void require_side(const dpsm_grid *g, int side, const char *function) {
+    const dpsm::Geometry &geo = g->core.geometry();
+    if (geo.is_mesh()) {
+        if (side != DPSM_MESH_EDGE)
+            fail(side >= DPSM_XMIN && side <= DPSM_YMAX ? DPSM_ERR_NOT_APPLICABLE : DPSM_ERR_UNKNOWN_ENUM, function,
+                 "side = ", side, " is not DPSM_MESH_EDGE, the one side of a mesh");
+        return;
+    }
+    if (side == DPSM_MESH_EDGE)
+        fail(DPSM_ERR_NOT_APPLICABLE, function, "side = DPSM_MESH_EDGE is the edge of a mesh; this grid is not one");
     if (side < DPSM_XMIN || side > DPSM_YMAX)
         fail(DPSM_ERR_UNKNOWN_ENUM, function, "side = ", side, " is not DPSM_XMIN, DPSM_XMAX, DPSM_YMIN or DPSM_YMAX");
-    const dpsm::Geometry &geo = g->core.geometry();
     if (geo.dim == 1 && side >= DPSM_YMIN)
         fail(DPSM_ERR_NOT_APPLICABLE, function, "a 1D grid has no y sides (side = ", side_name(side), ")");
     if (geo.axisymmetric && side == DPSM_XMIN)
@@ -245,7 +300,19 @@ int create(int dim, bool axisymmetric, std::int64_t nx, std::int64_t ny, double 
                  kMaxCells, ")");
         require_scale(dx, function, axisymmetric ? "dr" : "dx");
         require_scale(dy, function, "dy");
-        *out = new dpsm_grid(dpsm::Geometry{dim, axisymmetric, nx, ny, dx, dy});
+        *out = new dpsm_grid(dpsm::Geometry{dim, axisymmetric, nx, ny, dx, dy, nullptr});
+    });
+}
+
+// A mesh from a builder of mesh/mesh.hpp.
+template <class Build>
+int create_mesh(dpsm_grid **out, const char *function, Build &&build) {
+    if (out) *out = nullptr;
+    return guarded(nullptr, function, [&] {
+        require_pointer(out, function, "out");
+        std::shared_ptr<const dpsm::Mesh> mesh = build();
+        dpsm::Geometry geometry{2, false, mesh->cells, 1, mesh->min_distance, mesh->min_distance, mesh};
+        *out = new dpsm_grid(geometry);
     });
 }
 
@@ -265,6 +332,77 @@ int dpsm_create_2d(int64_t nx, int64_t ny, double dx, double dy, dpsm_grid **out
 
 int dpsm_create_axisymmetric(int64_t nr, double dr, dpsm_grid **out) {
     return create(1, true, nr, 1, dr, 1.0, out, "dpsm_create_axisymmetric");
+}
+
+int dpsm_create_mesh(int64_t nnodes, const double *node_xy, int64_t ncells, const int64_t *cell_start,
+                     const int64_t *cell_nodes, dpsm_grid **out) {
+    const char *fn = "dpsm_create_mesh";
+    return create_mesh(out, fn, [&] {
+        return dpsm::mesh_from_polygons(nnodes, node_xy, ncells, cell_start, cell_nodes, fn, 0);
+    });
+}
+
+int dpsm_create_graph(int64_t ncells, const double *cell_xy, const double *cell_area, int64_t nfaces,
+                      const int64_t *face_cells, const double *face_xy, const double *face_length, dpsm_grid **out) {
+    const char *fn = "dpsm_create_graph";
+    return create_mesh(out, fn, [&] {
+        return dpsm::mesh_from_graph(ncells, cell_xy, cell_area, nfaces, face_cells, face_xy, face_length, fn, 0);
+    });
+}
+
+int dpsm_create_dual_mesh(int64_t nnodes, const double *node_xy, int64_t ntriangles, const int64_t *triangle_nodes,
+                          dpsm_grid **out) {
+    const char *fn = "dpsm_create_dual_mesh";
+    return create_mesh(out, fn, [&] {
+        return dpsm::mesh_from_dual(nnodes, node_xy, ntriangles, triangle_nodes, fn, 0);
+    });
+}
+
+int dpsm_get_face_count(const dpsm_grid *g, int64_t *nfaces) {
+    const char *fn = "dpsm_get_face_count";
+    return guarded(g, fn, [&] {
+        require_grid(g, fn);
+        require_pointer(nfaces, fn, "nfaces");
+        require_mesh(g, fn);
+        *nfaces = mesh_of(g)->faces;
+    });
+}
+
+int dpsm_get_mesh_faces(const dpsm_grid *g, int64_t *face_cells) {
+    const char *fn = "dpsm_get_mesh_faces";
+    return guarded(g, fn, [&] {
+        require_grid(g, fn);
+        require_pointer(face_cells, fn, "face_cells");
+        require_mesh(g, fn);
+        const dpsm::Mesh &m = *mesh_of(g);
+        for (std::int64_t f = 0; f < m.faces; ++f) {
+            const std::int64_t a = m.host_cell[m.face_a[f]];
+            const std::int64_t b = m.face_b[f] < 0 ? -1 : m.host_cell[m.face_b[f]];
+            const std::int64_t k = m.host_face[f];
+            face_cells[2 * k] = m.host_sign[f] > 0 ? a : b;
+            face_cells[2 * k + 1] = m.host_sign[f] > 0 ? b : a;
+        }
+    });
+}
+
+int dpsm_set_edge_kinds(dpsm_grid *g, const uint8_t *kinds) {
+    const char *fn = "dpsm_set_edge_kinds";
+    return guarded(g, fn, [&] {
+        require_grid(g, fn);
+        require_mesh(g, fn);
+        const dpsm::Mesh &m = *mesh_of(g);
+        if (!kinds) {
+            g->core.set_edge_open(nullptr);
+            return;
+        }
+        for (std::int64_t k = 0; k < m.faces; ++k)
+            if (m.face_b[m.face_of_host[k]] < 0 && kinds[k] != DPSM_OPEN && kinds[k] != DPSM_WALL)
+                fail(DPSM_ERR_UNKNOWN_ENUM, fn, "kinds[", k, "] (face ", k, ", on the domain edge) = ",
+                     static_cast<int>(kinds[k]), " is not DPSM_OPEN or DPSM_WALL");
+        std::vector<std::uint8_t> open = faces_in_library_order(m, kinds);
+        for (std::uint8_t &o : open) o = o == DPSM_OPEN;
+        g->core.set_edge_open(open.data());
+    });
 }
 
 void dpsm_destroy(dpsm_grid *g) { delete g; }
@@ -319,7 +457,7 @@ int dpsm_set_boundary(dpsm_grid *g, int side, int kind) {
         if (kind != DPSM_OPEN && kind != DPSM_WALL)
             fail(DPSM_ERR_UNKNOWN_ENUM, fn, "kind = ", kind, " is not DPSM_OPEN or DPSM_WALL");
         require_side(g, side, fn);
-        g->core.set_side_open(side, kind == DPSM_OPEN);
+        g->core.set_side_open(side == DPSM_MESH_EDGE ? 0 : side, kind == DPSM_OPEN);
     });
 }
 
@@ -331,10 +469,11 @@ int dpsm_set_cell_kinds(dpsm_grid *g, const uint8_t *kinds) {
             const dpsm::Geometry &geo = g->core.geometry();
             for (std::int64_t c = 0; c < geo.cells(); ++c)
                 if (kinds[c] > DPSM_CELL_OPEN)
-                    fail(DPSM_ERR_UNKNOWN_ENUM, fn, "kinds[", c, "] (cell i = ", c % geo.nx, ", j = ", c / geo.nx,
-                         ") = ", static_cast<int>(kinds[c]), " is not DPSM_CELL_SAND, DPSM_CELL_WALL or DPSM_CELL_OPEN");
+                    fail(DPSM_ERR_UNKNOWN_ENUM, fn, "kinds[", c, "] (", host_cell_name(g, c), ") = ",
+                         static_cast<int>(kinds[c]), " is not DPSM_CELL_SAND, DPSM_CELL_WALL or DPSM_CELL_OPEN");
         }
-        g->core.set_cell_kinds(kinds);
+        std::vector<std::uint8_t> buffer;
+        g->core.set_cell_kinds(in_library_order(g, kinds, buffer));
     });
 }
 
@@ -343,8 +482,10 @@ int dpsm_set_heights(dpsm_grid *g, const double *h) {
     return guarded(g, fn, [&] {
         require_grid(g, fn);
         require_finite_array(g, h, fn, "h");
-        require_above_bed(g, g->core.whole(), h, false, fn, "h");
-        g->core.write_heights(g->core.whole(), h, false);
+        std::vector<double> buffer;
+        const double *values = in_library_order(g, h, buffer);
+        require_above_bed(g, g->core.whole(), values, false, fn, "h");
+        g->core.write_heights(g->core.whole(), values, false);
     });
 }
 
@@ -352,6 +493,7 @@ int dpsm_set_heights_region(dpsm_grid *g, int64_t i0, int64_t j0, int64_t ni, in
     const char *fn = "dpsm_set_heights_region";
     return guarded(g, fn, [&] {
         require_grid(g, fn);
+        require_grid_not_mesh(g, fn);
         const dpsm::Grid::Block block = require_block(g, i0, j0, ni, nj, fn);
         require_finite_block(h, block, fn, "h");
         require_above_bed(g, block, h, false, fn, "h");
@@ -363,6 +505,7 @@ int dpsm_add_heights_region(dpsm_grid *g, int64_t i0, int64_t j0, int64_t ni, in
     const char *fn = "dpsm_add_heights_region";
     return guarded(g, fn, [&] {
         require_grid(g, fn);
+        require_grid_not_mesh(g, fn);
         const dpsm::Grid::Block block = require_block(g, i0, j0, ni, nj, fn);
         require_finite_block(dh, block, fn, "dh");
         const std::vector<double> &h = g->core.heights();
@@ -382,6 +525,7 @@ int dpsm_get_heights_region(const dpsm_grid *g, int64_t i0, int64_t j0, int64_t 
     const char *fn = "dpsm_get_heights_region";
     return guarded(g, fn, [&] {
         require_grid(g, fn);
+        require_grid_not_mesh(g, fn);
         const dpsm::Grid::Block block = require_block(g, i0, j0, ni, nj, fn);
         require_pointer(h, fn, "h");
         g->core.read_heights(block, h);
@@ -393,6 +537,10 @@ int dpsm_get_heights(const dpsm_grid *g, double *h) {
     return guarded(g, fn, [&] {
         require_grid(g, fn);
         require_pointer(h, fn, "h");
+        if (mesh_of(g)) {
+            to_host_order(g, g->core.heights(), h);
+            return;
+        }
         g->core.read_heights(g->core.whole(), h);
     });
 }
@@ -402,7 +550,8 @@ int dpsm_set_source(dpsm_grid *g, const double *q) {
     return guarded(g, fn, [&] {
         require_grid(g, fn);
         if (q) require_finite_array(g, q, fn, "q");
-        g->core.set_source(q);
+        std::vector<double> buffer;
+        g->core.set_source(in_library_order(g, q, buffer));
     });
 }
 
@@ -532,7 +681,8 @@ int dpsm_set_bedrock(dpsm_grid *g, const double *zb) {
     return guarded(g, fn, [&] {
         require_grid(g, fn);
         if (zb) require_finite_array(g, zb, fn, "zb");
-        g->core.set_bed(zb);
+        std::vector<double> buffer;
+        g->core.set_bed(in_library_order(g, zb, buffer));
     });
 }
 
@@ -544,10 +694,11 @@ int dpsm_set_repose_angle_field(dpsm_grid *g, const double *theta) {
             const dpsm::Geometry &geo = g->core.geometry();
             for (std::int64_t c = 0; c < geo.cells(); ++c)
                 if (!(theta[c] > 0.0 && theta[c] < 0.5 * M_PI))  // also NaN
-                    fail(DPSM_ERR_INVALID_VALUE, fn, "theta_radians[", c, "] (cell i = ", c % geo.nx,
-                         ", j = ", c / geo.nx, ") = ", theta[c], " is outside (0, pi/2)");
+                    fail(DPSM_ERR_INVALID_VALUE, fn, "theta_radians[", c, "] (", host_cell_name(g, c), ") = ", theta[c],
+                         " is outside (0, pi/2)");
         }
-        g->core.set_angle_field(theta);
+        std::vector<double> buffer;
+        g->core.set_angle_field(in_library_order(g, theta, buffer));
     });
 }
 
@@ -577,6 +728,16 @@ int dpsm_set_side_levels(dpsm_grid *g, int side, const double *levels) {
     return guarded(g, fn, [&] {
         require_grid(g, fn);
         require_side(g, side, fn);
+        if (const dpsm::Mesh *mesh = mesh_of(g)) {
+            if (!levels) {
+                g->core.set_side_levels(0, nullptr);
+                return;
+            }
+            require_in_range(levels, mesh->faces, fn, "levels",
+                             [&](std::int64_t k) { return "face " + std::to_string(k); });
+            g->core.set_side_levels(0, faces_in_library_order(*mesh, levels).data());
+            return;
+        }
         if (levels) {
             const dpsm::Geometry &geo = g->core.geometry();
             const bool x_side = side <= DPSM_XMAX;
@@ -594,7 +755,9 @@ int dpsm_get_side_outflow(const dpsm_grid *g, int side, double *value) {
     return guarded(g, fn, [&] {
         require_grid(g, fn);
         const bool known = side >= DPSM_XMIN && side <= DPSM_YMAX;
-        const double local = known ? g->core.ledger().side_outflow[side].value() : 0.0;
+        const bool mesh_edge = side == DPSM_MESH_EDGE && mesh_of(g);
+        const double local =
+            mesh_edge ? g->core.ledger().side_outflow[0].value() : known ? g->core.ledger().side_outflow[side].value() : 0.0;
         double total = local;
         // A distributed grid's figure is global; every rank takes part in the
         // sum, a refusing one too, so that none waits for ever.
@@ -626,7 +789,9 @@ int dpsm_get_face_fluxes(const dpsm_grid *g, double *fx, double *fy) {
         require_grid(g, fn);
         require_pointer(fx, fn, "fx");
         const dpsm::Geometry &geo = g->core.geometry();
-        if (geo.dim == 2) require_pointer(fy, fn, "fy");
+        if (geo.is_mesh() && fy)
+            fail(DPSM_ERR_INVALID_VALUE, fn, "fy must be NULL on a mesh: fx holds every face");
+        if (geo.tiled()) require_pointer(fy, fn, "fy");
         if (geo.dim == 1 && fy)
             fail(DPSM_ERR_INVALID_VALUE, fn, "fy must be NULL on a ", geo.axisymmetric ? "axisymmetric" : "1D",
                  " grid: it has no y faces");
@@ -637,6 +802,11 @@ int dpsm_get_face_fluxes(const dpsm_grid *g, double *fx, double *fy) {
         if (!fluxes->available)
             fail(DPSM_ERR_NOT_APPLICABLE, fn, "the last step relaxed to rest (DPSM_RELAX_TO_REST), which has no face "
                  "fluxes; step with DPSM_RELAX_TIME_ACCURATE or the default for them");
+        if (const dpsm::Mesh *mesh = mesh_of(g)) {
+            const std::vector<double> &library = fluxes->x;
+            for (std::int64_t f = 0; f < mesh->faces; ++f) fx[mesh->host_face[f]] = mesh->host_sign[f] * library[f];
+            return;
+        }
         g->core.read_face_fluxes(fx, fy);
     });
 }

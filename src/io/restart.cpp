@@ -59,24 +59,68 @@ constexpr std::uint32_t kHasSideOutflows = 1u << 7;
 constexpr std::uint32_t kHasSideLevelsOfXMin = 1u << 8;  // .. 1u << 11 for DPSM_YMAX
 constexpr std::uint32_t kHasSideLevels = 0xfu << 8;
 constexpr std::uint32_t kRecordsFluxes = 1u << 12;
+// Version 5, unstructured meshes: a mesh record (what the host gave its
+// constructor) follows the fixed header and the block record, and the body's
+// arrays hold one value per cell in the library's order, which the mesh
+// rebuilt from the record has again; with kHasEdgeKinds, which faces of the
+// domain edge are open, one byte per face, after the side levels (the levels
+// of a mesh's edge are those of side 0, one per face).
+constexpr std::uint32_t kIsMesh = 1u << 13;
+constexpr std::uint32_t kHasEdgeKinds = 1u << 14;
 constexpr std::uint32_t kKnownFlags = kHasSource | kHasBed | kHasAngleField | kHasMoving | kIsBlock | kRelaxToRest |
-                                      kRelaxAuto | kHasSideOutflows | kHasSideLevels | kRecordsFluxes;
+                                      kRelaxAuto | kHasSideOutflows | kHasSideLevels | kRecordsFluxes | kIsMesh |
+                                      kHasEdgeKinds;
 // The flags a file of version 1 cannot hold, those version 2 cannot, and so on.
 constexpr std::uint32_t kVersion2Flags = kIsBlock | kRelaxToRest;
 constexpr std::uint32_t kVersion3Flags = kRelaxAuto;
 constexpr std::uint32_t kVersion4Flags = kHasSideOutflows | kHasSideLevels | kRecordsFluxes;
+constexpr std::uint32_t kVersion5Flags = kIsMesh | kHasEdgeKinds;
+// The fixed part of the mesh record: kind, a reserved word, and four counts.
+constexpr std::size_t kMeshRecordBytes = 40;
 
 constexpr std::uint32_t side_levels_flag(int side) { return kHasSideLevelsOfXMin << side; }
 
 // The oldest version that holds a file with these flags.
 std::uint32_t version_for(std::uint32_t flags) {
+    if (flags & kVersion5Flags) return 5;
     if (flags & kVersion4Flags) return 4;
     if (flags & kVersion3Flags) return 3;
     return (flags & kVersion2Flags) ? 2 : 1;
 }
 
-// The faces along a side: ny for the x sides, nx for the y sides.
-std::int64_t faces_along(int side, std::int64_t nx, std::int64_t ny) { return side < kYMin ? ny : nx; }
+// The faces along a side: ny for the x sides, nx for the y sides; on a mesh
+// (nfaces > 0) every face of the mesh for side 0, its edge.
+std::int64_t faces_along(int side, std::int64_t nx, std::int64_t ny, std::int64_t nfaces = 0) {
+    if (nfaces > 0) return nfaces;
+    return side < kYMin ? ny : nx;
+}
+
+// The counts of a mesh record, and the arrays of what the host gave.
+struct MeshRecord {
+    std::uint32_t kind = 0;
+    std::int64_t nnodes = 0, ncells = 0, nindices = 0, nfaces = 0;
+    std::size_t array_bytes() const {
+        if (kind == MeshInput::kGraph)
+            return static_cast<std::size_t>(ncells) * (16 + 8) + static_cast<std::size_t>(nfaces) * (16 + 16 + 8);
+        const std::size_t starts = kind == MeshInput::kPolygons ? static_cast<std::size_t>(ncells + 1) * 8 : 0;
+        return static_cast<std::size_t>(nnodes) * 16 + starts + static_cast<std::size_t>(nindices) * 8;
+    }
+};
+
+MeshRecord record_of(const Mesh &mesh) {
+    const MeshInput &in = mesh.input;
+    MeshRecord r;
+    r.kind = in.kind;
+    r.nfaces = mesh.faces;
+    if (in.kind == MeshInput::kGraph) {
+        r.ncells = in.ncells;
+        return r;
+    }
+    r.nnodes = static_cast<std::int64_t>(in.node_xy.size() / 2);
+    r.nindices = static_cast<std::int64_t>(in.cell_nodes.size());
+    r.ncells = in.kind == MeshInput::kPolygons ? static_cast<std::int64_t>(in.cell_start.size()) - 1 : r.nindices / 3;
+    return r;
+}
 
 
 // ---- CRC-32 (ISO-HDLC, as zlib, PNG and gzip: reflected 0xEDB88320) -------
@@ -177,6 +221,8 @@ std::uint32_t flags_of(const Grid &g) {
     for (int side = 0; side < 4; ++side)
         if (!g.side_levels(side).empty()) flags |= side_levels_flag(side);
     if (g.records_face_fluxes()) flags |= kRecordsFluxes;
+    if (g.geometry().is_mesh()) flags |= kIsMesh;
+    if (!g.edge_open_flags().empty()) flags |= kHasEdgeKinds;
     return flags;
 }
 
@@ -227,6 +273,30 @@ void write_block(Writer &w, const RestartBlock &block) {
     w.i32(block.ranks);
 }
 
+void write_mesh(Writer &w, const Grid &g) {
+    if (!g.geometry().is_mesh()) return;
+    const Mesh &mesh = *g.geometry().mesh;
+    const MeshRecord r = record_of(mesh);
+    w.u32(r.kind);
+    w.u32(0);
+    w.i64(r.nnodes);
+    w.i64(r.ncells);
+    w.i64(r.nindices);
+    w.i64(r.nfaces);
+    const MeshInput &in = mesh.input;
+    if (in.kind == MeshInput::kGraph) {
+        w.array(in.cell_xy, &Writer::f64);
+        w.array(in.cell_area, &Writer::f64);
+        w.array(in.face_cells, &Writer::i64);
+        w.array(in.face_xy, &Writer::f64);
+        w.array(in.face_length, &Writer::f64);
+        return;
+    }
+    w.array(in.node_xy, &Writer::f64);
+    w.array(in.cell_start, &Writer::i64);  // empty for the dual
+    w.array(in.cell_nodes, &Writer::i64);
+}
+
 void write_body(Writer &w, const Grid &g) {
     w.array(g.heights(), &Writer::f64);
     w.array(g.residuals(), &Writer::f32);
@@ -241,6 +311,7 @@ void write_body(Writer &w, const Grid &g) {
             w.f64(account.correction());
         }
     for (int side = 0; side < 4; ++side) w.array(g.side_levels(side), &Writer::f64);  // nothing when empty
+    w.array(g.edge_open_flags(), &Writer::u8);                                          // nothing when empty
     w.checksum();
     w.flush();
 }
@@ -317,6 +388,7 @@ private:
 
 // What the header says, before it is turned into a grid's state.
 struct Header {
+    MeshRecord mesh;  // kIsMesh only
     std::uint32_t version = 0, dim = 0, axisymmetric = 0;
     std::int64_t nx = 0, ny = 0;
     double dx = 0.0, dy = 0.0;
@@ -385,14 +457,46 @@ void read_body(Reader &r, const Header &h, std::size_t n, GridState &s) {
         }
     for (int side = 0; side < 4; ++side)
         if (h.flags & side_levels_flag(side))
-            r.array(s.side_levels[side], static_cast<std::size_t>(faces_along(side, h.nx, h.ny)), &Reader::f64);
+            r.array(s.side_levels[side], static_cast<std::size_t>(faces_along(side, h.nx, h.ny, h.mesh.nfaces)),
+                    &Reader::f64);
+    if (h.flags & kHasEdgeKinds) r.array(s.edge_open, static_cast<std::size_t>(h.mesh.nfaces), &Reader::u8);
 }
 
-// The bytes of version 4's parts after the arrays, by the flags.
-std::size_t coupling_bytes(std::uint32_t flags, std::int64_t nx, std::int64_t ny) {
+void read_mesh_counts(Reader &r, Header &h) {
+    if (!(h.flags & kIsMesh)) return;
+    h.mesh.kind = r.u32();
+    r.u32();
+    h.mesh.nnodes = r.i64();
+    h.mesh.ncells = r.i64();
+    h.mesh.nindices = r.i64();
+    h.mesh.nfaces = r.i64();
+}
+
+void read_mesh(Reader &r, const Header &h, MeshInput &in) {
+    if (!(h.flags & kIsMesh)) return;
+    const MeshRecord &m = h.mesh;
+    const auto n = [](std::int64_t count) { return static_cast<std::size_t>(count); };
+    in.kind = static_cast<MeshInput::Kind>(m.kind);
+    if (m.kind == MeshInput::kGraph) {
+        in.ncells = m.ncells;
+        r.array(in.cell_xy, 2 * n(m.ncells), &Reader::f64);
+        r.array(in.cell_area, n(m.ncells), &Reader::f64);
+        r.array(in.face_cells, 2 * n(m.nfaces), &Reader::i64);
+        r.array(in.face_xy, 2 * n(m.nfaces), &Reader::f64);
+        r.array(in.face_length, n(m.nfaces), &Reader::f64);
+        return;
+    }
+    r.array(in.node_xy, 2 * n(m.nnodes), &Reader::f64);
+    if (m.kind == MeshInput::kPolygons) r.array(in.cell_start, n(m.ncells) + 1, &Reader::i64);
+    r.array(in.cell_nodes, n(m.nindices), &Reader::i64);
+}
+
+// The bytes of version 4's parts after the arrays, by the flags (and a mesh's edge kinds).
+std::size_t coupling_bytes(std::uint32_t flags, std::int64_t nx, std::int64_t ny, std::int64_t nfaces = 0) {
     std::size_t bytes = (flags & kHasSideOutflows) ? 4 * 16 : 0;
     for (int side = 0; side < 4; ++side)
-        if (flags & side_levels_flag(side)) bytes += 8 * static_cast<std::size_t>(faces_along(side, nx, ny));
+        if (flags & side_levels_flag(side)) bytes += 8 * static_cast<std::size_t>(faces_along(side, nx, ny, nfaces));
+    if (flags & kHasEdgeKinds) bytes += static_cast<std::size_t>(nfaces);
     return bytes;
 }
 
@@ -429,7 +533,8 @@ void check_layout(const Header &h, const std::string &path, const char *fn) {
     if (h.nx > kMaxCells / h.ny)
         bad("nx * ny = ", h.nx, " * ", h.ny, " cells is more than this library can address (", kMaxCells, ")");
     if (h.flags & ~kKnownFlags) bad("unknown array flags ", hex32(h.flags & ~kKnownFlags));
-    const std::pair<std::uint32_t, std::uint32_t> needs[] = {{kVersion2Flags, 2}, {kVersion3Flags, 3}, {kVersion4Flags, 4}};
+    const std::pair<std::uint32_t, std::uint32_t> needs[] = {
+        {kVersion2Flags, 2}, {kVersion3Flags, 3}, {kVersion4Flags, 4}, {kVersion5Flags, 5}};
     for (const auto &[flags, version] : needs)
         if ((h.flags & flags) && h.version < version)
             bad("the flags ", hex32(h.flags & flags), " are set in a file of version ", h.version, " (they need version ",
@@ -437,6 +542,11 @@ void check_layout(const Header &h, const std::string &path, const char *fn) {
     if ((h.flags & kRelaxToRest) && (h.flags & kRelaxAuto)) bad("both relaxation flags are set");
     if ((h.flags & kRelaxToRest) && h.dim != 2) bad("a grid of dim = ", h.dim, " cannot relax to rest");
     if ((h.flags & kIsBlock) && h.dim != 2) bad("a block of a distributed grid must have dim = 2, not ", h.dim);
+    if ((h.flags & kHasEdgeKinds) && !(h.flags & kIsMesh)) bad("edge kinds are set but the file holds no mesh");
+    if (h.flags & kIsMesh) {
+        if (h.dim != 2 || h.ny != 1 || (h.flags & kIsBlock)) bad("a mesh has dim = 2, ny = 1 and no block record");
+        if (h.flags & (kHasSideLevels & ~side_levels_flag(kXMin))) bad("a mesh has levels beyond its edge only");
+    }
     for (int side = 0; side < 4; ++side)
         if ((h.flags & side_levels_flag(side)) && ((h.dim == 1 && side >= kYMin) || (h.axisymmetric && side == kXMin)))
             bad("levels beyond side ", side, ", which a grid of dim = ", h.dim,
@@ -557,6 +667,7 @@ void save_restart(const Grid &grid, const char *path, const char *function, cons
     if (w.buffered() != kHeaderBytes)
         fail(DPSM_ERR_INTERNAL, function, "the header takes ", w.buffered(), " bytes, not ", kHeaderBytes);
     write_block(w, block);
+    write_mesh(w, grid);
     write_body(w, grid);
     // On disk before it replaces the old file: a crash leaves one or the other.
     if (std::fflush(tmp.file) != 0) fail(DPSM_ERR_IO, function, "cannot write ", target, ": ", system_reason(errno));
@@ -634,12 +745,32 @@ void load_restart(const char *path, Geometry &geometry, GridState &state, Restar
     read_header(header_reader, header, state);
     check_layout(header, source, fn);
 
+    // A mesh's counts next: they size the rest. Trusted only as far as they
+    // are plausible; the file's checksum covers them.
+    std::size_t mesh_bytes = 0;
+    if (header.flags & kIsMesh) {
+        read_more(in.file, bytes, kMeshRecordBytes, source, fn);
+        if (bytes.size() < kHeaderBytes + kMeshRecordBytes)
+            bad(" is truncated: its mesh record is cut short at ", bytes.size(), " bytes");
+        Reader counts(bytes, kHeaderBytes, source, fn);
+        read_mesh_counts(counts, header);
+        const MeshRecord &m = header.mesh;
+        const bool graph = m.kind == MeshInput::kGraph;
+        if (m.kind != MeshInput::kPolygons && m.kind != MeshInput::kGraph && m.kind != MeshInput::kDual)
+            bad(" is corrupted: mesh kind ", m.kind, " is not 1, 2 or 3");
+        const std::int64_t most = kMaxCells / 8;
+        if (m.nfaces < 1 || m.nfaces > most || m.ncells < 1 || m.ncells > most || m.nnodes < 0 || m.nnodes > most ||
+            m.nindices < 0 || m.nindices > most || (graph ? m.ncells != header.nx : m.nnodes < 1))
+            bad(" is corrupted: its mesh record's counts (", m.nnodes, " nodes, ", m.ncells, " cells, ", m.nindices,
+                " node indices, ", m.nfaces, " faces) do not describe a mesh of ", header.nx, " cells");
+        mesh_bytes = kMeshRecordBytes + m.array_bytes();
+    }
     // Then exactly as many bytes as the header implies, read as they come (a
     // short file allocates no more than it holds).
     const std::size_t n = static_cast<std::size_t>(header.nx) * static_cast<std::size_t>(header.ny);
     const std::size_t block_bytes = (header.flags & kIsBlock) ? kBlockBytes : 0;
-    const std::size_t expected = kHeaderBytes + block_bytes + n * bytes_per_cell(header.flags) +
-                                 coupling_bytes(header.flags, header.nx, header.ny) + kChecksumBytes;
+    const std::size_t expected = kHeaderBytes + block_bytes + mesh_bytes + n * bytes_per_cell(header.flags) +
+                                 coupling_bytes(header.flags, header.nx, header.ny, header.mesh.nfaces) + kChecksumBytes;
     constexpr std::size_t kChunk = std::size_t{1} << 22;
     while (bytes.size() <= expected) {
         const std::size_t want = expected + 1 - bytes.size();
@@ -665,6 +796,11 @@ void load_restart(const char *path, Geometry &geometry, GridState &state, Restar
 
     Reader body(bytes, kHeaderBytes, source, fn);
     read_block(body, header, block);
+    MeshInput mesh_input;
+    if (header.flags & kIsMesh) {
+        read_mesh_counts(body, header);
+        read_mesh(body, header, mesh_input);
+    }
     read_body(body, header, n, state);
     if (body.at() != expected - kChecksumBytes)
         fail(DPSM_ERR_INTERNAL, fn, "read ", body.at(), " bytes of ", source, ", expected ", expected - kChecksumBytes);
@@ -677,7 +813,20 @@ void load_restart(const char *path, Geometry &geometry, GridState &state, Restar
     state.last_step.at_rest = header.at_rest != 0;
     state.record_fluxes = (header.flags & kRecordsFluxes) != 0;
     for (int side = 0; side < 4; ++side) state.side_open[side] = header.side_open[side] != 0;
-    geometry = Geometry{static_cast<int>(header.dim), header.axisymmetric != 0, header.nx, header.ny, header.dx, header.dy};
+    geometry = Geometry{static_cast<int>(header.dim), header.axisymmetric != 0, header.nx, header.ny, header.dx, header.dy, nullptr};
+    if (header.flags & kIsMesh) {
+        // The same checks as the constructors; what they refuse, the file got wrong.
+        try {
+            geometry.mesh = mesh_from_input(mesh_input, fn);
+        } catch (const Error &e) {
+            bad(" holds a mesh its constructor refuses: ", e.what());
+        }
+        if (geometry.mesh->cells != header.nx || geometry.mesh->faces != header.mesh.nfaces)
+            bad(" is corrupted: its mesh has ", geometry.mesh->cells, " cells and ", geometry.mesh->faces,
+                " faces, its header says ", header.nx, " and ", header.mesh.nfaces);
+        geometry.dx = geometry.dy = geometry.mesh->min_distance;
+        for (std::uint8_t &open : state.edge_open) open = open != 0;
+    }
 }
 
 }  // namespace dpsm

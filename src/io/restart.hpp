@@ -17,7 +17,8 @@ namespace dpsm {
 // (DPSM_RELAX_AUTO), version 4 for a grid with side levels, sand that left
 // through a side, or face fluxes recorded, so that older libraries still
 // read every file they could hold.
-constexpr std::uint32_t kRestartVersion = 4;
+// Version 5 holds unstructured meshes (the mesh as its constructor got it).
+constexpr std::uint32_t kRestartVersion = 5;
 
 // Where a block file's grid lies in its distributed grid (version 2): its
 // place, which of how many ranks saved it, and the mark that all the files

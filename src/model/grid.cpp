@@ -30,9 +30,13 @@ Grid::Grid(const Geometry &geometry)
       kinds_(static_cast<std::size_t>(geometry.cells()), kSand),
       rate_(geometry.dim == 1 ? static_cast<std::size_t>(geometry.cells()) : 0, 0.0),
       scheme_(geometry.dim == 2 ? kIsotropic : kPairwise) {
-    if (geometry.dim == 2) {
+    if (geometry.tiled()) {
         active_ = std::make_unique<ActiveSet>(geometry.nx, geometry.ny);
         active_->refresh_masks(*this);
+    }
+    if (geometry.is_mesh()) {
+        mesh_activity_ = std::make_unique<MeshActivity>();
+        mesh_activity_->hot.assign(static_cast<std::size_t>(geometry.cells()), 0);
     }
 }
 
@@ -90,6 +94,9 @@ void Grid::write_heights(const Block &block, const double *values, bool add) {
             const double v = values[i + block.ni * j];
             const double next = add ? heights_[c] + v : v;
             if (kinds_[c] == kSand) change.add((next - heights_[c]) * geometry_.cell_area(c));
+            // On a mesh only the cells that change, and those across their faces, wake.
+            if (mesh_activity_ && (next != heights_[c] || residuals_[c] != 0.0f))
+                mesh_activity_->wake_around(*geometry_.mesh, c);
             heights_[c] = next;
             residuals_[c] = 0.0f;
         }
@@ -217,6 +224,7 @@ void Grid::set_cell_kinds(const std::uint8_t *kinds) {
         active_->refresh_masks(*this);
         active_->mark_all();
     }
+    if (mesh_activity_) mesh_activity_->wake_all();
 }
 
 void Grid::restore(GridState &&s) {
@@ -230,6 +238,10 @@ void Grid::restore(GridState &&s) {
     relaxation_ = s.relaxation;
     side_open_ = s.side_open;
     side_levels_ = std::move(s.side_levels);
+    edge_open_ = std::move(s.edge_open);
+    edges_open_ = 0;
+    for (const std::uint8_t open : edge_open_) edges_open_ += open;
+    ++edges_version_;
     update_held_levels();
     set_face_flux_recording(s.record_fluxes);
     heights_ = std::move(s.heights);
@@ -238,7 +250,7 @@ void Grid::restore(GridState &&s) {
     residual_bounds_.add(0, geometry_.nx, 0, geometry_.ny);
     kinds_ = std::move(s.kinds);
     source_ = std::move(s.source);
-    clock_.assign(geometry_.dim == 2 && !source_.empty() ? heights_.size() : 0, 0.0);
+    clock_.assign(geometry_.tiled() && !source_.empty() ? heights_.size() : 0, 0.0);
     clock_base_ = 0.0;
     bed_ = std::move(s.bed);
     // The tangents and the smallest angle exactly as the setter computes them.
@@ -265,6 +277,7 @@ void Grid::restore(GridState &&s) {
         active_->refresh_masks(*this);
         active_->mark_all();
     }
+    if (mesh_activity_) mesh_activity_->wake_all();
 }
 
 void Grid::set_source(const double *q) {
@@ -272,7 +285,7 @@ void Grid::set_source(const double *q) {
         source_.assign(q, q + heights_.size());
     else
         source_.clear();
-    if (q && geometry_.dim == 2 && clock_.size() != heights_.size()) {
+    if (q && geometry_.tiled() && clock_.size() != heights_.size()) {
         clock_.assign(heights_.size(), 0.0);
         if (tiled_) tiled_->all_stale = true;
     }
@@ -311,7 +324,7 @@ void Grid::lift_to_bed() {
 }
 
 void Grid::set_side_levels(int side, const double *levels) {
-    const std::int64_t n = side < kYMin ? geometry_.ny : geometry_.nx;
+    const std::int64_t n = geometry_.is_mesh() ? geometry_.mesh->faces : side < kYMin ? geometry_.ny : geometry_.nx;
     if (levels)
         side_levels_[side].assign(levels, levels + n);
     else
@@ -327,7 +340,7 @@ double Grid::outside_level(std::int64_t i, std::int64_t j) const {
 
 void Grid::read_face_fluxes(double *fx, double *fy) const {
     const FaceFluxes &fluxes = *fluxes_;
-    if (geometry_.dim == 1) {
+    if (geometry_.dim == 1 || geometry_.is_mesh()) {
         std::copy(fluxes.x.begin(), fluxes.x.end(), fx);
         return;
     }
@@ -369,7 +382,42 @@ SideLevelRange side_level_range(const std::array<bool, 4> &open, const std::arra
     return range;
 }
 
+void Grid::set_edge_open(const std::uint8_t *open) {
+    const Mesh &mesh = *geometry_.mesh;
+    edges_open_ = 0;
+    if (open) {
+        edge_open_.assign(open, open + mesh.faces);
+        for (std::int64_t f = 0; f < mesh.faces; ++f) {
+            edge_open_[f] = mesh.face_b[f] < 0 && edge_open_[f] != 0;
+            edges_open_ += edge_open_[f];
+        }
+    } else {
+        edge_open_.clear();
+    }
+    side_open_[0] = false;  // the faces say which edges are open
+    ++edges_version_;
+    update_held_levels();
+    touched_everywhere();
+}
+
 void Grid::update_held_levels() {
+    if (geometry_.is_mesh()) {
+        // The levels beyond the open faces of the domain edge.
+        const Mesh &mesh = *geometry_.mesh;
+        const std::vector<double> &levels = side_levels_[0];
+        bool any = false;
+        double lo = 0.0, hi = 0.0;
+        for (std::int64_t f = 0; f < mesh.faces; ++f) {
+            if (mesh.face_b[f] >= 0 || !edge_open(f)) continue;
+            const double level = levels.empty() ? 0.0 : levels[f];
+            lo = any ? std::min(lo, level) : level;
+            hi = any ? std::max(hi, level) : level;
+            any = true;
+        }
+        side_level_min_ = lo;
+        side_level_max_ = hi;
+        return;
+    }
     const SideLevelRange range = side_level_range(side_open_, side_levels_);
     side_level_min_ = range.lowest;
     side_level_max_ = range.highest;
@@ -384,6 +432,11 @@ void Grid::set_face_flux_recording(bool on) {
     if (fluxes_) return;
     auto fluxes = std::make_unique<FaceFluxes>();
     const std::size_t nx = static_cast<std::size_t>(geometry_.nx), ny = static_cast<std::size_t>(geometry_.ny);
+    if (geometry_.is_mesh()) {
+        fluxes->x.assign(static_cast<std::size_t>(geometry_.mesh->faces), 0.0);
+        fluxes_ = std::move(fluxes);
+        return;
+    }
     fluxes->x.assign((nx + 1) * ny, 0.0);
     if (geometry_.dim == 2) {
         fluxes->y.assign(nx * (ny + 1), 0.0);

@@ -8,6 +8,8 @@
 #include <memory>
 #include <vector>
 
+#include "mesh/mesh.hpp"
+#include "mesh/mesh_engine.hpp"
 #include "structured/active_set.hpp"
 #include "model/face_fluxes.hpp"
 #include "model/ledger.hpp"
@@ -35,13 +37,19 @@ enum Relaxation { kTimeAccurate = 0, kToRest = 1, kAutoRelaxation = 2 };
 struct Geometry {
     int dim;             // 1 or 2
     bool axisymmetric;   // a 1D grid in radius r: cell i spans [i dx, (i+1) dx]
-    std::int64_t nx, ny; // ny == 1 in 1D
-    double dx, dy;       // dy == 1 in 1D, so that a cell's area is dx
+    std::int64_t nx, ny; // ny == 1 in 1D and on a mesh
+    double dx, dy;       // dy == 1 in 1D, so that a cell's area is dx; on a mesh the smallest face distance
+    // An unstructured mesh (dim == 2, nx its cells, ny == 1); null on grids.
+    std::shared_ptr<const Mesh> mesh;
 
     std::int64_t cells() const { return nx * ny; }
+    bool is_mesh() const { return mesh != nullptr; }
+    // A 2D Cartesian grid: the tiled engine's.
+    bool tiled() const { return dim == 2 && !mesh; }
     // The area (1D: length; axisymmetric: the ring's area 2 pi r dr) that
     // turns a cell's height into its mass.
     double cell_area(std::int64_t c) const {
+        if (mesh) return mesh->area[static_cast<std::size_t>(c)];
         return axisymmetric ? kTwoPi * (static_cast<double>(c) + 0.5) * dx * dx : dx * dy;
     }
     // The length (axisymmetric: circumference) of the x face on the high side
@@ -50,6 +58,11 @@ struct Geometry {
         return axisymmetric ? kTwoPi * static_cast<double>(i + 1) * dx : dy;
     }
     static constexpr double kTwoPi = 6.283185307179586476925;
+};
+
+// What an engine keeps of its own on a grid (stepping/engine.hpp).
+struct EngineState {
+    virtual ~EngineState() = default;
 };
 
 // What the last step did, for dpsm_get_step_info.
@@ -79,6 +92,7 @@ struct GridState {
     std::vector<double> heights;
     std::vector<float> residuals;
     std::vector<std::uint8_t> kinds;
+    std::vector<std::uint8_t> edge_open;           // a mesh's open edge faces; empty: as side_open[0]
     std::vector<double> source, bed, angle_field;  // empty: none
     double flux_exponent = 1.0;
     double static_angle = 0.0;          // 0: no hysteresis
@@ -164,12 +178,29 @@ public:
     void set_relaxation(Relaxation relaxation) { relaxation_ = relaxation; }
 
     bool side_open(int side) const { return side_open_[side]; }
-    bool any_side_open() const { return side_open_[0] || side_open_[1] || side_open_[2] || side_open_[3]; }
+    bool any_side_open() const {
+        return side_open_[0] || side_open_[1] || side_open_[2] || side_open_[3] || edges_open_ > 0;
+    }
+    // On a mesh, side 0 stands for its domain edge (DPSM_MESH_EDGE); a host
+    // may open some of its faces and not others: per face, in the library's
+    // order (empty: every edge face as side_open(0) says).
+    const std::vector<std::uint8_t> &edge_open_flags() const { return edge_open_; }
+    bool edge_open(std::int64_t face) const {
+        return edge_open_.empty() ? side_open_[0] : edge_open_[static_cast<std::size_t>(face)] != 0;
+    }
+    void set_edge_open(const std::uint8_t *open);  // per face of the mesh, library order; NULL: as side_open(0)
     void set_side_open(int side, bool open) {
         side_open_[side] = open;
+        if (geometry_.is_mesh()) {
+            edge_open_.clear();
+            edges_open_ = 0;
+            ++edges_version_;
+        }
         update_held_levels();
         touched_everywhere();
     }
+    // Changes whenever the host opens or closes edges of a mesh.
+    std::uint64_t edges_version() const { return edges_version_; }
     // The surface level outside an open side, per boundary face (k counts
     // along the side: j for the x sides, i for the y sides); 0 unless the
     // host set levels (dpsm_set_side_levels).
@@ -222,7 +253,7 @@ public:
     // began after which a source cell's stored height is current, where that
     // is later than clock_base(), the count at the start of the present step
     // (at the end of a step every source cell is current).
-    bool lazy_sources() const { return geometry_.dim == 2 && !uses_physics(); }
+    bool lazy_sources() const { return geometry_.tiled() && !uses_physics(); }
     const std::vector<double> &source_clock() const { return clock_; }
     std::vector<double> &source_clock_for_stepping() { return clock_; }
     double clock_base() const { return clock_base_; }
@@ -274,6 +305,12 @@ public:
     MassLedger &ledger() { return ledger_; }
     const MassLedger &ledger() const { return ledger_; }
 
+    // The mesh engine's active set (meshes only).
+    MeshActivity &mesh_activity() { return *mesh_activity_; }
+    const MeshActivity &mesh_activity() const { return *mesh_activity_; }
+    // What an engine keeps between steps besides the grid's fields (meshes: scratch).
+    std::unique_ptr<EngineState> &engine_state() { return engine_state_; }
+
     // Scratch space of the 1D sweep (1D and axisymmetric grids only).
     std::vector<double> &rate_workspace() { return rate_; }
     // The 2D sweep's active set and scratch (2D grids only).
@@ -307,6 +344,7 @@ private:
     // Something that may make any face steep changed: every tile is looked at again.
     void touched_everywhere() {
         if (active_) active_->mark_all();
+        if (mesh_activity_) mesh_activity_->wake_all();
     }
 
     Geometry geometry_;
@@ -335,6 +373,11 @@ private:
     std::vector<std::uint8_t> moving_;
     std::vector<double> rate_;
     std::unique_ptr<ActiveSet> active_;
+    std::unique_ptr<MeshActivity> mesh_activity_;
+    std::unique_ptr<EngineState> engine_state_;
+    std::vector<std::uint8_t> edge_open_;
+    std::int64_t edges_open_ = 0;  // faces of edge_open_ that are open
+    std::uint64_t edges_version_ = 0;
     std::unique_ptr<TiledWorkspace> tiled_;
     std::unique_ptr<RelaxWorkspace> relax_;
     bool record_fluxes_ = false;

@@ -639,7 +639,7 @@ int create_distributed(MPI_Comm comm, std::int64_t nx_global, std::int64_t ny_gl
         const Arguments mine{nx_global, ny_global, i0, j0, nx_local, ny_local, out == nullptr ? 1 : 0, dx, dy};
         const std::vector<Rect> blocks = agreed_blocks(comm, size, mine, fn);
         *out = distributed_grid(comm, rank, blocks, nx_global, ny_global, [&] {
-            return std::make_unique<dpsm_grid>(Geometry{2, false, nx_local, ny_local, dx, dy});
+            return std::make_unique<dpsm_grid>(Geometry{2, false, nx_local, ny_local, dx, dy, nullptr});
         }, fn);
     });
 }

@@ -32,9 +32,7 @@ void begin_face_fluxes(Grid &grid) {
 // between them forever.
 bool can_flow_forever(const Grid &grid, const StepAgreement &state, bool driven) {
     if (driven) return true;
-    const Geometry &geo = grid.geometry();
-    bool any_side_open = grid.side_open(kXMin) || grid.side_open(kXMax);
-    if (geo.dim == 2) any_side_open = any_side_open || grid.side_open(kYMin) || grid.side_open(kYMax);
+    const bool any_side_open = grid.any_side_open();
     if (!state.has_open_cells && !any_side_open) return false;
     double lowest = state.has_open_cells ? state.open_level_min : state.side_level_min;
     double highest = state.has_open_cells ? state.open_level_max : state.side_level_max;

@@ -11,6 +11,7 @@
 #endif
 
 #include "structured/active_set.hpp"
+#include "model/threads.hpp"
 #include "mpi/decomposition.hpp"
 #include "model/grid.hpp"
 #include "model/ledger.hpp"
@@ -25,15 +26,6 @@ constexpr std::int64_t kCellsForThreads = 8 * ActiveSet::kTile * ActiveSet::kTil
 // The longest grid row a tile kernel reads or writes in place: its indices
 // (rows of the buffer times the row length) stay within an int.
 constexpr std::int64_t kMaxDirectRowLength = std::numeric_limits<int>::max() / (2 * kBufferSide);
-
-int thread_count(int requested) {
-#if defined(_OPENMP)
-    return requested > 0 ? requested : omp_get_max_threads();
-#else
-    (void)requested;
-    return 1;
-#endif
-}
 
 // Residuals are kept in float in the grid and in double in a tile's buffer.
 // These loops run once per row of every tile visit; where the CPU has AVX-512

@@ -23,6 +23,7 @@ program test_fortran
   call test_physics()
   call test_coupling()
   call test_restart()
+  call test_meshes()
   call test_destroyed()
 
   if (failures > 0) then
@@ -674,6 +675,294 @@ contains
     close (unit, status='delete')
     call dpsm_destroy(g)
   end subroutine test_restart
+
+  !> Meshes: the three constructors with 1-based indices (good and bad),
+  !> their faces 1-based, per-face kinds, levels and fluxes, and the mesh
+  !> routines refused on a grid.
+  subroutine test_meshes()
+    type(dpsm_grid) :: g, grid
+    real(c_double) :: node_xy(2, 9), h(4), after(4), h2(4, 1), levels(12), fx(12), fx2(12, 1), fy(12)
+    real(c_double) :: out, total, total0, brought(4)
+    integer(c_int64_t) :: cell_start(5), cell_nodes(16), bad_nodes(16), nx, ny, nfaces, faces(2, 12)
+    integer(c_int32_t) :: nf32, faces32(2, 12)
+    integer(c_int8_t) :: kinds(12)
+    integer :: ierr, i, j, f
+    character(len=:), allocatable :: message
+
+    ! A 2 x 2 quad mesh of unit squares over 9 nodes: node 1 + i + 3j at (i, j);
+    ! cell c's nodes counter-clockwise, cell_start from 1 as a Fortran host holds it.
+    do j = 0, 2
+      do i = 0, 2
+        node_xy(:, 1 + i + 3*j) = [real(i, c_double), real(j, c_double)]
+      end do
+    end do
+    cell_start = [1, 5, 9, 13, 17]
+    cell_nodes = [1, 2, 5, 4, 2, 3, 6, 5, 4, 5, 8, 7, 5, 6, 9, 8]
+    call dpsm_create_mesh(g, 9_c_int64_t, node_xy, 4_c_int64_t, cell_start, cell_nodes, ierr)
+    call expect(ierr == DPSM_OK .and. dpsm_associated(g), 'dpsm_create_mesh (c_int64_t): '//dpsm_last_error())
+    call dpsm_get_shape(g, nx, ny)
+    call expect(nx == 4 .and. ny == 1, 'dpsm_get_shape of a mesh is (ncells, 1)')
+    call dpsm_get_face_count(g, nfaces, ierr)
+    call expect(ierr == DPSM_OK .and. nfaces == 12, 'dpsm_get_face_count: 4 interior faces and 8 on the edge')
+    call dpsm_get_face_count(g, nf32, ierr)
+    call expect(ierr == DPSM_OK .and. nf32 == 12, 'dpsm_get_face_count (c_int32_t)')
+    faces = -7
+    call dpsm_get_mesh_faces(g, faces, ierr)
+    call expect(ierr == DPSM_OK, 'dpsm_get_mesh_faces (c_int64_t)')
+    ! Faces as they first appear, cell by cell, edge by edge: cell 1's edges
+    ! 1-2 (edge), 2-5 (cell 2), 5-4 (cell 3), 4-1 (edge); then cell 2's new ones...
+    call expect(all(faces(2, [1, 4, 5, 6, 9, 10, 11, 12]) == 0), 'edge faces have b = 0: '//ints(faces(2, :)))
+    call expect(all(faces(1, [1, 4]) == 1) .and. all(faces(1, [5, 6]) == 2) .and. all(faces(1, [9, 10]) == 3) &
+                .and. all(faces(1, [11, 12]) == 4), 'edge faces name their cell, 1-based: '//ints(faces(1, :)))
+    call expect(same_pair(faces(:, 2), 1, 2) .and. same_pair(faces(:, 3), 1, 3) .and. same_pair(faces(:, 7), 2, 4) &
+                .and. same_pair(faces(:, 8), 3, 4), 'interior faces join their cells, 1-based')
+    faces32 = -7
+    call dpsm_get_mesh_faces(g, faces32, ierr)
+    call expect(ierr == DPSM_OK .and. all(faces32 == faces), 'dpsm_get_mesh_faces (c_int32_t)')
+    call dpsm_get_mesh_faces(g, faces(:, 1:11), ierr)
+    call expect(ierr == DPSM_ERR_INVALID_SIZE, 'dpsm_get_mesh_faces(face_cells(2, 11)) fails with INVALID_SIZE')
+    call expect(index(dpsm_last_error(g), 'face_cells(2, nfaces)') > 0, 'with a message: '//dpsm_last_error(g))
+
+    ! Per-cell arrays hold ncells values: h(ncells) or h(ncells, 1).
+    h = [2.0_c_double, 0.0_c_double, 0.0_c_double, 0.0_c_double]
+    call dpsm_set_heights(g, h, ierr)
+    call expect(ierr == DPSM_OK, 'dpsm_set_heights(h(ncells)) on a mesh')
+    call dpsm_get_heights(g, h2, ierr)
+    call expect(ierr == DPSM_OK .and. all(h2(:, 1) == h), 'dpsm_get_heights(h(ncells, 1)) on a mesh')
+    call dpsm_set_heights(g, node_xy(1, :), ierr)
+    call expect(ierr == DPSM_ERR_INVALID_SIZE, 'dpsm_set_heights(h(9)) on a mesh of 4 cells fails')
+    call dpsm_get_mass(g, DPSM_MASS_TOTAL, total0)
+    call expect(close_to(total0, 2.0_c_double, 1e-12_c_double), 'a mesh: TOTAL is sum h * area')
+
+    ! A collapse between walls, its face fluxes balancing each cell's change.
+    call dpsm_set_face_flux_recording(g, 1_c_int)
+    call dpsm_step(g, 0.05_c_double, ierr)
+    call expect(ierr == DPSM_OK, 'dpsm_step on a mesh')
+    call dpsm_get_heights(g, after)
+    call dpsm_get_face_fluxes(g, fx, ierr=ierr)
+    call expect(ierr == DPSM_OK, 'dpsm_get_face_fluxes(fx(nfaces)) on a mesh')
+    brought = 0
+    do f = 1, 12
+      brought(faces(1, f)) = brought(faces(1, f)) - fx(f)
+      if (faces(2, f) > 0) brought(faces(2, f)) = brought(faces(2, f)) + fx(f)
+    end do
+    call expect(all(abs(brought - (after - h)) <= 1e-14_c_double) .and. after(1) < 2, &
+                'each cell gained what its faces brought (positive from a to b)')
+    call expect(all(fx([1, 4, 5, 6, 9, 10, 11, 12]) == 0), 'walls carry nothing')
+    call dpsm_get_face_fluxes(g, fx2, ierr=ierr)
+    call expect(ierr == DPSM_OK .and. all(fx2(:, 1) == fx), 'dpsm_get_face_fluxes(fx(nfaces, 1)) on a mesh')
+    call dpsm_get_face_fluxes(g, fx, fy, ierr)
+    call expect(ierr == DPSM_ERR_INVALID_VALUE, 'dpsm_get_face_fluxes with fy on a mesh fails with INVALID_VALUE')
+    call dpsm_get_face_fluxes(g, fx(1:5), ierr=ierr)
+    call expect(ierr == DPSM_ERR_INVALID_SIZE, 'dpsm_get_face_fluxes(fx(5)) on a mesh of 12 faces fails')
+    call dpsm_get_mass(g, DPSM_MASS_TOTAL, total)
+    call expect(close_to(total, total0, 1e-12_c_double), 'walls all round the mesh: the mass stays')
+
+    ! The edge: levels and kinds per face (those of interior faces ignored).
+    levels = 5
+    call dpsm_set_side_levels(g, DPSM_MESH_EDGE, levels, ierr)
+    call expect(ierr == DPSM_OK, 'dpsm_set_side_levels(DPSM_MESH_EDGE, levels(nfaces))')
+    call dpsm_set_side_levels(g, DPSM_MESH_EDGE, levels(1:4), ierr)
+    call expect(ierr == DPSM_ERR_INVALID_SIZE, 'dpsm_set_side_levels(DPSM_MESH_EDGE, levels(4)) fails')
+    call dpsm_set_side_levels(g, DPSM_XMIN, levels(1:1), ierr)
+    call expect(ierr == DPSM_ERR_NOT_APPLICABLE, 'a mesh has no side DPSM_XMIN')
+    kinds = int(DPSM_WALL, c_int8_t)
+    kinds(1) = int(DPSM_OPEN, c_int8_t) ! the lower edge of cell 1
+    kinds(2) = 9                        ! an interior face: ignored
+    call dpsm_set_edge_kinds(g, kinds, ierr)
+    call expect(ierr == DPSM_OK, 'dpsm_set_edge_kinds(kinds(nfaces))')
+    kinds(12) = 9
+    call dpsm_set_edge_kinds(g, kinds, ierr)
+    call expect(ierr == DPSM_ERR_UNKNOWN_ENUM, 'dpsm_set_edge_kinds with a kind 9 on the edge fails')
+    call dpsm_set_edge_kinds(g, kinds(1:11), ierr)
+    call expect(ierr == DPSM_ERR_INVALID_SIZE, 'dpsm_set_edge_kinds(kinds(11)) fails with INVALID_SIZE')
+    call dpsm_step(g, 1.0_c_double)
+    call dpsm_get_side_outflow(g, DPSM_MESH_EDGE, out, ierr)
+    call expect(ierr == DPSM_OK .and. out < 0, 'sand comes in through the open face (outside at 5)')
+    call expect_ledger(g, 'a mesh with an open face')
+    call dpsm_set_edge_kinds(g, ierr=ierr)
+    call expect(ierr == DPSM_OK, 'dpsm_set_edge_kinds without kinds: every edge a wall')
+    call dpsm_set_boundary(g, DPSM_MESH_EDGE, DPSM_OPEN, ierr)
+    call expect(ierr == DPSM_OK, 'dpsm_set_boundary(DPSM_MESH_EDGE, DPSM_OPEN)')
+    call dpsm_set_heights_region(g, 0, 0, 1, 1, h(1:1), ierr)
+    call expect(ierr == DPSM_ERR_NOT_APPLICABLE, 'a mesh has no blocks')
+    call dpsm_destroy(g)
+
+    ! Default integers.
+    call dpsm_create_mesh(g, 9, node_xy, 4, int(cell_start, c_int32_t), int(cell_nodes, c_int32_t), ierr)
+    call expect(ierr == DPSM_OK, 'dpsm_create_mesh (default integers)')
+    call dpsm_destroy(g)
+
+    ! Bad input: node 10 of 9 (C's message counts from 0), node 0, a cell of 2 nodes.
+    bad_nodes = cell_nodes
+    bad_nodes(3) = 10
+    call dpsm_create_mesh(g, 9_c_int64_t, node_xy, 4_c_int64_t, cell_start, bad_nodes, ierr)
+    message = dpsm_last_error()
+    call expect(ierr == DPSM_ERR_INVALID_VALUE .and. .not. dpsm_associated(g), &
+                'dpsm_create_mesh with node 10 of 9 fails with INVALID_VALUE')
+    call expect(index(message, 'cell_nodes[2] = 9 is not a node index in [0, 8]') > 0, &
+                'the message names the 0-based copy: '//message)
+    bad_nodes(3) = 0
+    call dpsm_create_mesh(g, 9_c_int64_t, node_xy, 4_c_int64_t, cell_start, bad_nodes, ierr)
+    call expect(ierr == DPSM_ERR_INVALID_VALUE, 'dpsm_create_mesh with node 0 fails with INVALID_VALUE')
+    call dpsm_create_mesh(g, 9, node_xy, 4, [1, 5, 9, 13, 15], int(cell_nodes(1:14), c_int32_t), ierr)
+    call expect(ierr == DPSM_ERR_INVALID_VALUE, 'dpsm_create_mesh with a cell of 2 nodes fails with INVALID_VALUE')
+    call dpsm_create_mesh(g, 9_c_int64_t, node_xy, 4_c_int64_t, cell_start, cell_nodes(1:15), ierr)
+    message = dpsm_last_error()
+    call expect(ierr == DPSM_ERR_INVALID_SIZE, 'dpsm_create_mesh with 15 node indices for 16 fails with INVALID_SIZE')
+    call expect(index(message, 'cell_nodes has 15 values but cell_start(ncells+1)-1 = 16') > 0, &
+                'the Fortran side names the sizes: '//message)
+    call dpsm_create_mesh(g, 9_c_int64_t, node_xy(:, 1:8), 4_c_int64_t, cell_start, cell_nodes, ierr)
+    call expect(ierr == DPSM_ERR_INVALID_SIZE, &
+                'dpsm_create_mesh with node_xy(2, 8) for 9 nodes fails: '//dpsm_last_error())
+    call expect(index(dpsm_last_error(), 'node_xy(2, nnodes)') > 0, &
+                'dpsm_create_mesh with node_xy(2, 8) for 9 nodes fails: '//dpsm_last_error())
+    call dpsm_create_mesh(g, 0_c_int64_t, node_xy, 4_c_int64_t, cell_start, cell_nodes, ierr)
+    call expect(ierr == DPSM_ERR_INVALID_SIZE, &
+                'dpsm_create_mesh(nnodes = 0) fails in C: '//dpsm_last_error())
+    call expect(index(dpsm_last_error(), 'nnodes') > 0, &
+                'dpsm_create_mesh(nnodes = 0) fails in C: '//dpsm_last_error())
+    call expect(.not. dpsm_associated(g), 'no mesh after the failures')
+
+    ! The mesh routines on a grid.
+    call dpsm_create_2d(grid, 3, 3, 1.0_c_double, 1.0_c_double)
+    call dpsm_get_face_count(grid, nfaces, ierr)
+    call expect(ierr == DPSM_ERR_NOT_APPLICABLE, 'dpsm_get_face_count on a grid fails with NOT_APPLICABLE')
+    call dpsm_get_mesh_faces(grid, faces, ierr)
+    call expect(ierr == DPSM_ERR_NOT_APPLICABLE, &
+                'dpsm_get_mesh_faces on a grid fails with NOT_APPLICABLE: '//dpsm_last_error(grid))
+    call expect(index(dpsm_last_error(grid), 'dpsm_get_mesh_faces') > 0, &
+                'dpsm_get_mesh_faces on a grid fails with NOT_APPLICABLE: '//dpsm_last_error(grid))
+    call dpsm_set_edge_kinds(grid, kinds, ierr)
+    call expect(ierr == DPSM_ERR_NOT_APPLICABLE, 'dpsm_set_edge_kinds on a grid fails with NOT_APPLICABLE')
+    call dpsm_set_boundary(grid, DPSM_MESH_EDGE, DPSM_OPEN, ierr)
+    call expect(ierr == DPSM_ERR_NOT_APPLICABLE, 'a grid has no DPSM_MESH_EDGE')
+    call dpsm_destroy(grid)
+
+    call test_dual_mesh()
+    call test_graph()
+  end subroutine test_meshes
+
+  !> The median dual of 2 triangles over the unit square: one cell per node.
+  subroutine test_dual_mesh()
+    type(dpsm_grid) :: g
+    real(c_double) :: node_xy(2, 4), h(4), total
+    integer(c_int64_t) :: tris(3, 2), nx, ny, nfaces
+    integer(c_int64_t), allocatable :: faces(:, :)
+    integer :: ierr
+    node_xy = reshape([0.0_c_double, 0.0_c_double, 1.0_c_double, 0.0_c_double, &
+                       1.0_c_double, 1.0_c_double, 0.0_c_double, 1.0_c_double], [2, 4])
+    tris = reshape([1_c_int64_t, 2_c_int64_t, 3_c_int64_t, 1_c_int64_t, 3_c_int64_t, 4_c_int64_t], [3, 2])
+    call dpsm_create_dual_mesh(g, 4_c_int64_t, node_xy, 2_c_int64_t, tris, ierr)
+    call expect(ierr == DPSM_OK, 'dpsm_create_dual_mesh (c_int64_t): '//dpsm_last_error())
+    call dpsm_get_shape(g, nx, ny)
+    call expect(nx == 4 .and. ny == 1, 'a dual mesh has one cell per node')
+    call dpsm_get_face_count(g, nfaces)
+    ! 5 triangle edges between node cells, then 2 halves of each of the 4 boundary edges.
+    call expect(nfaces == 13, 'a dual mesh of 2 triangles has 5 + 8 faces')
+    allocate (faces(2, nfaces))
+    call dpsm_get_mesh_faces(g, faces)
+    call expect(all(faces(2, 1:5) > 0) .and. all(faces(2, 6:13) == 0) .and. all(faces(1, :) >= 1) .and. &
+                all(faces(1, :) <= 4), 'the triangle edges join node cells, 1-based, the halves lie on the edge')
+    call expect(same_pair(faces(:, 1), 1, 2), 'the first face joins nodes 1 and 2')
+    h = [1.0_c_double, 0.0_c_double, 0.0_c_double, 0.0_c_double]
+    call dpsm_set_heights(g, h)
+    call dpsm_step(g, 1.0_c_double)
+    call dpsm_get_mass(g, DPSM_MASS_TOTAL, total)
+    ! Node 1 lies in both triangles: its cell has a third of their area, 1/3.
+    call expect(close_to(total, 1/3.0_c_double, 1e-12_c_double), 'a node cell has a third of its triangles'' area')
+    call expect_ledger(g, 'a dual mesh')
+    call dpsm_destroy(g)
+    call dpsm_create_dual_mesh(g, 4, node_xy, 2, int(tris, c_int32_t), ierr)
+    call expect(ierr == DPSM_OK, 'dpsm_create_dual_mesh (default integers)')
+    call dpsm_destroy(g)
+    tris(2, 2) = 5
+    call dpsm_create_dual_mesh(g, 4_c_int64_t, node_xy, 2_c_int64_t, tris, ierr)
+    call expect(ierr == DPSM_ERR_INVALID_VALUE, &
+                'dpsm_create_dual_mesh with node 5 of 4 fails, C naming the 0-based copy: '//dpsm_last_error())
+    call expect(index(dpsm_last_error(), 'triangle_nodes[4] (triangle 1) = 4') > 0, &
+                'dpsm_create_dual_mesh with node 5 of 4 fails, C naming the 0-based copy: '//dpsm_last_error())
+    tris(2, 2) = 3
+    call dpsm_create_dual_mesh(g, 4_c_int64_t, node_xy, 2_c_int64_t, tris(:, 1:1), ierr)
+    call expect(ierr == DPSM_ERR_INVALID_SIZE, &
+                'dpsm_create_dual_mesh with 1 triangle for 2 fails: '//dpsm_last_error())
+    call expect(index(dpsm_last_error(), 'triangle_nodes(3, ntriangles)') > 0, &
+                'dpsm_create_dual_mesh with 1 triangle for 2 fails: '//dpsm_last_error())
+  end subroutine test_dual_mesh
+
+  !> A graph of 2 unit squares side by side: one interior face, 6 on the edge.
+  subroutine test_graph()
+    type(dpsm_grid) :: g
+    real(c_double) :: cell_xy(2, 2), area(2), face_xy(2, 7), length(7), h(2), fx(7), total
+    integer(c_int64_t) :: face_cells(2, 7), back(2, 7), bad(2, 7), nx, ny, nfaces
+    integer :: ierr
+    cell_xy = reshape([0.5_c_double, 0.5_c_double, 1.5_c_double, 0.5_c_double], [2, 2])
+    area = 1
+    ! Face 1 between the cells; then cell 1's left, bottom and top; cell 2's right, bottom and top.
+    face_cells = reshape([1_c_int64_t, 2_c_int64_t, 1_c_int64_t, 0_c_int64_t, 1_c_int64_t, 0_c_int64_t, &
+                          1_c_int64_t, 0_c_int64_t, 2_c_int64_t, 0_c_int64_t, 2_c_int64_t, 0_c_int64_t, &
+                          2_c_int64_t, 0_c_int64_t], [2, 7])
+    face_xy = reshape([1.0_c_double, 0.5_c_double, 0.0_c_double, 0.5_c_double, 0.5_c_double, 0.0_c_double, &
+                       0.5_c_double, 1.0_c_double, 2.0_c_double, 0.5_c_double, 1.5_c_double, 0.0_c_double, &
+                       1.5_c_double, 1.0_c_double], [2, 7])
+    length = 1
+    call dpsm_create_graph(g, 2_c_int64_t, cell_xy, area, 7_c_int64_t, face_cells, face_xy, length, ierr)
+    call expect(ierr == DPSM_OK, 'dpsm_create_graph (c_int64_t): '//dpsm_last_error())
+    call dpsm_get_shape(g, nx, ny)
+    call dpsm_get_face_count(g, nfaces)
+    call expect(nx == 2 .and. ny == 1 .and. nfaces == 7, 'a graph of 2 cells and 7 faces')
+    call dpsm_get_mesh_faces(g, back)
+    call expect(all(back == face_cells), 'dpsm_get_mesh_faces gives back the host''s faces, 1-based, 0 on the edge')
+    h = [2.0_c_double, 0.0_c_double]
+    call dpsm_set_heights(g, h)
+    call dpsm_set_face_flux_recording(g, 1_c_int)
+    call dpsm_step(g, 0.1_c_double)
+    call dpsm_get_heights(g, h)
+    call dpsm_get_face_fluxes(g, fx)
+    call expect(h(2) > 0 .and. fx(1) > 0 .and. abs(fx(1) - h(2)) <= 1e-14_c_double, &
+                'sand crosses face 1 from cell 1 to cell 2')
+    call dpsm_get_mass(g, DPSM_MASS_TOTAL, total)
+    call expect(close_to(total, 2.0_c_double, 1e-12_c_double), 'a graph: the mass stays')
+    call dpsm_destroy(g)
+    call dpsm_create_graph(g, 2, cell_xy, area, 7, int(face_cells, c_int32_t), face_xy, length, ierr)
+    call expect(ierr == DPSM_OK, 'dpsm_create_graph (default integers)')
+    call dpsm_destroy(g)
+    bad = face_cells
+    bad(2, 1) = 3
+    call dpsm_create_graph(g, 2_c_int64_t, cell_xy, area, 7_c_int64_t, bad, face_xy, length, ierr)
+    call expect(ierr == DPSM_ERR_INVALID_VALUE, &
+                'dpsm_create_graph with cell 3 of 2 fails, C naming the 0-based copy: '//dpsm_last_error())
+    call expect(index(dpsm_last_error(), 'face 0: face_cells[1] = 2') > 0, &
+                'dpsm_create_graph with cell 3 of 2 fails, C naming the 0-based copy: '//dpsm_last_error())
+    bad = face_cells
+    bad(1, 2) = 0
+    call dpsm_create_graph(g, 2_c_int64_t, cell_xy, area, 7_c_int64_t, bad, face_xy, length, ierr)
+    call expect(ierr == DPSM_ERR_INVALID_VALUE, 'dpsm_create_graph with a = 0 (the edge) fails with INVALID_VALUE')
+    call dpsm_create_graph(g, 2_c_int64_t, cell_xy, area, 7_c_int64_t, face_cells, face_xy, length(1:6), ierr)
+    call expect(ierr == DPSM_ERR_INVALID_SIZE, &
+                'dpsm_create_graph with face_length(6) for 7 faces fails: '//dpsm_last_error())
+    call expect(index(dpsm_last_error(), 'face_length has 6 values') > 0, &
+                'dpsm_create_graph with face_length(6) for 7 faces fails: '//dpsm_last_error())
+    call expect(.not. dpsm_associated(g), 'no graph after the failures')
+  end subroutine test_graph
+
+  logical function same_pair(pair, a, b)
+    integer(c_int64_t), intent(in) :: pair(2)
+    integer, intent(in) :: a, b
+    same_pair = (pair(1) == a .and. pair(2) == b) .or. (pair(1) == b .and. pair(2) == a)
+  end function same_pair
+
+  function ints(values) result(s)
+    integer(c_int64_t), intent(in) :: values(:)
+    character(len=:), allocatable :: s
+    character(len=24) :: buffer
+    integer :: k
+    s = ''
+    do k = 1, size(values)
+      write (buffer, '(i0)') values(k)
+      s = s//' '//trim(buffer)
+    end do
+  end function ints
 
   subroutine test_destroyed()
     type(dpsm_grid) :: g, empty

@@ -629,9 +629,9 @@ static void op_parameter(reader_t *r, unsigned which) {
             const unsigned b = u8(r);
             const int side = (int)(b % 6) - 1, kind = (int)((b / 6) % 4) - 1;
             int want = DPSM_OK;
-            if (side < 0 || side > 3 || kind < 0 || kind > 1)
+            if (side < 0 || side > DPSM_MESH_EDGE || kind < 0 || kind > 1)
                 want = DPSM_ERR_UNKNOWN_ENUM;
-            else if ((s->geom != GEOM_2D && side >= 2) || (s->geom == GEOM_AXI && side == DPSM_XMIN))
+            else if (side == DPSM_MESH_EDGE || (s->geom != GEOM_2D && side >= 2) || (s->geom == GEOM_AXI && side == DPSM_XMIN))
                 want = DPSM_ERR_NOT_APPLICABLE;
             ON_BOTH(s, want, g_op, dpsm_set_boundary(g_, side, kind));
             if (want == DPSM_OK) s->open[side] = kind == DPSM_OPEN;
@@ -1285,7 +1285,11 @@ static void op_coupling(reader_t *r) {
     const unsigned which = u8(r), b = u8(r);
     const int side = (int)(b % 6) - 1;
     const int known = side >= DPSM_XMIN && side <= DPSM_YMAX;
-    const int side_status = !known ? DPSM_ERR_UNKNOWN_ENUM : has_side(s, side) ? DPSM_OK : DPSM_ERR_NOT_APPLICABLE;
+    /* DPSM_MESH_EDGE is a side of meshes only. */
+    const int side_status = side == DPSM_MESH_EDGE ? DPSM_ERR_NOT_APPLICABLE
+                            : !known               ? DPSM_ERR_UNKNOWN_ENUM
+                            : has_side(s, side)    ? DPSM_OK
+                                                   : DPSM_ERR_NOT_APPLICABLE;
     switch (which % 4) {
         case 0: {
             g_op = "dpsm_set_side_levels";

@@ -38,6 +38,7 @@ C_TYPES = {
     "double *": ctypes.POINTER(ctypes.c_double),
     "const double *": ctypes.POINTER(ctypes.c_double),
     "int64_t *": ctypes.POINTER(ctypes.c_int64),
+    "const int64_t *": ctypes.POINTER(ctypes.c_int64),
     "const uint8_t *": ctypes.POINTER(ctypes.c_uint8),
 }
 

@@ -506,7 +506,8 @@ class TestCoupling(LedgerMixin, unittest.TestCase):
             g.set_side_levels(dpsm.XMIN)  # back to 0
             if np is not None:
                 g.set_side_levels(dpsm.XMAX, np.full(5, 0.1))
-            self.assertFails(dpsm.ERR_UNKNOWN_ENUM, g.set_side_levels, 4, [0.0] * 5)
+            self.assertFails(dpsm.ERR_UNKNOWN_ENUM, g.set_side_levels, 9, [0.0] * 5)
+            self.assertFails(dpsm.ERR_NOT_APPLICABLE, g.set_side_levels, dpsm.MESH_EDGE, [0.0] * 5)
             self.assertFails(dpsm.ERR_UNKNOWN_ENUM, g.get_side_outflow, -1)
             self.assertFails(dpsm.ERR_INVALID_SIZE, g.set_side_levels, dpsm.XMIN, [0.0] * 12)
             e = self.assertFails(dpsm.ERR_INVALID_VALUE, g.set_side_levels, dpsm.YMAX, [0.0] * 11 + [float("nan")])
@@ -666,6 +667,291 @@ class TestRestart(LedgerMixin, unittest.TestCase):
             self.assertFails(dpsm.ERR_IO, g.save, "nul\0byte")
             g.step(0.1)  # the grid is as it was
         self.assertFails(dpsm.ERR_NULL_POINTER, g.save, self.path)
+
+
+class FakeBlock:
+    """A meshio CellBlock: .type and .data."""
+
+    def __init__(self, kind, data):
+        self.type = kind
+        self.data = data
+
+
+class FakeMesh:
+    """A meshio.Mesh as Grid.from_meshio sees it: .points and .cells (meshio is not installed here)."""
+
+    def __init__(self, points, cells):
+        self.points = points
+        self.cells = cells
+
+
+def square_nodes(n, d=1.0):
+    """The (n+1)^2 nodes of an n by n square of side n*d, node i + (n+1)*j at (i*d, j*d)."""
+    return [(i * d, j * d) for j in range(n + 1) for i in range(n + 1)]
+
+
+def split_squares(n):
+    """Two triangles (0-based nodes) per square of square_nodes(n)."""
+    triangles = []
+    for j in range(n):
+        for i in range(n):
+            a, b = i + (n + 1) * j, i + 1 + (n + 1) * j
+            c, d = b + n + 1, a + n + 1
+            triangles += [(a, b, c), (a, c, d)]
+    return triangles
+
+
+class TestMesh(LedgerMixin, unittest.TestCase):
+    """Meshes: create_mesh (Grid.mesh), create_graph (Grid.graph), create_dual_mesh (Grid.dual_mesh),
+    from_meshio, their faces, edge kinds, levels and fluxes; 0-based indices as in C."""
+
+    # A 2 x 2 quad mesh of unit squares over 9 nodes, cells counter-clockwise.
+    node_xy = square_nodes(2)
+    cell_start = [0, 4, 8, 12, 16]
+    cell_nodes = [0, 1, 4, 3, 1, 2, 5, 4, 3, 4, 7, 6, 4, 5, 8, 7]
+    # Faces as they first appear, cell by cell, edge by edge.
+    faces = [[0, -1], [0, 1], [0, 2], [0, -1], [1, -1], [1, -1], [1, 3], [2, 3], [2, -1], [2, -1], [3, -1], [3, -1]]
+    edge = [0, 3, 4, 5, 8, 9, 10, 11]
+
+    def test_quad_mesh(self):
+        with dpsm.Grid.create_mesh(self.node_xy, self.cell_start, self.cell_nodes) as g:
+            self.assertEqual(g.kind, "mesh")
+            self.assertEqual(g.get_shape(), (4, 1))
+            self.assertEqual(g.shape, (4,))
+            self.assertIn("ncells=4", repr(g))
+            self.assertEqual(g.get_face_count(), 12)
+            self.assertEqual(g.face_count(), 12)
+            self.assertEqual(as_list(g.get_mesh_faces()), self.faces)
+            faces = g.mesh_faces()
+            if np is not None:
+                self.assertEqual(faces.shape, (12, 2))
+                self.assertEqual(faces.dtype, np.int64)
+            else:
+                self.assertIsInstance(faces, list)
+            g.set_heights([1.0, 2.0, 3.0, 4.0])
+            self.assertEqual(as_list(g.get_heights()), [1.0, 2.0, 3.0, 4.0])
+            self.assertAlmostEqual(g.get_mass(dpsm.MASS_TOTAL), 10.0, delta=1e-12)
+            self.assertFails(dpsm.ERR_INVALID_SIZE, g.set_heights, [1.0] * 5)
+            out = array.array("d", [0.0] * 4)
+            self.assertIs(g.get_heights(out=out), out)
+            self.assertEqual(list(out), [1.0, 2.0, 3.0, 4.0])
+            # A mesh has no blocks and no x or y sides.
+            self.assertFails(dpsm.ERR_NOT_APPLICABLE, g.get_heights_region, 0, 0, 1, 1)
+            self.assertFails(dpsm.ERR_NOT_APPLICABLE, g.set_boundary, dpsm.XMIN, dpsm.OPEN)
+
+    def test_aliases_and_flat_input(self):
+        flat_xy = [v for xy in self.node_xy for v in xy]
+        with dpsm.Grid.mesh(flat_xy, self.cell_start, self.cell_nodes) as g:
+            self.assertEqual(as_list(g.mesh_faces()), self.faces)
+        if np is not None:
+            with dpsm.Grid.mesh(np.array(self.node_xy), np.array(self.cell_start, dtype=np.int32),
+                                np.array(self.cell_nodes, dtype=np.uint16)) as g:
+                self.assertEqual(g.face_count(), 12)
+
+    def test_bad_meshes(self):
+        f = dpsm.Grid.create_mesh
+        bad = list(self.cell_nodes)
+        bad[2] = 9
+        e = self.assertFails(dpsm.ERR_INVALID_VALUE, f, self.node_xy, self.cell_start, bad)
+        self.assertEqual(e.function, "dpsm_create_mesh")
+        self.assertIn("cell_nodes[2] = 9 is not a node index in [0, 8]", e.message)
+        self.assertEqual(dpsm.last_error(), e.message)
+        bad[2] = -1
+        self.assertFails(dpsm.ERR_INVALID_VALUE, f, self.node_xy, self.cell_start, bad)
+        e = self.assertFails(dpsm.ERR_INVALID_VALUE, f, self.node_xy, [0, 4, 8, 12, 14], self.cell_nodes[:14])
+        self.assertIn("cell 3", e.message)
+        e = self.assertFails(dpsm.ERR_INVALID_SIZE, f, self.node_xy, self.cell_start, self.cell_nodes[:15])
+        self.assertIn("cell_nodes has 15 values but cell_start[-1] is 16", e.message)
+        self.assertFails(dpsm.ERR_INVALID_SIZE, f, [(0.0, 0.0, 0.0)] * 9, self.cell_start, self.cell_nodes)
+        self.assertFails(dpsm.ERR_INVALID_SIZE, f, [0.0] * 17, self.cell_start, self.cell_nodes)
+        self.assertFails(dpsm.ERR_INVALID_SIZE, f, self.node_xy, [0], [])
+        self.assertFails(dpsm.ERR_INVALID_SIZE, f, [], self.cell_start, self.cell_nodes)
+        with self.assertRaises(TypeError):
+            f(self.node_xy, [0.0, 4.0, 8.0, 12.0, 16.0], self.cell_nodes)
+        self.assertFails(dpsm.ERR_INVALID_VALUE, f, self.node_xy, self.cell_start, [2**70] + self.cell_nodes[1:])
+
+    def test_faces_kinds_levels_and_fluxes(self):
+        g = dpsm.Grid.create_mesh(self.node_xy, self.cell_start, self.cell_nodes)
+        h = [2.0, 0.0, 0.0, 0.0]
+        g.set_heights(h)
+        g.set_face_flux_recording(True)
+        g.step(0.05)
+        after = flat(g.get_heights())
+        fx, fy = g.get_face_fluxes()
+        self.assertIsNone(fy)
+        fx = flat(fx)
+        self.assertEqual(len(fx), 12)
+        brought = [0.0] * 4
+        for (a, b), q in zip(self.faces, fx):
+            brought[a] -= q
+            if b >= 0:
+                brought[b] += q
+        for c in range(4):
+            self.assertAlmostEqual(brought[c], after[c] - h[c], delta=1e-14)  # unit areas
+        self.assertLess(after[0], 2.0)
+        self.assertEqual([fx[k] for k in self.edge], [0.0] * 8)
+        self.assertFails(dpsm.ERR_INVALID_VALUE, g.get_face_fluxes, None, array.array("d", [0.0] * 12))
+        self.assertAlmostEqual(g.get_mass(dpsm.MASS_TOTAL), 2.0, delta=1e-12)
+
+        # One open face at level 5, above the sand: sand comes in through it.
+        g.set_side_levels(dpsm.MESH_EDGE, [5.0] * 12)
+        self.assertFails(dpsm.ERR_INVALID_SIZE, g.set_side_levels, dpsm.MESH_EDGE, [0.5] * 4)
+        self.assertFails(dpsm.ERR_NOT_APPLICABLE, g.set_side_levels, dpsm.XMIN, [0.5])
+        kinds = [dpsm.WALL] * 12
+        kinds[0] = dpsm.OPEN
+        kinds[1] = 9  # an interior face: ignored
+        g.set_edge_kinds(kinds)
+        kinds[11] = 9
+        e = self.assertFails(dpsm.ERR_UNKNOWN_ENUM, g.set_edge_kinds, kinds)
+        self.assertIn("kinds[11]", e.message)
+        self.assertFails(dpsm.ERR_INVALID_SIZE, g.set_edge_kinds, kinds[:11])
+        self.assertFails(dpsm.ERR_UNKNOWN_ENUM, g.set_edge_kinds, [300] * 12)
+        g.step(1.0)
+        self.assertLess(g.get_side_outflow(dpsm.MESH_EDGE), 0.0)
+        self.assertLedger(g)
+        g.set_edge_kinds(None)
+        g.set_boundary(dpsm.MESH_EDGE, dpsm.OPEN)
+        g.set_side_levels(dpsm.MESH_EDGE, None)
+        g.close()
+
+    def test_mesh_functions_on_a_grid(self):
+        with dpsm.Grid.create_2d(3, 3, 1.0, 1.0) as g:
+            self.assertFails(dpsm.ERR_NOT_APPLICABLE, g.get_face_count)
+            e = self.assertFails(dpsm.ERR_NOT_APPLICABLE, g.get_mesh_faces)
+            self.assertEqual(e.function, "dpsm_get_mesh_faces")
+            self.assertFails(dpsm.ERR_NOT_APPLICABLE, g.set_edge_kinds, [dpsm.OPEN] * 9)
+            self.assertFails(dpsm.ERR_NOT_APPLICABLE, g.set_edge_kinds, None)
+            self.assertFails(dpsm.ERR_NOT_APPLICABLE, g.set_boundary, dpsm.MESH_EDGE, dpsm.OPEN)
+
+    def test_dual_mesh(self):
+        square = [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)]
+        triangles = [(0, 1, 2), (0, 2, 3)]
+        with dpsm.Grid.create_dual_mesh(square, triangles) as g:
+            self.assertEqual(g.get_shape(), (4, 1))
+            # The 5 triangle edges, then the halves of the 4 boundary edges.
+            self.assertEqual(g.get_face_count(), 13)
+            faces = as_list(g.get_mesh_faces())
+            self.assertEqual(faces[:5], [[0, 1], [0, 2], [0, 3], [1, 2], [2, 3]])
+            self.assertEqual([b for a, b in faces[5:]], [-1] * 8)
+            g.set_heights([1.0, 0.0, 0.0, 0.0])
+            self.assertAlmostEqual(g.get_mass(dpsm.MASS_TOTAL), 1 / 3, delta=1e-12)  # a third of two triangles
+        with dpsm.Grid.dual_mesh([v for xy in square for v in xy], [0, 1, 2, 0, 2, 3]) as g:
+            self.assertEqual(g.face_count(), 13)
+        e = self.assertFails(dpsm.ERR_INVALID_VALUE, dpsm.Grid.create_dual_mesh, square, [(0, 1, 2), (0, 2, 4)])
+        self.assertIn("triangle 1", e.message)
+        self.assertFails(dpsm.ERR_INVALID_SIZE, dpsm.Grid.create_dual_mesh, square, [0, 1, 2, 0])
+        self.assertFails(dpsm.ERR_INVALID_VALUE, dpsm.Grid.create_dual_mesh, square + [(5.0, 5.0)], triangles)
+
+    def test_graph(self):
+        # Two unit squares side by side: face 0 between them, 6 on the edge.
+        cell_xy = [(0.5, 0.5), (1.5, 0.5)]
+        face_cells = [(0, 1), (0, -1), (0, -1), (0, -1), (1, -1), (1, -1), (1, -1)]
+        face_xy = [(1.0, 0.5), (0.0, 0.5), (0.5, 0.0), (0.5, 1.0), (2.0, 0.5), (1.5, 0.0), (1.5, 1.0)]
+        g = dpsm.Grid.create_graph(cell_xy, [1.0, 1.0], face_cells, face_xy, [1.0] * 7)
+        self.assertEqual(g.get_shape(), (2, 1))
+        self.assertEqual(g.get_face_count(), 7)
+        self.assertEqual(as_list(g.get_mesh_faces()), [list(p) for p in face_cells])  # the host's order
+        g.set_heights([2.0, 0.0])
+        g.set_face_flux_recording(1)
+        g.step(0.1)
+        h = flat(g.get_heights())
+        fx = flat(g.get_face_fluxes()[0])
+        self.assertGreater(fx[0], 0.0)
+        self.assertAlmostEqual(fx[0], h[1], delta=1e-14)
+        self.assertAlmostEqual(sum(h), 2.0, delta=1e-12)
+        g.close()
+        with dpsm.Grid.graph(cell_xy, [1.0, 1.0], face_cells, face_xy, [1.0] * 7) as g:
+            self.assertEqual(g.face_count(), 7)
+        bad = list(face_cells)
+        bad[0] = (0, 2)
+        e = self.assertFails(dpsm.ERR_INVALID_VALUE, dpsm.Grid.create_graph, cell_xy, [1.0, 1.0], bad, face_xy,
+                             [1.0] * 7)
+        self.assertIn("face 0", e.message)
+        bad[0] = (0, 0)
+        self.assertFails(dpsm.ERR_INVALID_VALUE, dpsm.Grid.create_graph, cell_xy, [1.0, 1.0], bad, face_xy, [1.0] * 7)
+        e = self.assertFails(dpsm.ERR_INVALID_SIZE, dpsm.Grid.create_graph, cell_xy, [1.0, 1.0], face_cells, face_xy,
+                             [1.0] * 6)
+        self.assertIn("face_length has 6 values", e.message)
+        self.assertFails(dpsm.ERR_INVALID_SIZE, dpsm.Grid.create_graph, cell_xy, [1.0], face_cells, face_xy,
+                         [1.0] * 7)
+
+    def test_column_collapse_on_triangles(self):
+        # A column of sand on a 12 x 12 triangle mesh of a square, between walls.
+        n, d = 12, 0.1
+        triangles = split_squares(n)
+        node_xy = square_nodes(n, d)
+        cell_start = [3 * t for t in range(len(triangles) + 1)]
+        cell_nodes = [v for tri in triangles for v in tri]
+        g = dpsm.Grid.create_mesh(node_xy, cell_start, cell_nodes)
+        self.assertEqual(g.get_shape(), (2 * n * n, 1))
+        centre = n * d / 2
+        h = []
+        for tri in triangles:
+            x = sum(node_xy[v][0] for v in tri) / 3
+            y = sum(node_xy[v][1] for v in tri) / 3
+            h.append(1.0 if math.hypot(x - centre, y - centre) < 0.25 else 0.0)
+        g.set_heights(h)
+        mass = g.get_mass(dpsm.MASS_TOTAL)
+        self.assertAlmostEqual(mass, sum(h) * d * d / 2, delta=1e-12)
+        g.step(10.0)
+        self.assertEqual(g.get_step_info(dpsm.INFO_AT_REST), 1.0)
+        after = flat(g.get_heights())
+        self.assertLess(max(after), 1.0)
+        self.assertGreater(sum(1 for v in after if v > 0.0), sum(1 for v in h if v > 0.0))  # it spread
+        self.assertAlmostEqual(g.get_mass(dpsm.MASS_TOTAL), mass, delta=1e-12 * mass)
+        self.assertLedger(g)
+        g.close()
+
+    def test_restart(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            path = os.path.join(tmp, "mesh.dpsm")
+            with dpsm.Grid.create_mesh(self.node_xy, self.cell_start, self.cell_nodes) as g:
+                g.set_heights([2.0, 0.0, 0.0, 0.0])
+                g.save(path)
+                with dpsm.Grid.load(path) as loaded:
+                    self.assertEqual(loaded.kind, "mesh")
+                    self.assertEqual(loaded.shape, (4,))
+                    self.assertEqual(loaded.last_error(), "")
+                    self.assertEqual(as_list(loaded.get_mesh_faces()), self.faces)
+                    g.step(0.05)
+                    loaded.step(0.05)
+                    self.assertEqual(as_list(loaded.get_heights()), as_list(g.get_heights()))
+
+    def test_from_meshio(self):
+        # Two quads and two triangles over 7 points with z, a line block and a vertex block to skip.
+        points = [(0.0, 0.0, 0.0), (1.0, 0.0, 0.0), (2.0, 0.0, 0.0), (0.0, 1.0, 0.0), (1.0, 1.0, 0.0),
+                  (2.0, 1.0, 0.0), (1.0, 2.0, 0.0)]
+        cells = [FakeBlock("vertex", [[0]]),
+                 FakeBlock("line", [[0, 1], [1, 2]]),
+                 FakeBlock("quad", [[0, 1, 4, 3], [1, 2, 5, 4]]),
+                 FakeBlock("triangle", [[3, 4, 6], [4, 5, 6]])]
+        with dpsm.Grid.from_meshio(FakeMesh(points, cells)) as g:
+            self.assertEqual(g.get_shape(), (4, 1))
+            faces = as_list(g.get_mesh_faces())
+            self.assertEqual(sorted(tuple(sorted(p)) for p in faces if p[1] >= 0), [(0, 1), (0, 2), (1, 3), (2, 3)])
+            g.set_heights([1.0, 1.0, 1.0, 1.0])
+            self.assertAlmostEqual(g.get_mass(dpsm.MASS_TOTAL), 3.0, delta=1e-12)  # 1 + 1 + 1/2 + 1/2
+        # (type, data) pairs and 2D points; a polygon block.
+        with dpsm.Grid.from_meshio(FakeMesh([p[:2] for p in points], [("polygon", [[0, 1, 2, 5, 4, 3]])])) as g:
+            self.assertEqual(g.get_shape(), (1, 1))
+            self.assertEqual(g.get_face_count(), 6)
+        # Polygons of several sizes in one block: a quad and a triangle.
+        with dpsm.Grid.from_meshio(FakeMesh(points, [FakeBlock("polygon", [[0, 1, 4, 3], [3, 4, 6]])])) as g:
+            self.assertEqual(g.get_shape(), (2, 1))
+            self.assertEqual(g.get_face_count(), 6)
+        if np is not None:
+            mesh = FakeMesh(np.array(points), [FakeBlock("line", np.array([[0, 1]])),
+                                               FakeBlock("quad", np.array([[0, 1, 4, 3], [1, 2, 5, 4]])),
+                                               FakeBlock("triangle", np.array([[3, 4, 6], [4, 5, 6]]))])
+            with dpsm.Grid.from_meshio(mesh) as g:
+                self.assertEqual(g.get_shape(), (4, 1))
+        e = self.assertFails(dpsm.ERR_INVALID_VALUE, dpsm.Grid.from_meshio,
+                             FakeMesh(points, [FakeBlock("tetra", [[0, 1, 3, 6]])]))
+        self.assertIn("tetra", e.message)
+        self.assertFails(dpsm.ERR_INVALID_SIZE, dpsm.Grid.from_meshio, FakeMesh(points, [FakeBlock("line", [[0, 1]])]))
+        bad = FakeMesh(points, [FakeBlock("triangle", [[0, 1, 9]])])
+        e = self.assertFails(dpsm.ERR_INVALID_VALUE, dpsm.Grid.from_meshio, bad)
+        self.assertEqual(e.function, "dpsm_create_mesh")
 
 
 if __name__ == "__main__":

@@ -23,6 +23,7 @@ DPSM_XMIN = 0
 DPSM_XMAX = 1
 DPSM_YMIN = 2
 DPSM_YMAX = 3
+DPSM_MESH_EDGE = 4  # every domain edge of a mesh (meshes only)
 
 # Boundary kinds.
 DPSM_OPEN = 0

@@ -27,7 +27,14 @@ _INT_RANGE = (-(2**31), 2**31 - 1)
 _RESTART_KIND_OFFSET = 12
 _INT64_RANGE = (-(2**63), 2**63 - 1)
 _P_DOUBLE = ctypes.POINTER(ctypes.c_double)
+_P_INT64 = ctypes.POINTER(ctypes.c_int64)
 _P_UINT8 = ctypes.POINTER(ctypes.c_uint8)
+
+# The 2D cell types of meshio that Grid.from_meshio takes, with the number of
+# corner nodes it keeps (higher-order cells list their corners first); None:
+# as many as the block's rows hold. 0D and 1D blocks are skipped.
+_MESHIO_CELLS = {"triangle": 3, "triangle6": 3, "triangle7": 3, "quad": 4, "quad8": 4, "quad9": 4, "polygon": None}
+_MESHIO_SKIPPED = ("vertex", "line")
 
 
 def _text(raw):
@@ -162,20 +169,99 @@ def _raise_shape(function, name, got, shape):
     raise _shape_error(function, name, got, shape)
 
 
+def _rows_error(function, name, got, width):
+    want = "(n,)" if width == 1 else "(n, %d) or (%d*n,)" % (width, width)
+    return Error(C.DPSM_ERR_INVALID_SIZE, "%s has %s; expected shape %s" % (name, got, want), function)
+
+
+def _table_in(values, width, name, function, integer):
+    """A flat copy of ``n`` rows of ``width`` values, given as an (n, width)
+    array or nested sequence or a flat sequence of n*width values (width 1: a
+    flat sequence): (the flat values, a pointer to C's copy of them, n, the
+    object that keeps that copy alive). Integers
+    are int64 (a float is refused with TypeError, as ctypes would), other
+    values float64."""
+    ctype = ctypes.c_int64 if integer else ctypes.c_double
+    if np is not None:
+        array = np.asarray(values)
+        if integer:
+            if array.size == 0:
+                array = array.astype(np.int64)
+            elif array.dtype.kind == "O":  # Python ints beyond int64, or mixed objects
+                values = [_c_int(v, name, function, C.DPSM_ERR_INVALID_VALUE, _INT64_RANGE, "int64_t")
+                          for v in array.reshape(-1)]
+                array = np.array(values, dtype=np.int64).reshape(array.shape)
+            elif array.dtype.kind not in "iu":
+                raise TypeError("%s: %s must hold integers, not %s" % (function, name, array.dtype))
+            elif array.dtype.kind == "u" and array.max() > _INT64_RANGE[1]:
+                raise Error(C.DPSM_ERR_INVALID_VALUE, "%s holds values that do not fit in a C int64_t" % name, function)
+        if width == 1:
+            ok = array.ndim == 1
+        else:
+            ok = (array.ndim == 2 and array.shape[1] == width) or (array.ndim == 1 and array.size % width == 0)
+        if not ok:
+            raise _rows_error(function, name, "shape %s" % (array.shape,), width)
+        flat = np.ascontiguousarray(array, dtype=np.int64 if integer else np.float64).reshape(-1)
+        return flat, flat.ctypes.data_as(ctypes.POINTER(ctype)), flat.size // width, flat
+    items = list(values)
+    if width > 1 and items and all(_is_sequence(item) for item in items):
+        rows = [list(row) for row in items]
+        for row in rows:
+            if len(row) != width or any(_is_sequence(v) for v in row):
+                raise _rows_error(function, name, "a row of %d values" % len(row), width)
+        items = [v for row in rows for v in row]
+    elif any(_is_sequence(item) for item in items) or len(items) % width:
+        raise _rows_error(function, name, "%d items" % len(items), width)
+    if integer:
+        flat = [_c_int(v, name, function, C.DPSM_ERR_INVALID_VALUE, _INT64_RANGE, "int64_t") for v in items]
+    else:
+        flat = [float(v) for v in items]
+    buffer = (ctype * max(len(flat), 1))(*flat)
+    return flat, ctypes.cast(buffer, ctypes.POINTER(ctype)), len(flat) // width, buffer
+
+
+def _sizes_agree(function, sizes):
+    """Raises ERR_INVALID_SIZE unless every (name, count, unit, wanted, what) agrees."""
+    for name, count, unit, wanted, what in sizes:
+        if count != wanted:
+            raise Error(C.DPSM_ERR_INVALID_SIZE, "%s has %d %s but %s is %d" % (name, count, unit, what, wanted),
+                        function)
+
+
+def _meshio_blocks(cells):
+    """(type, data) of each block of a meshio.Mesh's cells: a list of
+    CellBlock (.type, .data), of (type, data) pairs, or an old meshio's dict."""
+    if hasattr(cells, "items"):
+        return list(cells.items())
+    blocks = []
+    for block in cells:
+        if hasattr(block, "type") and hasattr(block, "data"):
+            blocks.append((block.type, block.data))
+        else:
+            kind, data = block[0], block[1]
+            blocks.append((kind, data))
+    return blocks
+
+
 class Grid:
     """A dpsm grid (``dpsm_grid *``): create one with ``Grid.create_1d``,
-    ``Grid.create_2d`` or ``Grid.create_axisymmetric``, or read one from a
-    restart file with ``Grid.load``.
+    ``Grid.create_2d`` or ``Grid.create_axisymmetric``, a mesh with
+    ``Grid.create_mesh`` (``Grid.mesh``), ``Grid.create_graph``
+    (``Grid.graph``), ``Grid.create_dual_mesh`` (``Grid.dual_mesh``) or
+    ``Grid.from_meshio``, or read one from a restart file with ``Grid.load``.
 
     Arrays of heights, sources and cell kinds have the grid's ``shape``:
     ``(ny, nx)`` on a 2D grid (row ``j`` holds cells ``(0..nx-1, j)``, as a C
     ``h[ny][nx]``; a flat sequence of ``nx*ny`` values, x fastest, is also
-    accepted) and ``(nx,)`` on 1D and axisymmetric grids.
+    accepted) and ``(nx,)`` on 1D and axisymmetric grids; on a mesh
+    (``kind == "mesh"``) ``(ncells,)``, one value per cell in the host's cell
+    order (``nx`` is the number of cells, ``ny`` is 1).
     """
 
     def __init__(self, _handle=None, _kind=None):
         if not isinstance(_handle, GridPtr) or not _handle:
-            raise TypeError("make a Grid with Grid.create_1d, Grid.create_2d or Grid.create_axisymmetric")
+            raise TypeError("make a Grid with Grid.create_1d, Grid.create_2d, Grid.create_axisymmetric, "
+                            "Grid.create_mesh, Grid.create_graph, Grid.create_dual_mesh or Grid.from_meshio")
         self._handle = _handle
         self.kind = _kind
         nx, ny = ctypes.c_int64(), ctypes.c_int64()
@@ -208,6 +294,131 @@ class Grid:
         f = "dpsm_create_axisymmetric"
         return cls._create(f, "axisymmetric", _c_int64(nr, "nr", f), float(dr))
 
+    # ---- meshes ----------------------------------------------------------------
+    # Indices are 0-based, as in C: a face's second cell is -1 on the domain
+    # edge. Pairs and triples are rows: node_xy (nnodes, 2), face_cells
+    # (nfaces, 2), triangle_nodes (ntriangles, 3), or flat sequences.
+
+    @classmethod
+    def create_mesh(cls, node_xy, cell_start, cell_nodes):
+        """``dpsm_create_mesh``: a mesh of polygonal cells over shared nodes.
+        ``node_xy``: ``(nnodes, 2)`` or ``2*nnodes`` coordinates; cell ``c`` has
+        the nodes ``cell_nodes[cell_start[c]:cell_start[c+1]]`` (``cell_start``
+        holds ``ncells+1`` offsets from 0, ``cell_nodes`` ``cell_start[-1]``
+        node indices from 0). Also ``Grid.mesh``."""
+        f = "dpsm_create_mesh"
+        _, xy, nnodes, keep_xy = _table_in(node_xy, 2, "node_xy", f, False)
+        start, start_p, nstart, keep_start = _table_in(cell_start, 1, "cell_start", f, True)
+        _, nodes_p, total, keep_nodes = _table_in(cell_nodes, 1, "cell_nodes", f, True)
+        ncells = max(nstart - 1, 0)
+        # The library reads cell_start[-1] node indices once cell_start[0] is
+        # 0 and every cell has 3 nodes or more (it refuses the others first).
+        if nnodes >= 1 and ncells >= 1 and int(start[0]) == 0:
+            _sizes_agree(f, [("cell_nodes", total, "values", int(start[-1]), "cell_start[-1]")])
+        grid = cls._create(f, "mesh", nnodes, xy, ncells, start_p, nodes_p)
+        del keep_xy, keep_start, keep_nodes
+        return grid
+
+    @classmethod
+    def create_graph(cls, cell_xy, cell_area, face_cells, face_xy, face_length):
+        """``dpsm_create_graph``: a mesh from a finite-volume graph, as a host
+        holds it: ``cell_xy`` ``(ncells, 2)`` centres, ``cell_area`` ``ncells``
+        areas, ``face_cells`` ``(nfaces, 2)`` the cells ``(a, b)`` of each face
+        from 0 (``b == -1`` on the domain edge), ``face_xy`` ``(nfaces, 2)``
+        midpoints, ``face_length`` ``nfaces`` lengths. Faces keep this order.
+        Also ``Grid.graph``."""
+        f = "dpsm_create_graph"
+        _, cxy, ncells, keep_cxy = _table_in(cell_xy, 2, "cell_xy", f, False)
+        _, area, nareas, keep_area = _table_in(cell_area, 1, "cell_area", f, False)
+        _, cells, nfaces, keep_cells = _table_in(face_cells, 2, "face_cells", f, True)
+        _, fxy, nfxy, keep_fxy = _table_in(face_xy, 2, "face_xy", f, False)
+        _, length, nlength, keep_length = _table_in(face_length, 1, "face_length", f, False)
+        if ncells >= 1 and nfaces >= 1:  # else the library refuses the count
+            _sizes_agree(f, [("cell_area", nareas, "values", ncells, "ncells (the rows of cell_xy)"),
+                             ("face_xy", nfxy, "rows", nfaces, "nfaces (the rows of face_cells)"),
+                             ("face_length", nlength, "values", nfaces, "nfaces (the rows of face_cells)")])
+        grid = cls._create(f, "mesh", ncells, cxy, area, nfaces, cells, fxy, length)
+        del keep_cxy, keep_area, keep_cells, keep_fxy, keep_length
+        return grid
+
+    @classmethod
+    def create_dual_mesh(cls, node_xy, triangle_nodes):
+        """``dpsm_create_dual_mesh``: the median dual of a triangle mesh, one
+        cell per node (heights, sources and kinds per node): ``node_xy``
+        ``(nnodes, 2)``, ``triangle_nodes`` ``(ntriangles, 3)`` node indices from
+        0. Also ``Grid.dual_mesh``."""
+        f = "dpsm_create_dual_mesh"
+        _, xy, nnodes, keep_xy = _table_in(node_xy, 2, "node_xy", f, False)
+        _, tris, ntriangles, keep_tris = _table_in(triangle_nodes, 3, "triangle_nodes", f, True)
+        grid = cls._create(f, "mesh", nnodes, xy, ntriangles, tris)
+        del keep_xy, keep_tris
+        return grid
+
+    mesh = create_mesh
+    graph = create_graph
+    dual_mesh = create_dual_mesh
+
+    @classmethod
+    def from_meshio(cls, mesh):
+        """A polygon mesh (``create_mesh``) from a ``meshio.Mesh``, or any
+        object like one: ``.points`` of shape ``(n, 2)`` or ``(n, 3)`` (z is
+        dropped) and ``.cells``, blocks with ``.type`` and ``.data`` (meshio's
+        CellBlock; ``(type, data)`` pairs and an old meshio's dict of them are
+        taken too). The cells are those of its 2D blocks ("triangle", "quad",
+        "polygon"; of "triangle6", "quad8"... the corners), in block order;
+        "vertex" and "line" blocks are skipped, other (3D) cells refused.
+        meshio itself is not imported."""
+        f = "Grid.from_meshio"
+        blocks = []
+        for kind, data in _meshio_blocks(mesh.cells):
+            kind = str(kind)
+            if kind.startswith(_MESHIO_SKIPPED):
+                continue
+            if kind not in _MESHIO_CELLS and not kind.startswith("polygon"):
+                raise Error(C.DPSM_ERR_INVALID_VALUE, "cells of type %r are not 2D cells (a mesh takes triangle, "
+                            "quad and polygon cells)" % kind, f)
+            blocks.append((kind, _MESHIO_CELLS.get(kind), data))
+        if not blocks:
+            raise Error(C.DPSM_ERR_INVALID_SIZE, "the mesh has no 2D cells (triangle, quad or polygon)", f)
+        if np is not None:
+            points = np.asarray(mesh.points, dtype=np.float64)
+            if points.ndim != 2 or points.shape[1] not in (2, 3):
+                raise Error(C.DPSM_ERR_INVALID_SIZE, "points has shape %s; expected (n, 2) or (n, 3)"
+                            % (points.shape,), f)
+            node_xy = points[:, :2]
+            counts, nodes = [], []
+            for kind, corners, data in blocks:
+                try:
+                    array = np.asarray(data)
+                    regular = array.ndim == 2 and array.dtype != object
+                except ValueError:  # numpy refuses ragged rows
+                    regular = False
+                if regular:
+                    rows = array[:, :corners] if corners else array
+                    counts.append(np.full(rows.shape[0], rows.shape[1], dtype=np.int64))
+                    nodes.append(rows.reshape(-1))
+                else:  # polygons of several sizes in one block
+                    rows = [np.asarray(row)[:corners] if corners else np.asarray(row) for row in data]
+                    counts.append(np.array([len(row) for row in rows], dtype=np.int64))
+                    nodes.extend(rows)
+            counts = np.concatenate(counts)
+            cell_start = np.concatenate([[0], np.cumsum(counts)])
+            cell_nodes = np.concatenate(nodes) if nodes else np.zeros(0, dtype=np.int64)
+            return cls.create_mesh(node_xy, cell_start, cell_nodes)
+        node_xy = []
+        for point in mesh.points:
+            point = list(point)
+            if len(point) not in (2, 3):
+                raise Error(C.DPSM_ERR_INVALID_SIZE, "a point has %d coordinates; expected 2 or 3" % len(point), f)
+            node_xy.extend(point[:2])
+        cell_start, cell_nodes = [0], []
+        for kind, corners, data in blocks:
+            for row in data:
+                row = list(row)[:corners] if corners else list(row)
+                cell_nodes.extend(row)
+                cell_start.append(len(cell_nodes))
+        return cls.create_mesh(node_xy, cell_start, cell_nodes)
+
     @classmethod
     def load(cls, path):
         """``dpsm_load``: a new grid from a file written by ``save`` (a str,
@@ -218,12 +429,16 @@ class Grid:
         raw = _c_path(path, f)
         handle = GridPtr()
         _check(lib.dpsm_load(raw, ctypes.byref(handle)), f, created=True)
+        # A mesh knows its faces; a grid refuses (and the next call, which
+        # succeeds, clears that message).
+        nfaces = ctypes.c_int64()
+        mesh = lib.dpsm_get_face_count(handle, ctypes.byref(nfaces)) == C.DPSM_OK
         nx, ny = ctypes.c_int64(), ctypes.c_int64()
         status = lib.dpsm_get_shape(handle, ctypes.byref(nx), ctypes.byref(ny))
         if status != C.DPSM_OK:  # cannot happen with a loaded grid; do not leak it
             lib.dpsm_destroy(handle)
             _check(status, "dpsm_get_shape")
-        return cls(_handle=handle, _kind=_restart_kind(raw, ny.value))
+        return cls(_handle=handle, _kind="mesh" if mesh else _restart_kind(raw, ny.value))
 
     def save(self, path):
         """``dpsm_save``: writes everything needed to continue the run bit for
@@ -259,12 +474,17 @@ class Grid:
                 pass
 
     def __repr__(self):
-        state = "closed" if self.closed else "nx=%d, ny=%d" % (self.nx, self.ny)
+        if self.closed:
+            state = "closed"
+        elif self.kind == "mesh":
+            state = "ncells=%d" % self.nx
+        else:
+            state = "nx=%d, ny=%d" % (self.nx, self.ny)
         return "<dpsm.Grid %s %s>" % (self.kind, state)
 
     @property
     def shape(self):
-        """The shape of this grid's arrays: ``(ny, nx)`` in 2D, ``(nx,)`` otherwise."""
+        """The shape of this grid's arrays: ``(ny, nx)`` in 2D, ``(nx,)`` otherwise (``(ncells,)`` on a mesh)."""
         return (self.ny, self.nx) if self.kind == "2d" else (self.nx,)
 
     def _call(self, function, *args):
@@ -293,13 +513,16 @@ class Grid:
         self._call(f, _c_int(relaxation, "relaxation", f, C.DPSM_ERR_UNKNOWN_ENUM))
 
     def set_boundary(self, side, kind):
-        """``dpsm_set_boundary``: side ``XMIN``, ``XMAX``, ``YMIN`` or ``YMAX``; kind ``OPEN`` or ``WALL``."""
+        """``dpsm_set_boundary``: side ``XMIN``, ``XMAX``, ``YMIN`` or ``YMAX`` (``MESH_EDGE`` on a mesh:
+        every edge face); kind ``OPEN`` or ``WALL``."""
         f = "dpsm_set_boundary"
         self._call(f, _c_int(side, "side", f, C.DPSM_ERR_UNKNOWN_ENUM), _c_int(kind, "kind", f, C.DPSM_ERR_UNKNOWN_ENUM))
 
     def _faces_along(self, side):
         """The faces along ``side``: ``ny`` for the x sides, ``nx`` for the y sides, 1 on 1D grids;
-        None for a side the library will refuse anyway."""
+        None for a side the library will refuse anyway. On a mesh: every face for ``MESH_EDGE``."""
+        if self.kind == "mesh":
+            return self.get_face_count() if side == C.DPSM_MESH_EDGE else None
         if self.kind != "2d":
             return 1 if side in (C.DPSM_XMIN, C.DPSM_XMAX) else None
         return {C.DPSM_XMIN: self.ny, C.DPSM_XMAX: self.ny, C.DPSM_YMIN: self.nx, C.DPSM_YMAX: self.nx}.get(side)
@@ -307,7 +530,8 @@ class Grid:
     def set_side_levels(self, side, levels=None):
         """``dpsm_set_side_levels``: the surface level beyond the open side ``side``, one value per
         boundary face (``ny`` values for ``XMIN`` and ``XMAX``, ``nx`` for ``YMIN`` and ``YMAX``; one on
-        1D and axisymmetric grids); ``None`` returns the side to 0. Sand comes in from a higher level."""
+        1D and axisymmetric grids; on a mesh, side ``MESH_EDGE``, one per face, those of interior faces
+        ignored); ``None`` returns the side to 0. Sand comes in from a higher level."""
         f = "dpsm_set_side_levels"
         side = _c_int(side, "side", f, C.DPSM_ERR_UNKNOWN_ENUM)
         faces = self._faces_along(side)
@@ -395,21 +619,71 @@ class Grid:
         if kinds is None:
             self._call(f, None)
             return
-        shape = self.shape
-        count = self.nx * self.ny
+        pointer, keep = self._kinds_in(kinds, self.shape, f)
+        self._call(f, pointer)
+        del keep
+
+    @staticmethod
+    def _kinds_in(kinds, shape, f):
+        """(pointer, keep-alive) for C from kinds of ``shape`` as uint8."""
+        count = 1
+        for n in shape:
+            count *= n
         if np is not None:
             array = np.asarray(kinds)
-            if array.shape != shape and array.shape != (count,):
+            if array.shape != tuple(shape) and array.shape != (count,):
                 raise _shape_error(f, "kinds", "shape %s" % (array.shape,), _rows_columns(shape))
             if array.size and (array.min() < 0 or array.max() > 255):
                 raise Error(C.DPSM_ERR_UNKNOWN_ENUM, "kinds holds values outside 0..255", f)
             array = np.ascontiguousarray(array, dtype=np.uint8)
-            self._call(f, array.ctypes.data_as(_P_UINT8))
-            return
+            return array.ctypes.data_as(_P_UINT8), array
         flat = [operator.index(k) for k in _flatten(kinds, _rows_columns(shape), "kinds", f)]
         if any(k < 0 or k > 255 for k in flat):
             raise Error(C.DPSM_ERR_UNKNOWN_ENUM, "kinds holds values outside 0..255", f)
-        self._call(f, (ctypes.c_uint8 * count)(*flat))
+        buffer = (ctypes.c_uint8 * max(count, 1))(*flat)
+        return buffer, buffer
+
+    # ---- the faces of a mesh ---------------------------------------------------
+
+    def get_face_count(self):
+        """``dpsm_get_face_count``: the faces of a mesh, interior and on the domain edge
+        (``ERR_NOT_APPLICABLE`` on a grid). Also ``face_count()``."""
+        value = ctypes.c_int64()
+        self._call("dpsm_get_face_count", ctypes.byref(value))
+        return value.value
+
+    def get_mesh_faces(self):
+        """``dpsm_get_mesh_faces``: the two cells ``(a, b)`` of every face, from 0, ``b == -1`` on the
+        domain edge, in the host's face order (that of ``get_face_fluxes``, ``set_edge_kinds`` and the
+        levels of ``MESH_EDGE``): a numpy int64 array of shape ``(nfaces, 2)``, or a list of ``[a, b]``
+        pairs without numpy. Also ``mesh_faces()``."""
+        f = "dpsm_get_mesh_faces"
+        if self.kind != "mesh":  # refused by the library, with its message
+            self._call(f, (ctypes.c_int64 * 2)())
+        nfaces = self.get_face_count()
+        if np is not None:
+            faces = np.empty((nfaces, 2), dtype=np.int64)
+            self._call(f, faces.ctypes.data_as(_P_INT64))
+            return faces
+        buffer = (ctypes.c_int64 * max(2 * nfaces, 1))()
+        self._call(f, buffer)
+        return [[buffer[2 * k], buffer[2 * k + 1]] for k in range(nfaces)]
+
+    face_count = get_face_count
+    mesh_faces = get_mesh_faces
+
+    def set_edge_kinds(self, kinds=None):
+        """``dpsm_set_edge_kinds``: ``OPEN`` or ``WALL`` per face of a mesh (``nfaces`` values, those of
+        interior faces ignored); ``None`` makes every edge face a wall. An open face holds the outside at
+        its level (``set_side_levels(MESH_EDGE, levels)``) and books what leaves as outflow of
+        ``MESH_EDGE``; ``set_boundary(MESH_EDGE, kind)`` sets every edge face at once."""
+        f = "dpsm_set_edge_kinds"
+        if kinds is None or self.kind != "mesh":  # a grid: refused by the library, with its message
+            self._call(f, None)
+            return
+        pointer, keep = self._kinds_in(kinds, (self.get_face_count(),), f)
+        self._call(f, pointer)
+        del keep
 
     def set_heights(self, h):
         """``dpsm_set_heights``: the height of every cell, an array of ``shape``."""
@@ -540,11 +814,15 @@ class Grid:
         """``dpsm_get_face_fluxes``: ``(fx, fy)``, the volume each face carried in the last step,
         positive towards increasing x (y). In 2D ``fx`` has shape ``(ny, nx+1)`` (``fx[j, i]`` is the
         face on the low side of cell ``(i, j)``) and ``fy`` shape ``(ny+1, nx)``; on 1D and
-        axisymmetric grids ``fx`` has ``nx+1`` values and ``fy`` is None. ``out_x`` and ``out_y``
-        are filled and returned instead, as ``out`` of ``get_heights``."""
+        axisymmetric grids ``fx`` has ``nx+1`` values and ``fy`` is None; on a mesh ``fx`` has one value
+        per face (``nfaces``), positive from its cell ``a`` to its ``b`` (``get_mesh_faces``), and ``fy``
+        is None. ``out_x`` and ``out_y`` are filled and returned instead, as ``out`` of ``get_heights``."""
         f = "dpsm_get_face_fluxes"
         two_d = self.kind == "2d"
-        x_shape = (self.ny, self.nx + 1) if two_d else (self.nx + 1,)
+        if self.kind == "mesh":
+            x_shape = (self.get_face_count(),)
+        else:
+            x_shape = (self.ny, self.nx + 1) if two_d else (self.nx + 1,)
         x_pointer, x_result, x_finish = self._doubles_out(x_shape, out_x, "fx", f)
         if two_d:
             y_pointer, y_result, y_finish = self._doubles_out((self.ny + 1, self.nx), out_y, "fy", f)

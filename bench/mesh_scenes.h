@@ -1,0 +1,44 @@
+/* Meshes of a square for the mesh validation, the tests and the examples:
+ * quadrilaterals, jittered triangles (Delaunay-like: each jittered square is
+ * split along its shorter diagonal), hexagons (the Voronoi mesh of a
+ * triangular lattice) and the median dual of the jittered triangles; and the
+ * share of a cell inside a disk, to pour a column by cell averages. */
+#ifndef DPSM_MESH_SCENES_H
+#define DPSM_MESH_SCENES_H
+
+#include <stdint.h>
+
+#include <dpsm/dpsm.h>
+
+typedef enum { SCENE_QUADS, SCENE_TRIANGLES, SCENE_HEXAGONS, SCENE_DUAL, SCENE_GMSH_DISK } scene_kind;
+
+typedef struct {
+    scene_kind kind;
+    int64_t nnodes;
+    double *node_xy;     /* 2 * nnodes */
+    int64_t npolygons;   /* polygons (or triangles of the dual) */
+    int64_t *cell_start; /* npolygons + 1 */
+    int64_t *cell_nodes;
+    /* The cells dpsm makes of it (the dual: one per node), with their
+     * centres (the dual: the node) and areas. */
+    int64_t cells;
+    double *cx, *cy, *area;
+} mesh_scene;
+
+/* n cells (the dual: n triangles' nodes) along each side of [-half, half]^2;
+ * SCENE_GMSH_DISK: the disk of radius 2.5 of bench/data/disk.geo meshed by
+ * gmsh with triangles of size 7 / n (gmsh must be on the PATH and
+ * DPSM_DISK_GEO name the .geo file; an empty scene, cells == 0, otherwise). */
+mesh_scene scene_make(scene_kind kind, int n, double half, unsigned seed);
+/* Reads the triangles of a gmsh file in the MSH 2.2 ASCII format. */
+mesh_scene scene_read_msh(const char *path);
+/* Creates the dpsm mesh of the scene (dpsm_create_mesh or dpsm_create_dual_mesh). */
+int scene_create(const mesh_scene *s, dpsm_grid **out);
+/* The share of every cell inside the disk of radius r about the origin. */
+void scene_disk_fractions(const mesh_scene *s, double r, double *share);
+/* The mean cell size: the square root of the mean area. */
+double scene_mean_size(const mesh_scene *s);
+const char *scene_name(scene_kind kind);
+void scene_free(mesh_scene *s);
+
+#endif

@@ -1,0 +1,379 @@
+/* The mesh engine's validation and speed (dpsm-bench mesh-accuracy, mesh).
+ *
+ * mesh-accuracy: the column collapse of the 2D validation (a = 0.5, 30
+ * degrees, open table, the exact deposit a truncated cone) on every mesh
+ * kind of mesh_scenes.h at three refinements, stepped in time to rest: the
+ * L1 difference over the column's volume, the observed order, the runout in
+ * 16 directions against the exact foot, the time at which it rested; and the
+ * cone (40 high, slope 1.5, 33 degrees) on jittered triangles, its top
+ * against 22.89.
+ *
+ * mesh: a fully active jittered triangle mesh (steep plane, every face over
+ * the threshold) against the plain face loop below (one pass over faces
+ * computing the gradient and flux, one over cells updating, in the host's
+ * order); the sparse scene (slip faces on ~1 % of cells) and a mesh at rest,
+ * each against a fully active sub-step. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "bench_util.h"
+#include "mesh_scenes.h"
+
+#if defined(_OPENMP)
+#include <omp.h>
+#endif
+
+static const double kPi = 3.14159265358979323846;
+
+/* ---- accuracy -------------------------------------------------------------- */
+
+typedef struct {
+    double l1, runout_error, rest_time, top;
+    int at_rest;
+    double seconds, cell_updates;
+    int64_t cells;
+    double size;
+} mesh_result;
+
+static double column_foot(double alpha) { return (0.5 + sqrt(4.0 * alpha * alpha - 0.25 / 3.0)) / (2.0 * alpha); }
+
+/* Steps in calls of dt until the surface rests or t_end passes. */
+static void step_to_rest(dpsm_grid *g, double dt, double t_end, mesh_result *out) {
+    double t = 0.0;
+    out->at_rest = 0;
+    out->cell_updates = 0.0;
+    while (t < t_end) {
+        CHECK(g, dpsm_step(g, dt));
+        double at_rest = 0.0, integrated = 0.0, updates = 0.0;
+        CHECK(g, dpsm_get_step_info(g, DPSM_INFO_AT_REST, &at_rest));
+        CHECK(g, dpsm_get_step_info(g, DPSM_INFO_TIME_INTEGRATED, &integrated));
+        CHECK(g, dpsm_get_step_info(g, DPSM_INFO_CELL_UPDATES, &updates));
+        out->cell_updates += updates;
+        t += integrated;
+        if (at_rest > 0.0) {
+            out->at_rest = 1;
+            break;
+        }
+    }
+    out->rest_time = t;
+}
+
+/* The scene's mesh with its edge open, at angle theta, holding h. */
+static dpsm_grid *open_mesh(const mesh_scene *s, double theta, int threads, const double *h) {
+    dpsm_grid *g = NULL;
+    CHECK(NULL, scene_create(s, &g));
+    CHECK(g, dpsm_set_threads(g, threads));
+    CHECK(g, dpsm_set_repose_angle(g, theta));
+    CHECK(g, dpsm_set_boundary(g, DPSM_MESH_EDGE, DPSM_OPEN));
+    CHECK(g, dpsm_set_heights(g, h));
+    return g;
+}
+
+static mesh_result column_on(scene_kind kind, int n, int threads) {
+    const double theta = 30.0 * kPi / 180.0, alpha = tan(theta), foot = column_foot(alpha);
+    const double half = 1.25 * fmax(2.0, foot);
+    mesh_scene s = scene_make(kind, n, half, 12345u);
+    mesh_result r;
+    memset(&r, 0, sizeof r);
+    if (s.cells == 0) return r; /* gmsh or its .geo not found */
+    double *share = xcalloc((size_t)s.cells, sizeof(double)), *h = xcalloc((size_t)s.cells, sizeof(double));
+    scene_disk_fractions(&s, 1.0, share);
+    for (int64_t c = 0; c < s.cells; ++c) h[c] = 0.5 * share[c];
+    r.cells = s.cells;
+    r.size = scene_mean_size(&s);
+    const double t0 = now_seconds();
+    dpsm_grid *g = open_mesh(&s, theta, threads, h);
+    step_to_rest(g, 0.1, 20.0, &r);
+    CHECK(g, dpsm_get_heights(g, h));
+    r.seconds = now_seconds() - t0;
+    double err = 0.0, volume = kPi * 0.5, top = 0.0;
+    double runout[16] = {0};
+    for (int64_t c = 0; c < s.cells; ++c) {
+        const double radius = hypot(s.cx[c], s.cy[c]);
+        const double exact = fmin(0.5, fmax(0.0, alpha * (foot - radius)));
+        err += fabs(h[c] - exact) * s.area[c];
+        top = fmax(top, h[c]);
+        if (h[c] > 1e-6) {
+            const double angle = atan2(s.cy[c], s.cx[c]);
+            const int sector = ((int)lround(angle / (2.0 * kPi / 16.0)) + 16) % 16;
+            const double along = s.cx[c] * cos(sector * 2.0 * kPi / 16.0) + s.cy[c] * sin(sector * 2.0 * kPi / 16.0);
+            /* within half a cell of the ray */
+            const double across = fabs(-s.cx[c] * sin(sector * 2.0 * kPi / 16.0) + s.cy[c] * cos(sector * 2.0 * kPi / 16.0));
+            if (across <= r.size && along > runout[sector]) runout[sector] = along;
+        }
+    }
+    r.l1 = err / volume;
+    r.top = top;
+    for (int k = 0; k < 16; ++k) r.runout_error = fmax(r.runout_error, fabs(runout[k] - foot));
+    dpsm_destroy(g);
+    free(share);
+    free(h);
+    scene_free(&s);
+    return r;
+}
+
+/* The cone of the dune models' scene: 40 high, slope 1.5, relaxed at 33 degrees. */
+static mesh_result cone_on(scene_kind kind, int n, int threads) {
+    const double theta = 33.0 * kPi / 180.0;
+    mesh_scene s = scene_make(kind, n, 40.0, 777u);
+    double *h = xcalloc((size_t)s.cells, sizeof(double));
+    for (int64_t c = 0; c < s.cells; ++c) h[c] = fmax(0.0, 40.0 - 1.5 * hypot(s.cx[c], s.cy[c]));
+    mesh_result r;
+    memset(&r, 0, sizeof r);
+    r.cells = s.cells;
+    r.size = scene_mean_size(&s);
+    const double t0 = now_seconds();
+    dpsm_grid *g = open_mesh(&s, theta, threads, h);
+    step_to_rest(g, 10.0, 1e5, &r);
+    CHECK(g, dpsm_get_heights(g, h));
+    r.seconds = now_seconds() - t0;
+    for (int64_t c = 0; c < s.cells; ++c) r.top = fmax(r.top, h[c]);
+    dpsm_destroy(g);
+    free(h);
+    scene_free(&s);
+    return r;
+}
+
+int cmd_mesh_accuracy(int argc, char **argv) {
+    const int threads = argc > 0 ? atoi(argv[0]) : 0;
+    const int levels = argc > 1 ? atoi(argv[1]) : 3;
+    const char *only = argc > 2 ? argv[2] : NULL; /* one mesh kind (its name) or "columns", without the cone */
+    /* about 4,000, 16,000 and 65,000 cells on each kind */
+    static const struct {
+        scene_kind kind;
+        int n;
+    } kinds[] = {{SCENE_QUADS, 64}, {SCENE_TRIANGLES, 45}, {SCENE_HEXAGONS, 59}, {SCENE_DUAL, 64}, {SCENE_GMSH_DISK, 64}};
+    const double alpha = tan(30.0 * kPi / 180.0);
+    fprintf(stderr, "mesh-accuracy: column collapse a = 0.5, 30 deg, open edges; exact foot %.4f; threads %d\n",
+            column_foot(alpha), threads);
+    printf("scene,mesh,cells,mean_size,l1_error,order,runout_error_cells,at_rest,rest_time,cell_updates,seconds\n");
+    fflush(stdout);
+    for (size_t k = 0; k < sizeof kinds / sizeof *kinds; ++k) {
+        if (only && strcmp(only, "columns") != 0 && strcmp(only, scene_name(kinds[k].kind)) != 0) continue;
+        double previous = 0.0;
+        for (int level = 0; level < levels; ++level) {
+            const int n = kinds[k].n << level;
+            const mesh_result r = column_on(kinds[k].kind, n, threads);
+            if (r.cells == 0) {
+                fprintf(stderr, "mesh-accuracy: %s skipped: gmsh not found or DPSM_DISK_GEO (bench/data/disk.geo) not set\n",
+                        scene_name(kinds[k].kind));
+                break;
+            }
+            const double order = level > 0 ? log2(previous / r.l1) : NAN;
+            printf("column,%s,%lld,%.5f,%.4e,%.2f,%.2f,%d,%.3f,%.4g,%.3f\n", scene_name(kinds[k].kind),
+                   (long long)r.cells, r.size, r.l1, order, r.runout_error / r.size, r.at_rest, r.rest_time,
+                   r.cell_updates, r.seconds);
+            fflush(stdout);
+            previous = r.l1;
+        }
+    }
+    if (only) return 0;
+    const mesh_result cone = cone_on(SCENE_TRIANGLES, 72, threads);
+    printf("cone,%s,%lld,%.5f,top %.4f against 22.89 (%+.3f %%),,,%d,%.3f,%.4g,%.3f\n", scene_name(SCENE_TRIANGLES),
+           (long long)cone.cells, cone.size, cone.top, 100.0 * (cone.top / 22.89 - 1.0), cone.at_rest, cone.rest_time,
+           cone.cell_updates, cone.seconds);
+    return 0;
+}
+
+/* ---- speed ------------------------------------------------------------------ */
+
+/* The plain face loop: the mesh as the host holds it (its cell order), the
+ * faces found from the polygons' edges, each face's slope from the two-point
+ * difference and the least-squares gradients of its cells computed on the
+ * spot, the fluxes added to both cells, then every cell updated. */
+typedef struct {
+    int64_t cells, faces;
+    int64_t *fa, *fb;                 /* faces' cells, fb = -1 on the edge */
+    double *d, *ortho, *tx, *ty;      /* distance, length over distance, tangent */
+    int64_t *nb_start, *nb;           /* each cell's neighbours */
+    double *wx, *wy;                  /* least-squares weights per neighbour */
+    double *area, *rate;
+} plain_mesh;
+
+typedef struct {
+    int64_t lo, hi, cell;
+} edge_use;
+
+static int edge_order(const void *l, const void *r) {
+    const edge_use *a = l, *b = r;
+    if (a->lo != b->lo) return a->lo < b->lo ? -1 : 1;
+    if (a->hi != b->hi) return a->hi < b->hi ? -1 : 1;
+    return a->cell < b->cell ? -1 : a->cell > b->cell;
+}
+
+static plain_mesh plain_from(const mesh_scene *s) {
+    plain_mesh p;
+    memset(&p, 0, sizeof p);
+    p.cells = s->cells;
+    const int64_t uses = s->cell_start[s->cells];
+    edge_use *e = xcalloc((size_t)uses, sizeof *e);
+    for (int64_t c = 0; c < s->cells; ++c)
+        for (int64_t k = s->cell_start[c]; k < s->cell_start[c + 1]; ++k) {
+            const int64_t u = s->cell_nodes[k], v = s->cell_nodes[k + 1 < s->cell_start[c + 1] ? k + 1 : s->cell_start[c]];
+            e[k].lo = u < v ? u : v, e[k].hi = u < v ? v : u, e[k].cell = c;
+        }
+    qsort(e, (size_t)uses, sizeof *e, edge_order);
+    p.fa = xcalloc((size_t)uses, sizeof(int64_t)), p.fb = xcalloc((size_t)uses, sizeof(int64_t));
+    p.d = xcalloc((size_t)uses, sizeof(double)), p.ortho = xcalloc((size_t)uses, sizeof(double));
+    p.tx = xcalloc((size_t)uses, sizeof(double)), p.ty = xcalloc((size_t)uses, sizeof(double));
+    int64_t *degree = xcalloc((size_t)s->cells + 1, sizeof(int64_t));
+    for (int64_t k = 0; k < uses;) {
+        const int shared = k + 1 < uses && e[k + 1].lo == e[k].lo && e[k + 1].hi == e[k].hi;
+        const int64_t a = e[k].cell, b = shared ? e[k + 1].cell : -1, f = p.faces++;
+        const double *xy = s->node_xy;
+        const double len = hypot(xy[2 * e[k].hi] - xy[2 * e[k].lo], xy[2 * e[k].hi + 1] - xy[2 * e[k].lo + 1]);
+        const double mx = 0.5 * (xy[2 * e[k].hi] + xy[2 * e[k].lo]), my = 0.5 * (xy[2 * e[k].hi + 1] + xy[2 * e[k].lo + 1]);
+        const double ex = b >= 0 ? s->cx[b] - s->cx[a] : 2.0 * (mx - s->cx[a]);
+        const double ey = b >= 0 ? s->cy[b] - s->cy[a] : 2.0 * (my - s->cy[a]);
+        p.fa[f] = a, p.fb[f] = b, p.d[f] = hypot(ex, ey), p.ortho[f] = len / p.d[f];
+        p.tx[f] = -ey / p.d[f], p.ty[f] = ex / p.d[f];
+        if (b >= 0) ++degree[a], ++degree[b];
+        k += shared ? 2 : 1;
+    }
+    free(e);
+    p.nb_start = xcalloc((size_t)s->cells + 1, sizeof(int64_t));
+    for (int64_t c = 0; c < s->cells; ++c) p.nb_start[c + 1] = p.nb_start[c] + degree[c];
+    p.nb = xcalloc((size_t)p.nb_start[s->cells] + 1, sizeof(int64_t));
+    for (int64_t c = 0; c < s->cells; ++c) degree[c] = p.nb_start[c];
+    for (int64_t f = 0; f < p.faces; ++f)
+        if (p.fb[f] >= 0) p.nb[degree[p.fa[f]]++] = p.fb[f], p.nb[degree[p.fb[f]]++] = p.fa[f];
+    free(degree);
+    const int64_t links = p.nb_start[s->cells];
+    p.wx = xcalloc((size_t)links + 1, sizeof(double)), p.wy = xcalloc((size_t)links + 1, sizeof(double));
+    for (int64_t c = 0; c < s->cells; ++c) {
+        double sxx = 0, sxy = 0, syy = 0;
+        for (int64_t k = p.nb_start[c]; k < p.nb_start[c + 1]; ++k) {
+            const double dx = s->cx[p.nb[k]] - s->cx[c], dy = s->cy[p.nb[k]] - s->cy[c], w = 1.0 / (dx * dx + dy * dy);
+            sxx += w * dx * dx, sxy += w * dx * dy, syy += w * dy * dy;
+        }
+        const double det = sxx * syy - sxy * sxy;
+        if (!(det > 1e-6 * (sxx + syy) * (sxx + syy))) continue;
+        for (int64_t k = p.nb_start[c]; k < p.nb_start[c + 1]; ++k) {
+            const double dx = s->cx[p.nb[k]] - s->cx[c], dy = s->cy[p.nb[k]] - s->cy[c], w = 1.0 / (dx * dx + dy * dy);
+            p.wx[k] = w * (syy * dx - sxy * dy) / det, p.wy[k] = w * (sxx * dy - sxy * dx) / det;
+        }
+    }
+    p.area = s->area;
+    p.rate = xcalloc((size_t)s->cells, sizeof(double));
+    return p;
+}
+
+static void plain_gradient(const plain_mesh *p, const double *h, int64_t c, double *gx, double *gy) {
+    double x = 0, y = 0;
+    for (int64_t k = p->nb_start[c]; k < p->nb_start[c + 1]; ++k) {
+        const double dh = h[p->nb[k]] - h[c];
+        x += p->wx[k] * dh, y += p->wy[k] * dh;
+    }
+    *gx = x, *gy = y;
+}
+
+/* One sub-step of the plain loop with open edges held at 0. */
+static void plain_substep(const plain_mesh *p, double *h, double dt, double tan_theta) {
+    memset(p->rate, 0, sizeof(double) * (size_t)p->cells);
+    for (int64_t f = 0; f < p->faces; ++f) {
+        const int64_t a = p->fa[f], b = p->fb[f];
+        double gax, gay, gbx = 0, gby = 0;
+        plain_gradient(p, h, a, &gax, &gay);
+        if (b >= 0) plain_gradient(p, h, b, &gbx, &gby);
+        const double hb = b >= 0 ? h[b] : 0.0;
+        const double normal = (h[a] - hb) / p->d[f];
+        const double tangential = b >= 0 ? 0.5 * ((gax + gbx) * p->tx[f] + (gay + gby) * p->ty[f]) : gax * p->tx[f] + gay * p->ty[f];
+        const double slope = sqrt(normal * normal + tangential * tangential);
+        if (!(slope > tan_theta)) continue;
+        const double flux = (slope - tan_theta) / sqrt(1.0 + slope * slope) / slope * p->ortho[f] * (h[a] - hb);
+        p->rate[a] -= flux;
+        if (b >= 0) p->rate[b] += flux;
+    }
+    for (int64_t c = 0; c < p->cells; ++c) h[c] += dt * p->rate[c] / p->area[c];
+}
+
+static void plain_free(plain_mesh *p) {
+    free(p->fa), free(p->fb), free(p->d), free(p->ortho), free(p->tx), free(p->ty), free(p->nb_start), free(p->nb),
+        free(p->wx), free(p->wy), free(p->rate);
+}
+
+static double seconds_per_substep(dpsm_grid *g, int substeps, double *updates) {
+    double dt = 0.0;
+    CHECK(g, dpsm_stable_dt(g, &dt));
+    const double t0 = now_seconds();
+    CHECK(g, dpsm_step(g, substeps * dt));
+    const double seconds = now_seconds() - t0;
+    double taken = 0.0;
+    CHECK(g, dpsm_get_step_info(g, DPSM_INFO_SUBSTEPS, &taken));
+    CHECK(g, dpsm_get_step_info(g, DPSM_INFO_CELL_UPDATES, updates));
+    *updates /= taken > 0 ? taken : 1.0;
+    return seconds / (taken > 0 ? taken : 1.0);
+}
+
+int cmd_mesh(int argc, char **argv) {
+    const int n = argc > 0 ? atoi(argv[0]) : 708; /* 2 n^2 triangles: 1,002,528 */
+    const int runs = argc > 1 ? atoi(argv[1]) : 3;
+    const double tan_theta = tan(30.0 * kPi / 180.0);
+    mesh_scene s = scene_make(SCENE_TRIANGLES, n, 1.0, 4242u);
+    fprintf(stderr, "mesh: %lld jittered triangles; fully active (a plane of slope 10 draining over open edges),"
+                    " sparse (ridges on ~1 %% of cells), idle; best of %d\n", (long long)s.cells, runs);
+    double *h = xcalloc((size_t)s.cells, sizeof(double)), *plain_h = xcalloc((size_t)s.cells, sizeof(double));
+    for (int64_t c = 0; c < s.cells; ++c) h[c] = 30.0 + 10.0 * (s.cx[c] + 0.3 * s.cy[c]);
+    dpsm_grid *g = NULL;
+    CHECK(NULL, scene_create(&s, &g));
+    CHECK(g, dpsm_set_boundary(g, DPSM_MESH_EDGE, DPSM_OPEN));
+    double dt = 0.0;
+    CHECK(g, dpsm_stable_dt(g, &dt));
+    plain_mesh p = plain_from(&s);
+    printf("scene,threads,seconds_per_substep,mcells_per_s,reference_mcells_per_s,ratio,cells_visited_per_substep\n");
+    const int substeps = 20;
+    double plain_best = 1e300;
+    for (int run = 0; run < runs; ++run) {
+        memcpy(plain_h, h, sizeof(double) * (size_t)s.cells);
+        const double t0 = now_seconds();
+        for (int k = 0; k < substeps; ++k) plain_substep(&p, plain_h, dt, tan_theta);
+        plain_best = fmin(plain_best, (now_seconds() - t0) / substeps);
+    }
+    double active_best[3] = {1e300, 1e300, 1e300};
+    for (int threads = 1; threads <= 2; ++threads) {
+        CHECK(g, dpsm_set_threads(g, threads));
+        double updates = 0.0;
+        for (int run = 0; run < runs; ++run) {
+            CHECK(g, dpsm_set_heights(g, h));
+            active_best[threads] = fmin(active_best[threads], seconds_per_substep(g, substeps, &updates));
+        }
+        printf("fully_active,%d,%.6f,%.1f,%.1f,%.2f,%.0f\n", threads, active_best[threads], s.cells / active_best[threads] / 1e6,
+               s.cells / plain_best / 1e6, plain_best / active_best[threads], updates);
+        fflush(stdout);
+    }
+    /* Sparse: flat ground with ridges on about 1 % of the cells. */
+    for (int64_t c = 0; c < s.cells; ++c) {
+        const double band = fabs(fmod(s.cy[c] + 1.0, 0.5) - 0.25);
+        h[c] = band < 0.0025 ? 0.02 : 0.0;
+    }
+    for (int threads = 1; threads <= 2; ++threads) {
+        CHECK(g, dpsm_set_threads(g, threads));
+        double best = 1e300, updates = 0.0;
+        for (int run = 0; run < runs; ++run) {
+            CHECK(g, dpsm_set_heights(g, h));
+            CHECK(g, dpsm_step(g, dt)); /* the host's edit is looked at once */
+            best = fmin(best, seconds_per_substep(g, substeps, &updates));
+        }
+        printf("sparse,%d,%.6f,,,%.4f of fully active,%.0f (%.2f %% of cells)\n", threads, best, best / active_best[threads],
+               updates, 100.0 * updates / s.cells);
+        fflush(stdout);
+    }
+    /* Idle: the same mesh at rest. */
+    for (int64_t c = 0; c < s.cells; ++c) h[c] = 0.1 * s.cx[c];
+    CHECK(g, dpsm_set_heights(g, h));
+    CHECK(g, dpsm_step(g, dt));
+    double best = 1e300;
+    for (int run = 0; run < runs * 100; ++run) {
+        const double t0 = now_seconds();
+        CHECK(g, dpsm_step(g, dt));
+        best = fmin(best, now_seconds() - t0);
+    }
+    printf("idle,2,%.9f,,,%.6f of fully active,0\n", best, best / active_best[2]);
+    plain_free(&p);
+    dpsm_destroy(g);
+    free(h), free(plain_h);
+    scene_free(&s);
+    return 0;
+}

@@ -1,0 +1,41 @@
+#!/usr/bin/env bash
+# Regenerates the figures of docs/guide_meshes.md: the column collapse on every
+# mesh kind at three refinements and the cone on triangles (dpsm-bench
+# mesh-accuracy, with the gmsh disk when gmsh is installed), the 2D grid's
+# isotropic scheme beside them (docs/data/work_precision.csv), the speed of
+# the mesh engine (dpsm-bench mesh), the error-against-cells figure and the
+# picture of a pile on a gmsh mesh (examples/python/mesh_pile.py).
+#
+#   bash bench/run_mesh_validation.sh     # about 15 minutes on 2 cores, on a quiet machine
+#
+# BUILD_DIR (default build-bench) is the build tree; PYTHON (default
+# /usr/bin/python3) runs the plots, which need python3-matplotlib.
+set -euo pipefail
+
+root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
+build=${BUILD_DIR:-$root/build-bench}
+python=${PYTHON:-/usr/bin/python3}
+data=$root/docs/data
+figures=$root/docs/figures
+
+cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=Release -DDPSM_BUILD_BENCH=ON \
+      -DDPSM_BUILD_TESTS=OFF -DDPSM_BUILD_DOCS=OFF -DDPSM_BUILD_EXAMPLES=OFF >/dev/null
+cmake --build "$build" --target dpsm-bench dpsm
+bench=$build/bench/dpsm-bench
+mkdir -p "$data" "$figures"
+{
+  echo "generated: $(date -u +%Y-%m-%dT%H:%M:%SZ) by bench/run_mesh_validation.sh"
+  echo "source tree $(git -C "$root" describe --always --dirty 2>/dev/null || echo unknown)"
+  echo "machine: $(uname -m), $(nproc) cores; gmsh: $(gmsh --version 2>&1 || echo 'not found')"
+} > "$data/mesh_provenance.txt"
+
+echo ">> dpsm-bench mesh-accuracy"
+DPSM_DISK_GEO=$root/bench/data/disk.geo "$bench" mesh-accuracy 2 3 > "$data/mesh_accuracy.csv" 2> "$data/mesh_accuracy.log"
+cat "$data/mesh_accuracy.csv"
+echo ">> dpsm-bench mesh"
+"$bench" mesh > "$data/mesh_speed.csv" 2> "$data/mesh_speed.log"
+cat "$data/mesh_speed.csv"
+"$python" "$root/bench/plot_mesh_accuracy.py" "$data/mesh_accuracy.csv" "$data/work_precision.csv" \
+    "$figures/mesh_accuracy.png"
+PYTHONPATH=$root/bindings/python DPSM_LIBRARY=$build/src/libdpsm.so \
+    "$python" "$root/examples/python/mesh_pile.py" --save "$figures/mesh_pile.png"

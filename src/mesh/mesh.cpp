@@ -1,0 +1,562 @@
+#include "mesh/mesh.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdlib>
+#include <numeric>
+#include <string>
+#include <utility>
+
+#include "dpsm/dpsm.h"
+#include "model/error.hpp"
+#include "model/limits.hpp"
+
+namespace dpsm {
+
+namespace {
+
+struct Vec {
+    double x, y;
+};
+Vec operator-(Vec a, Vec b) { return {a.x - b.x, a.y - b.y}; }
+Vec operator+(Vec a, Vec b) { return {a.x + b.x, a.y + b.y}; }
+Vec operator*(double s, Vec a) { return {s * a.x, s * a.y}; }
+double dot(Vec a, Vec b) { return a.x * b.x + a.y * b.y; }
+double cross(Vec a, Vec b) { return a.x * b.y - a.y * b.x; }
+double norm(Vec a) { return std::hypot(a.x, a.y); }
+
+// A face as the builders find it, in the host's numbering.
+struct RawFace {
+    std::int64_t a, b;  // b == -1: domain edge
+    Vec mid;
+    double length;
+    Vec normal_length;  // length times the unit normal, pointing from a to b (outwards on the edge)
+    bool normal_known;  // false on a graph: the normal is taken along a to b
+    std::int64_t along = 0;  // polygons: the edge's place in cell a, which orders the host's faces
+};
+
+struct RawCells {
+    std::vector<double> area;
+    std::vector<Vec> centre;
+};
+
+void require_coordinates(const double *xy, std::int64_t n, const char *function, const char *name, const char *what,
+                         int base) {
+    if (!xy) fail(DPSM_ERR_NULL_POINTER, function, name, " is NULL");
+    for (std::int64_t k = 0; k < 2 * n; ++k)
+        if (!std::isfinite(xy[k]) || std::fabs(xy[k]) > kMaxMagnitude)
+            fail(DPSM_ERR_INVALID_VALUE, function, name, "[", k + base, "] (", k % 2 ? "y" : "x", " of ", what, " ",
+                 k / 2 + base, ") = ", xy[k], " is not finite or lies outside [-1e50, 1e50]");
+}
+
+void require_count(std::int64_t n, const char *function, const char *name) {
+    if (n < 1) fail(DPSM_ERR_INVALID_SIZE, function, name, " = ", n, " must be at least 1");
+    if (n > kMaxCells) fail(DPSM_ERR_INVALID_SIZE, function, name, " = ", n, " is more than this library can address");
+}
+
+// The Hilbert index of (x, y) on a 2^16 by 2^16 lattice.
+std::uint64_t hilbert_index(std::uint32_t x, std::uint32_t y) {
+    std::uint64_t d = 0;
+    for (std::uint32_t s = 1u << 15; s > 0; s >>= 1) {
+        const std::uint32_t rx = (x & s) ? 1u : 0u, ry = (y & s) ? 1u : 0u;
+        d += static_cast<std::uint64_t>(s) * s * ((3u * rx) ^ ry);
+        if (ry == 0) {
+            if (rx == 1) {
+                x = s - 1 - (x & (s - 1)) + (x & ~(s - 1));
+                y = s - 1 - (y & (s - 1)) + (y & ~(s - 1));
+                x &= (s << 1) - 1;
+                y &= (s << 1) - 1;
+            }
+            std::swap(x, y);
+        }
+    }
+    return d;
+}
+
+// Cells ordered along a Hilbert curve over their centres.
+std::vector<std::int64_t> hilbert_order(const std::vector<Vec> &centre) {
+    double x0 = centre[0].x, x1 = x0, y0 = centre[0].y, y1 = y0;
+    for (const Vec &c : centre) {
+        x0 = std::min(x0, c.x), x1 = std::max(x1, c.x);
+        y0 = std::min(y0, c.y), y1 = std::max(y1, c.y);
+    }
+    const double span = std::max({x1 - x0, y1 - y0, 1e-300});
+    std::vector<std::pair<std::uint64_t, std::int64_t>> keyed(centre.size());
+    for (std::size_t c = 0; c < centre.size(); ++c) {
+        const auto lattice = [&](double v, double lo) {
+            return static_cast<std::uint32_t>(std::min(65535.0, std::floor((v - lo) / span * 65535.0)));
+        };
+        keyed[c] = {hilbert_index(lattice(centre[c].x, x0), lattice(centre[c].y, y0)), static_cast<std::int64_t>(c)};
+    }
+    std::sort(keyed.begin(), keyed.end());
+    std::vector<std::int64_t> order(centre.size());
+    for (std::size_t k = 0; k < keyed.size(); ++k) order[k] = keyed[k].second;
+    return order;
+}
+
+// The least-squares gradient weights of every cell, weighted by inverse
+// distance squared, over one ring of neighbours across faces or, where cells
+// have fewer than 4 of them on average, two; a cell whose neighbours do not
+// span the plane gets none (its faces use the two-point slope alone).
+void gradient_weights(Mesh &m) {
+    const double mean_neighbours =
+        static_cast<double>(m.cell_faces.size()) / static_cast<double>(m.cells);  // edges count: an upper figure
+    m.grad_rings = mean_neighbours < 4.0 ? 2 : 1;
+    m.grad_start.assign(m.cells + 1, 0);
+    m.grad_cells.clear();
+    std::vector<std::int64_t> seen(m.cells, -1), ring;
+    for (std::int64_t c = 0; c < m.cells; ++c) {
+        ring.clear();
+        seen[c] = c;
+        for (std::int64_t k = m.cell_face_start[c]; k < m.cell_face_start[c + 1]; ++k) {
+            const std::int64_t n = m.other[k];
+            if (n >= 0 && seen[n] != c) seen[n] = c, ring.push_back(n);
+        }
+        if (m.grad_rings > 1) {
+            const std::size_t first = ring.size();
+            for (std::size_t r = 0; r < first; ++r)
+                for (std::int64_t k = m.cell_face_start[ring[r]]; k < m.cell_face_start[ring[r] + 1]; ++k) {
+                    const std::int64_t n = m.other[k];
+                    if (n >= 0 && seen[n] != c) seen[n] = c, ring.push_back(n);
+                }
+        }
+        std::sort(ring.begin(), ring.end());
+        m.grad_cells.insert(m.grad_cells.end(), ring.begin(), ring.end());
+        m.grad_start[c + 1] = static_cast<std::int64_t>(m.grad_cells.size());
+    }
+    m.grad_wx.assign(m.grad_cells.size(), 0.0);
+    m.grad_wy.assign(m.grad_cells.size(), 0.0);
+    for (std::int64_t c = 0; c < m.cells; ++c) {
+        double sxx = 0.0, sxy = 0.0, syy = 0.0;
+        const std::int64_t k0 = m.grad_start[c], k1 = m.grad_start[c + 1];
+        for (std::int64_t k = k0; k < k1; ++k) {
+            const std::int64_t n = m.grad_cells[k];
+            const double dx = m.x[n] - m.x[c], dy = m.y[n] - m.y[c];
+            const double w = 1.0 / (dx * dx + dy * dy);
+            sxx += w * dx * dx, sxy += w * dx * dy, syy += w * dy * dy;
+        }
+        const double det = sxx * syy - sxy * sxy;
+        const double trace = sxx + syy;
+        if (!(det > 1e-6 * trace * trace)) continue;
+        for (std::int64_t k = k0; k < k1; ++k) {
+            const std::int64_t n = m.grad_cells[k];
+            const double dx = m.x[n] - m.x[c], dy = m.y[n] - m.y[c];
+            const double w = 1.0 / (dx * dx + dy * dy);
+            m.grad_wx[k] = w * (syy * dx - sxy * dy) / det;
+            m.grad_wy[k] = w * (sxx * dy - sxy * dx) / det;
+        }
+    }
+}
+
+// Renumbers cells and faces, derives what a face's slope needs and checks
+// the faces' geometry. `cells` and `faces` are in the host's numbering.
+std::shared_ptr<const Mesh> assemble(MeshInput &&input, const RawCells &cells, const std::vector<RawFace> &faces,
+                                     const char *function, int base) {
+    auto mesh = std::make_shared<Mesh>();
+    Mesh &m = *mesh;
+    m.input = std::move(input);
+    m.cells = static_cast<std::int64_t>(cells.area.size());
+    m.faces = static_cast<std::int64_t>(faces.size());
+    m.host_cell = hilbert_order(cells.centre);
+    m.cell_of_host.assign(m.cells, 0);
+    for (std::int64_t c = 0; c < m.cells; ++c) m.cell_of_host[m.host_cell[c]] = c;
+    m.area.resize(m.cells), m.x.resize(m.cells), m.y.resize(m.cells);
+    for (std::int64_t c = 0; c < m.cells; ++c) {
+        const std::int64_t h = m.host_cell[c];
+        m.area[c] = cells.area[h], m.x[c] = cells.centre[h].x, m.y[c] = cells.centre[h].y;
+    }
+    // Faces follow their first cell in the library's order.
+    std::vector<std::pair<std::pair<std::int64_t, std::int64_t>, std::int64_t>> keyed(faces.size());
+    for (std::size_t f = 0; f < faces.size(); ++f) {
+        const std::int64_t a = m.cell_of_host[faces[f].a];
+        const std::int64_t b = faces[f].b < 0 ? -1 : m.cell_of_host[faces[f].b];
+        const std::int64_t lo = b < 0 ? a : std::min(a, b), hi = b < 0 ? -1 : std::max(a, b);
+        keyed[f] = {{lo, hi}, static_cast<std::int64_t>(f)};
+    }
+    std::sort(keyed.begin(), keyed.end());
+    const std::size_t nf = faces.size();
+    m.host_face.resize(nf), m.face_of_host.resize(nf), m.face_a.resize(nf), m.face_b.resize(nf);
+    m.distance.resize(nf), m.conductance.resize(nf), m.length.resize(nf), m.tangent_x.resize(nf),
+        m.tangent_y.resize(nf), m.orthogonal.resize(nf), m.skew.resize(nf), m.host_sign.resize(nf);
+    double smallest = 0.0;
+    for (std::size_t f = 0; f < nf; ++f) {
+        const std::int64_t h = keyed[f].second;
+        const RawFace &raw = faces[h];
+        m.host_face[f] = h;
+        m.face_of_host[h] = static_cast<std::int64_t>(f);
+        const std::int64_t a = keyed[f].first.first, b = keyed[f].first.second;
+        const bool flipped = b >= 0 && a != m.cell_of_host[raw.a];
+        m.face_a[f] = a, m.face_b[f] = b;
+        m.host_sign[f] = flipped ? -1 : 1;
+        const Vec ca{m.x[a], m.y[a]};
+        Vec nl = raw.normal_length;
+        if (flipped) nl = -1.0 * nl;
+        const auto name_face = [&] {
+            return std::string("face ") + std::to_string(h + base) + " (cells " + std::to_string(raw.a + base) +
+                   (raw.b < 0 ? std::string(" and the domain edge") : " and " + std::to_string(raw.b + base)) + ")";
+        };
+        if (!(raw.length > 0.0) || !std::isfinite(raw.length))
+            fail(DPSM_ERR_INVALID_VALUE, function, name_face(), " has length ", raw.length, ", not a positive number");
+        Vec e;
+        double d;
+        if (b >= 0) {
+            const Vec between = Vec{m.x[b], m.y[b]} - ca;
+            d = norm(between);
+            if (!(d > 0.0))
+                fail(DPSM_ERR_INVALID_VALUE, function, name_face(), " joins two cells whose centres coincide at (",
+                     ca.x, ", ", ca.y, ")");
+            e = (1.0 / d) * between;
+            if (!raw.normal_known) nl = raw.length * e;
+        } else {
+            // The outside is the cell's mirror image across the face.
+            const Vec to_mid = raw.mid - ca;
+            d = 2.0 * norm(to_mid);
+            if (!raw.normal_known) nl = (raw.length / norm(to_mid)) * to_mid;
+            e = (1.0 / raw.length) * nl;
+            if (!(d > 0.0))
+                fail(DPSM_ERR_INVALID_VALUE, function, name_face(), " has its midpoint at the cell's centre (",
+                     ca.x, ", ", ca.y, ")");
+        }
+        m.distance[f] = d;
+        m.length[f] = raw.length;
+        m.tangent_x[f] = -e.y, m.tangent_y[f] = e.x;
+        m.orthogonal[f] = std::max(0.0, dot(nl, e));
+        m.skew[f] = dot(nl, Vec{m.tangent_x[f], m.tangent_y[f]});
+        m.conductance[f] = norm(nl) / d;
+        smallest = f == 0 ? d : std::min(smallest, d);
+    }
+    m.min_distance = smallest;
+    // Each cell's faces, in increasing face order.
+    m.cell_face_start.assign(m.cells + 1, 0);
+    for (std::size_t f = 0; f < nf; ++f) {
+        ++m.cell_face_start[m.face_a[f] + 1];
+        if (m.face_b[f] >= 0) ++m.cell_face_start[m.face_b[f] + 1];
+    }
+    for (std::int64_t c = 0; c < m.cells; ++c) m.cell_face_start[c + 1] += m.cell_face_start[c];
+    m.cell_faces.resize(m.cell_face_start[m.cells]);
+    m.other.resize(m.cell_faces.size());
+    std::vector<std::int64_t> fill(m.cell_face_start.begin(), m.cell_face_start.end() - 1);
+    for (std::size_t f = 0; f < nf; ++f) {
+        const std::int64_t a = m.face_a[f], b = m.face_b[f];
+        m.cell_faces[fill[a]] = static_cast<std::int64_t>(f);
+        m.other[fill[a]++] = b;
+        if (b >= 0) {
+            m.cell_faces[fill[b]] = static_cast<std::int64_t>(f);
+            m.other[fill[b]++] = a;
+        }
+    }
+    gradient_weights(m);
+    for (std::int64_t c = 0; c < m.cells; ++c) {
+        double sum = 0.0;
+        for (std::int64_t k = m.cell_face_start[c]; k < m.cell_face_start[c + 1]; ++k) sum += m.conductance[m.cell_faces[k]];
+        if (sum > 0.0 && (m.step_scale == 0.0 || m.area[c] / sum < m.step_scale)) m.step_scale = m.area[c] / sum;
+    }
+    if (m.step_scale == 0.0) m.step_scale = 1.0;  // no face conducts: nothing ever moves
+    return mesh;
+}
+
+// Polygons over nodes: the shoelace area and centroid per cell, and faces
+// from edges, found by sorting the edges' node pairs.
+struct EdgeUse {
+    std::int64_t lo, hi, cell, along;  // along: the position of the edge in its cell
+    bool operator<(const EdgeUse &o) const {
+        return lo != o.lo ? lo < o.lo : hi != o.hi ? hi < o.hi : cell != o.cell ? cell < o.cell : along < o.along;
+    }
+};
+
+// The uses of one edge: edges[k .. end), sorted so that they lie together;
+// more than two is a mesh no face can describe.
+std::size_t end_of_edge(const std::vector<EdgeUse> &edges, std::size_t k, const char *function, int base,
+                        const char *cells) {
+    std::size_t end = k + 1;
+    while (end < edges.size() && edges[end].lo == edges[k].lo && edges[end].hi == edges[k].hi) ++end;
+    if (end - k > 2)
+        fail(DPSM_ERR_INVALID_VALUE, function, "the edge between nodes ", edges[k].lo + base, " and ",
+             edges[k].hi + base, " is shared by ", end - k, " ", cells, " (", edges[k].cell + base, ", ",
+             edges[k + 1].cell + base, ", ", edges[k + 2].cell + base, "); an edge belongs to one or two");
+    return end;
+}
+
+}  // namespace
+
+std::shared_ptr<const Mesh> mesh_from_polygons(std::int64_t nnodes, const double *node_xy, std::int64_t ncells,
+                                               const std::int64_t *cell_start, const std::int64_t *cell_nodes,
+                                               const char *function, int base) {
+    require_count(nnodes, function, "nnodes");
+    require_count(ncells, function, "ncells");
+    require_coordinates(node_xy, nnodes, function, "node_xy", "node", base);
+    if (!cell_start) fail(DPSM_ERR_NULL_POINTER, function, "cell_start is NULL");
+    if (!cell_nodes) fail(DPSM_ERR_NULL_POINTER, function, "cell_nodes is NULL");
+    if (cell_start[0] != 0)
+        fail(DPSM_ERR_INVALID_VALUE, function, "cell_start[", base, "] = ", cell_start[0], " must be 0");
+    for (std::int64_t c = 0; c < ncells; ++c)
+        if (cell_start[c + 1] < cell_start[c] + 3 || cell_start[c + 1] - cell_start[c] > (1 << 20))
+            fail(DPSM_ERR_INVALID_VALUE, function, "cell ", c + base, " has ", cell_start[c + 1] - cell_start[c],
+                 " nodes (cell_start[", c + base, "] = ", cell_start[c], ", cell_start[", c + 1 + base,
+                 "] = ", cell_start[c + 1], "); a polygon needs at least 3");
+    const std::int64_t total = cell_start[ncells];
+    for (std::int64_t k = 0; k < total; ++k)
+        if (cell_nodes[k] < 0 || cell_nodes[k] >= nnodes)
+            fail(DPSM_ERR_INVALID_VALUE, function, "cell_nodes[", k + base, "] = ", cell_nodes[k] + base,
+                 " is not a node index in [", base, ", ", nnodes - 1 + base, "]");
+    MeshInput input;
+    input.kind = MeshInput::kPolygons;
+    input.node_xy.assign(node_xy, node_xy + 2 * nnodes);
+    input.cell_start.assign(cell_start, cell_start + ncells + 1);
+    input.cell_nodes.assign(cell_nodes, cell_nodes + total);
+    const auto node = [&](std::int64_t n) { return Vec{node_xy[2 * n], node_xy[2 * n + 1]}; };
+
+    RawCells cells;
+    cells.area.resize(ncells), cells.centre.resize(ncells);
+    std::vector<signed char> orientation(ncells);
+    std::vector<EdgeUse> edges;
+    edges.reserve(total);
+    for (std::int64_t c = 0; c < ncells; ++c) {
+        const std::int64_t k0 = cell_start[c], count = cell_start[c + 1] - k0;
+        std::vector<std::int64_t> distinct(cell_nodes + k0, cell_nodes + k0 + count);
+        std::sort(distinct.begin(), distinct.end());
+        if (std::unique(distinct.begin(), distinct.end()) - distinct.begin() < 3)
+            fail(DPSM_ERR_INVALID_VALUE, function, "cell ", c + base, " has fewer than 3 distinct nodes");
+        // Relative to the first node, so that a small cell far from the origin keeps its digits.
+        const Vec origin = node(cell_nodes[k0]);
+        double twice_area = 0.0;
+        Vec moment{0.0, 0.0};
+        double perimeter = 0.0;
+        for (std::int64_t k = 0; k < count; ++k) {
+            const Vec p = node(cell_nodes[k0 + k]) - origin, q = node(cell_nodes[k0 + (k + 1) % count]) - origin;
+            const double w = cross(p, q);
+            twice_area += w;
+            moment = moment + (w / 3.0) * (p + q);
+            perimeter += norm(q - p);
+            const std::int64_t u = cell_nodes[k0 + k], v = cell_nodes[k0 + (k + 1) % count];
+            if (u == v)
+                fail(DPSM_ERR_INVALID_VALUE, function, "cell ", c + base, " repeats node ", u + base,
+                     " in consecutive places: an edge of zero length");
+            edges.push_back({std::min(u, v), std::max(u, v), c, k});
+        }
+        const double area = 0.5 * std::fabs(twice_area);
+        if (!(area > 1e-12 * perimeter * perimeter))
+            fail(DPSM_ERR_INVALID_VALUE, function, "cell ", c + base, " has zero area (", area,
+                 ") for its perimeter ", perimeter, ": its nodes lie on a line");
+        orientation[c] = twice_area > 0.0 ? 1 : -1;
+        cells.area[c] = area;
+        cells.centre[c] = origin + (1.0 / twice_area) * moment;
+    }
+    std::sort(edges.begin(), edges.end());
+    std::vector<RawFace> faces;
+    faces.reserve(edges.size());
+    for (std::size_t k = 0; k < edges.size();) {
+        const std::size_t end = end_of_edge(edges, k, function, base, "cells");
+        const EdgeUse &first = edges[k];
+        if (end - k == 2 && edges[k + 1].cell == first.cell)
+            fail(DPSM_ERR_INVALID_VALUE, function, "cell ", first.cell + base, " has the edge between nodes ",
+                 first.lo + base, " and ", first.hi + base, " twice");
+        const Vec p = node(first.lo), q = node(first.hi);
+        RawFace face;
+        face.a = first.cell;
+        face.b = end - k == 2 ? edges[k + 1].cell : -1;
+        face.mid = 0.5 * (p + q);
+        face.length = norm(q - p);
+        // The normal pointing out of a: the edge's direction in a's own
+        // orientation, turned clockwise for a counter-clockwise cell.
+        const std::int64_t k0 = cell_start[first.cell], count = cell_start[first.cell + 1] - k0;
+        const Vec from = node(cell_nodes[k0 + first.along]), to = node(cell_nodes[k0 + (first.along + 1) % count]);
+        const Vec along = to - from;
+        face.normal_length = orientation[first.cell] > 0 ? Vec{along.y, -along.x} : Vec{-along.y, along.x};
+        face.normal_known = true;
+        face.along = first.along;
+        faces.push_back(face);
+        k = end;
+    }
+    // The host's face order: as the faces first appear, cell by cell in the
+    // host's order, edge by edge in each cell's order.
+    std::sort(faces.begin(), faces.end(),
+              [](const RawFace &l, const RawFace &r) { return l.a != r.a ? l.a < r.a : l.along < r.along; });
+    return assemble(std::move(input), cells, faces, function, base);
+}
+
+std::shared_ptr<const Mesh> mesh_from_graph(std::int64_t ncells, const double *cell_xy, const double *cell_area,
+                                            std::int64_t nfaces, const std::int64_t *face_cells,
+                                            const double *face_xy, const double *face_length, const char *function,
+                                            int base) {
+    require_count(ncells, function, "ncells");
+    require_count(nfaces, function, "nfaces");
+    require_coordinates(cell_xy, ncells, function, "cell_xy", "cell", base);
+    require_coordinates(face_xy, nfaces, function, "face_xy", "face", base);
+    if (!cell_area) fail(DPSM_ERR_NULL_POINTER, function, "cell_area is NULL");
+    if (!face_cells) fail(DPSM_ERR_NULL_POINTER, function, "face_cells is NULL");
+    if (!face_length) fail(DPSM_ERR_NULL_POINTER, function, "face_length is NULL");
+    RawCells cells;
+    cells.area.resize(ncells), cells.centre.resize(ncells);
+    for (std::int64_t c = 0; c < ncells; ++c) {
+        if (!(cell_area[c] > 0.0) || !(cell_area[c] <= kMaxMagnitude))
+            fail(DPSM_ERR_INVALID_VALUE, function, "cell_area[", c + base, "] (cell ", c + base, ") = ", cell_area[c],
+                 " is not a positive area within 1e50");
+        cells.area[c] = cell_area[c];
+        cells.centre[c] = Vec{cell_xy[2 * c], cell_xy[2 * c + 1]};
+    }
+    std::vector<RawFace> faces(nfaces);
+    std::vector<std::vector<double>> angles(ncells);
+    for (std::int64_t f = 0; f < nfaces; ++f) {
+        const std::int64_t a = face_cells[2 * f], b = face_cells[2 * f + 1];
+        if (a < 0 || a >= ncells)
+            fail(DPSM_ERR_INVALID_VALUE, function, "face ", f + base, ": face_cells[", 2 * f + base, "] = ", a + base,
+                 " is not a cell index in [", base, ", ", ncells - 1 + base, "]");
+        if (b < -1 || b >= ncells)
+            fail(DPSM_ERR_INVALID_VALUE, function, "face ", f + base, ": face_cells[", 2 * f + 1 + base, "] = ",
+                 b < 0 ? b : b + base, " is not a cell index in [", base, ", ", ncells - 1 + base, "] nor ",
+                 base - 1, " (the domain edge)");
+        if (a == b)
+            fail(DPSM_ERR_INVALID_VALUE, function, "face ", f + base, " joins cell ", a + base, " to itself");
+        if (b >= 0 && cells.centre[a].x == cells.centre[b].x && cells.centre[a].y == cells.centre[b].y)
+            fail(DPSM_ERR_INVALID_VALUE, function, "face ", f + base, " (cells ", a + base, " and ", b + base,
+                 ") joins two cells whose centres coincide at (", cells.centre[a].x, ", ", cells.centre[a].y, ")");
+        if (!(face_length[f] > 0.0) || !(face_length[f] <= kMaxMagnitude))
+            fail(DPSM_ERR_INVALID_VALUE, function, "face_length[", f + base, "] (face ", f + base, ") = ",
+                 face_length[f], " is not a positive length within 1e50");
+        RawFace &face = faces[f];
+        face.a = a, face.b = b;
+        face.mid = Vec{face_xy[2 * f], face_xy[2 * f + 1]};
+        face.length = face_length[f];
+        face.normal_length = Vec{0.0, 0.0};
+        face.normal_known = false;
+        for (const std::int64_t c : {a, b}) {
+            if (c < 0) continue;
+            const Vec to = face.mid - cells.centre[c];
+            if (norm(to) > 0.0) angles[c].push_back(std::atan2(to.y, to.x));
+        }
+    }
+    // A cell is closed when its faces surround its centre: no gap of half a
+    // turn or more between the directions to their midpoints.
+    for (std::int64_t c = 0; c < ncells; ++c) {
+        std::vector<double> &dir = angles[c];
+        std::sort(dir.begin(), dir.end());
+        double gap = dir.empty() ? 7.0 : dir.front() + 2.0 * M_PI - dir.back();
+        for (std::size_t k = 1; k < dir.size(); ++k) gap = std::max(gap, dir[k] - dir[k - 1]);
+        if (dir.size() < 3 || gap >= M_PI * (1.0 - 1e-9))
+            fail(DPSM_ERR_INVALID_VALUE, function, "the faces of cell ", c + base, " (", dir.size(),
+                 " of them) do not close it: their midpoints leave a gap of ", gap * 180.0 / M_PI,
+                 " degrees around its centre; give every face of the cell, domain edges with b = ", base - 1);
+    }
+    MeshInput input;
+    input.kind = MeshInput::kGraph;
+    input.ncells = ncells;
+    input.cell_xy.assign(cell_xy, cell_xy + 2 * ncells);
+    input.cell_area.assign(cell_area, cell_area + ncells);
+    input.face_cells.assign(face_cells, face_cells + 2 * nfaces);
+    input.face_xy.assign(face_xy, face_xy + 2 * nfaces);
+    input.face_length.assign(face_length, face_length + nfaces);
+    return assemble(std::move(input), cells, faces, function, base);
+}
+
+std::shared_ptr<const Mesh> mesh_from_dual(std::int64_t nnodes, const double *node_xy, std::int64_t ntriangles,
+                                           const std::int64_t *triangle_nodes, const char *function, int base) {
+    require_count(nnodes, function, "nnodes");
+    require_count(ntriangles, function, "ntriangles");
+    require_coordinates(node_xy, nnodes, function, "node_xy", "node", base);
+    if (!triangle_nodes) fail(DPSM_ERR_NULL_POINTER, function, "triangle_nodes is NULL");
+    for (std::int64_t k = 0; k < 3 * ntriangles; ++k)
+        if (triangle_nodes[k] < 0 || triangle_nodes[k] >= nnodes)
+            fail(DPSM_ERR_INVALID_VALUE, function, "triangle_nodes[", k + base, "] (triangle ", k / 3 + base,
+                 ") = ", triangle_nodes[k] + base, " is not a node index in [", base, ", ", nnodes - 1 + base, "]");
+    const auto node = [&](std::int64_t n) { return Vec{node_xy[2 * n], node_xy[2 * n + 1]}; };
+    RawCells cells;
+    cells.area.assign(nnodes, 0.0);
+    cells.centre.resize(nnodes);
+    for (std::int64_t n = 0; n < nnodes; ++n) cells.centre[n] = node(n);
+    std::vector<EdgeUse> edges;
+    edges.reserve(3 * ntriangles);
+    for (std::int64_t t = 0; t < ntriangles; ++t) {
+        const std::int64_t *v = triangle_nodes + 3 * t;
+        if (v[0] == v[1] || v[1] == v[2] || v[0] == v[2])
+            fail(DPSM_ERR_INVALID_VALUE, function, "triangle ", t + base, " has fewer than 3 distinct nodes");
+        const Vec p = node(v[0]), q = node(v[1]), r = node(v[2]);
+        const double area = 0.5 * std::fabs(cross(q - p, r - p));
+        const double perimeter = norm(q - p) + norm(r - q) + norm(p - r);
+        if (!(area > 1e-12 * perimeter * perimeter))
+            fail(DPSM_ERR_INVALID_VALUE, function, "triangle ", t + base, " has zero area: its nodes lie on a line");
+        for (int k = 0; k < 3; ++k) {
+            cells.area[v[k]] += area / 3.0;
+            edges.push_back({std::min(v[k], v[(k + 1) % 3]), std::max(v[k], v[(k + 1) % 3]), t, k});
+        }
+    }
+    for (std::int64_t n = 0; n < nnodes; ++n)
+        if (!(cells.area[n] > 0.0))
+            fail(DPSM_ERR_INVALID_VALUE, function, "node ", n + base, " belongs to no triangle: its cell has no area");
+    std::sort(edges.begin(), edges.end());
+    std::vector<RawFace> faces, edge_faces;
+    for (std::size_t k = 0; k < edges.size();) {
+        const std::size_t end = end_of_edge(edges, k, function, base, "triangles");
+        const EdgeUse &first = edges[k];
+        const Vec p = node(first.lo), q = node(first.hi), m = 0.5 * (p + q);
+        // The dual face between the edge's nodes: from the edge's midpoint to
+        // the centroid of each triangle on it; its normal, integrated along
+        // it, points from lo to hi.
+        RawFace face;
+        face.a = first.lo, face.b = first.hi;
+        face.length = 0.0;
+        face.normal_length = Vec{0.0, 0.0};
+        Vec mid_sum{0.0, 0.0};
+        for (std::size_t u = k; u < end; ++u) {
+            const std::int64_t *v = triangle_nodes + 3 * edges[u].cell;
+            const Vec centroid = (1.0 / 3.0) * (node(v[0]) + node(v[1]) + node(v[2]));
+            const Vec seg = centroid - m;
+            Vec normal{seg.y, -seg.x};
+            if (dot(normal, q - p) < 0.0) normal = -1.0 * normal;
+            face.normal_length = face.normal_length + normal;
+            face.length += norm(seg);
+            mid_sum = mid_sum + norm(seg) * (0.5 * (centroid + m));
+        }
+        face.mid = (1.0 / face.length) * mid_sum;
+        face.normal_known = true;
+        faces.push_back(face);
+        if (end - k == 1) {
+            // A boundary edge: each of its nodes has half of it on the domain edge.
+            const std::int64_t *v = triangle_nodes + 3 * first.cell;
+            const Vec centroid = (1.0 / 3.0) * (node(v[0]) + node(v[1]) + node(v[2]));
+            Vec outward{(q - p).y, -(q - p).x};
+            if (dot(outward, m - centroid) < 0.0) outward = -1.0 * outward;
+            outward = (1.0 / norm(outward)) * outward;
+            for (const std::int64_t n : {first.lo, first.hi}) {
+                RawFace half;
+                half.a = n, half.b = -1;
+                half.mid = 0.5 * (node(n) + m);
+                half.length = norm(m - node(n));
+                half.normal_length = half.length * outward;
+                half.normal_known = true;
+                edge_faces.push_back(half);
+            }
+        }
+        k = end;
+    }
+    faces.insert(faces.end(), edge_faces.begin(), edge_faces.end());
+    MeshInput input;
+    input.kind = MeshInput::kDual;
+    input.node_xy.assign(node_xy, node_xy + 2 * nnodes);
+    input.cell_nodes.assign(triangle_nodes, triangle_nodes + 3 * ntriangles);
+    return assemble(std::move(input), cells, faces, function, base);
+}
+
+std::shared_ptr<const Mesh> mesh_from_input(const MeshInput &input, const char *function) {
+    switch (input.kind) {
+        case MeshInput::kPolygons: {
+            const std::int64_t ncells = static_cast<std::int64_t>(input.cell_start.size()) - 1;
+            if (ncells < 1 || input.cell_start.back() != static_cast<std::int64_t>(input.cell_nodes.size()))
+                fail(DPSM_ERR_BAD_FILE, function, "the mesh's cells do not match their node list");
+            return mesh_from_polygons(static_cast<std::int64_t>(input.node_xy.size() / 2), input.node_xy.data(), ncells,
+                                      input.cell_start.data(), input.cell_nodes.data(), function, 0);
+        }
+        case MeshInput::kGraph:
+            return mesh_from_graph(input.ncells, input.cell_xy.data(), input.cell_area.data(),
+                                   static_cast<std::int64_t>(input.face_length.size()), input.face_cells.data(),
+                                   input.face_xy.data(), input.face_length.data(), function, 0);
+        case MeshInput::kDual:
+            return mesh_from_dual(static_cast<std::int64_t>(input.node_xy.size() / 2), input.node_xy.data(),
+                                  static_cast<std::int64_t>(input.cell_nodes.size() / 3), input.cell_nodes.data(),
+                                  function, 0);
+    }
+    fail(DPSM_ERR_BAD_FILE, function, "unknown mesh kind ", static_cast<unsigned>(input.kind));
+}
+
+}  // namespace dpsm

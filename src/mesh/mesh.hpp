@@ -1,0 +1,94 @@
+// An unstructured mesh as the mesh engine reads it: cells with an area and a
+// centre, faces between two cells (or on the domain edge), and what a face's
+// slope needs (its distance, its conductance, the least-squares gradients of
+// its cells). Built from what a host holds (polygons over nodes, a
+// finite-volume graph, the median dual of a triangle mesh), checked, and
+// renumbered along a Hilbert curve over the cell centres so that neighbours
+// lie near each other in memory; the host keeps its own numbering
+// (host_cell, cell_of_host, host_face, face_of_host).
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+namespace dpsm {
+
+// What the host gave, kept to save in a restart file and to build the same
+// mesh from it again.
+struct MeshInput {
+    enum Kind : std::uint32_t { kPolygons = 1, kGraph = 2, kDual = 3 };
+    Kind kind = kPolygons;
+    // kPolygons and kDual: nodes and cells over them (kDual: 3 per triangle,
+    // cell_start empty).
+    std::vector<double> node_xy;
+    std::vector<std::int64_t> cell_start, cell_nodes;
+    // kGraph: cells and faces as the host holds them.
+    std::int64_t ncells = 0;
+    std::vector<double> cell_xy, cell_area, face_xy, face_length;
+    std::vector<std::int64_t> face_cells;
+};
+
+struct Mesh {
+    MeshInput input;
+    std::int64_t cells = 0, faces = 0;
+
+    // Per cell, in the library's order.
+    std::vector<double> area, x, y;
+    // Cell c's faces are cell_faces[cell_face_start[c] .. cell_face_start[c + 1]),
+    // in increasing face order; a face's other cell is `other` at the same
+    // place (-1 on the domain edge).
+    std::vector<std::int64_t> cell_face_start, cell_faces, other;
+    // The least-squares gradient of cell c is the sum over
+    // grad_cells[grad_start[c] .. grad_start[c + 1]) of (grad_wx, grad_wy) *
+    // (h_n - h_c): over the cells across its faces, and on meshes whose
+    // cells have fewer than 4 neighbours (triangles) also over theirs, so
+    // that the fit is not set by 3 points alone; none where they do not span
+    // the plane. grad_rings is how many rings of neighbours that reaches (1
+    // or 2): how far a change of height reaches into the slopes of faces.
+    std::vector<std::int64_t> grad_start, grad_cells;
+    std::vector<double> grad_wx, grad_wy;
+    int grad_rings = 1;
+
+    // Per face, in the library's order: cells a < b (b == -1 on the domain
+    // edge), the centre-to-centre distance d (on the domain edge twice the
+    // distance to the face's midpoint: the outside is the cell's mirror
+    // image), the unit tangent t perpendicular to the unit vector e from a
+    // to b, whose gradient component completes the face's slope, and the
+    // face's normal times its length, L n, split along e and t: orthogonal =
+    // L n . e (at least 0), skew = L n . t (0 where the face is orthogonal to
+    // the line between its cells, as on a graph); conductance = |L n| / d
+    // bounds what a face may carry per unit height difference and slope law.
+    std::vector<std::int64_t> face_a, face_b;
+    std::vector<double> distance, length, tangent_x, tangent_y, orthogonal, skew, conductance;
+    // The direction from a to b relative to the host's face (+1 or -1): a
+    // host reads a face's flux as positive from its own cell a to its b.
+    std::vector<signed char> host_sign;
+
+    // The library's cell c is the host's host_cell[c]; the host's cell k is
+    // the library's cell_of_host[k]. The same for faces.
+    std::vector<std::int64_t> host_cell, cell_of_host, host_face, face_of_host;
+
+    // The smallest distance of any face (the rest tolerance's length scale).
+    double min_distance = 0.0;
+    // The smallest area over summed conductance of any cell: the largest
+    // monotone sub-step is this over the flux law's largest slope.
+    double step_scale = 0.0;
+};
+
+// Each builds a mesh from the host's arrays, checked, or throws
+// Error(DPSM_ERR_*) naming the host's cell, node or face (counted from
+// `base`: 0 in C, 1 from Fortran) and the function in `function`.
+std::shared_ptr<const Mesh> mesh_from_polygons(std::int64_t nnodes, const double *node_xy, std::int64_t ncells,
+                                               const std::int64_t *cell_start, const std::int64_t *cell_nodes,
+                                               const char *function, int base);
+std::shared_ptr<const Mesh> mesh_from_graph(std::int64_t ncells, const double *cell_xy, const double *cell_area,
+                                            std::int64_t nfaces, const std::int64_t *face_cells,
+                                            const double *face_xy, const double *face_length, const char *function,
+                                            int base);
+std::shared_ptr<const Mesh> mesh_from_dual(std::int64_t nnodes, const double *node_xy, std::int64_t ntriangles,
+                                           const std::int64_t *triangle_nodes, const char *function, int base);
+// The same mesh again from what a restart file kept.
+std::shared_ptr<const Mesh> mesh_from_input(const MeshInput &input, const char *function);
+
+}  // namespace dpsm

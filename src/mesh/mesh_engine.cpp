@@ -1,0 +1,455 @@
+#include "mesh/mesh_engine.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <vector>
+
+#include "model/flux_law.hpp"
+#include "model/grid.hpp"
+#include "model/ledger.hpp"
+#include "model/threads.hpp"
+#include "stepping/engine.hpp"
+
+namespace dpsm {
+
+namespace {
+
+// Below this many cells in a pass the threads cost more than they save.
+constexpr std::int64_t kCellsForThreads = 32768;
+// A sub-step over more hot cells than this share of the mesh runs the plain
+// passes over every cell: the lists would cost more than they save.
+constexpr double kDenseShare = 0.125;
+
+// DPSM_VISIT_ALL_CELLS=1 turns the active set off (every sub-step visits
+// every cell), for tests that show it changes no result; read at every
+// sub-step so that a test can compare the two within one process.
+bool visit_all_cells() {
+    const char *all = std::getenv("DPSM_VISIT_ALL_CELLS");
+    return all && *all && *all != '0';
+}
+
+// The scratch of the passes, kept between sub-steps and steps.
+struct MeshScratch final : EngineState {
+    std::vector<double> gx, gy;   // least-squares gradients
+    std::vector<double> flux;     // per face, volume per unit time from a to b; 0 outside a sub-step's faces
+    std::vector<std::uint32_t> face_seen, cell_seen;
+    std::uint32_t stamp = 0;
+    std::vector<std::int64_t> faces, gradient_cells, update_cells, source_cells;
+    std::vector<std::int64_t> sink_faces;  // faces onto open edges or open cells
+    std::vector<double> available;         // bed: the sand a face may take
+    std::vector<std::uint8_t> moving_next;
+    std::vector<std::uint8_t> changed;     // dense: per cell, a face of it carried sand
+    bool flux_clean = true;
+    // The masks and edges sink_faces and source_cells were found for.
+    std::uint64_t masks_seen = 0, edges_seen = 0;
+    bool lists_current = false;
+};
+
+MeshScratch &scratch_of(Grid &grid) {
+    std::unique_ptr<EngineState> &state = grid.engine_state();
+    if (!state) state = std::make_unique<MeshScratch>();
+    return static_cast<MeshScratch &>(*state);
+}
+
+// One sub-step's view of the grid: what every pass reads.
+struct FaceLaw {
+    const Mesh &m;
+    const double *h;
+    const std::uint8_t *kind;
+    const double *gx, *gy;
+    const std::uint8_t *edge_open;  // per face; null: every edge as open_edges says
+    bool open_edges;
+    const double *edge_level;       // per face; null: 0
+    const double *tan_field;        // null: uniform
+    const std::uint8_t *moving;     // hysteresis: null when off
+    const double *available;        // bed: null when none
+    double nu, tan_theta, tolerance, tan_static, p, dt;
+    bool isotropic;
+
+    // The volume per unit time from a to b over face f, and its excess slope.
+    double operator()(std::int64_t f, double &excess) const {
+        const std::int64_t a = m.face_a[f], b = m.face_b[f];
+        const std::uint8_t ka = kind[a];
+        double hb, tangential = 0.0;
+        std::uint8_t kb;
+        if (b >= 0) {
+            kb = kind[b];
+            if (ka == kWall || kb == kWall || (ka != kSand && kb != kSand)) return 0.0;
+            hb = h[b];
+            if (isotropic)
+                tangential = 0.5 * ((gx[a] + gx[b]) * m.tangent_x[f] + (gy[a] + gy[b]) * m.tangent_y[f]);
+        } else {
+            if (ka != kSand || !(edge_open ? edge_open[f] != 0 : open_edges)) return 0.0;
+            kb = kOutside;
+            hb = edge_level ? edge_level[f] : 0.0;
+            if (isotropic) tangential = gx[a] * m.tangent_x[f] + gy[a] * m.tangent_y[f];
+        }
+        const double normal = (h[a] - hb) / m.distance[f];
+        double tan_face = tan_theta;
+        if (tan_field) {
+            const double ta = ka == kSand ? tan_field[a] : tan_field[b];
+            const double tb = kb == kSand ? tan_field[b] : ta;
+            tan_face = 0.5 * (ta + tb);
+        }
+        double threshold = tan_face * (1.0 + tolerance);
+        if (moving && !moving[a] && !(b >= 0 && moving[b])) threshold = std::max(threshold, tan_static);
+        const double s = std::sqrt(normal * normal + tangential * tangential);
+        if (!(s > threshold)) return 0.0;
+        const double abs_normal = std::fabs(normal);
+        if (!(abs_normal > tolerance * tan_face)) return 0.0;
+        // The flux across the face's normal, -nu f(s)/s grad h . L n, with
+        // grad h . e from the two points and grad h . t reconstructed, written
+        // as C (h_a - h_b): its factor C d / (nu f(s)/s) is held in [0, |L n|]
+        // (a face never carries sand up its two-point slope, nor more than
+        // the stable sub-step allows).
+        double factor = m.orthogonal[f];
+        if (m.skew[f] != 0.0) factor -= tangential * m.skew[f] / normal;
+        const double most = m.conductance[f] * m.distance[f];
+        factor = std::min(factor, most);
+        // The slope across the face. Near rest, a face nearly parallel to the
+        // slope (across it at most kMeshDeadZone tan(theta)) carries nothing
+        // unless its slope is clearly steep, and none carries sand with a
+        // slope across it below the rest tolerance (mesh_engine.hpp,
+        // docs/guarantees.md).
+        const double across = factor * abs_normal / most;
+        if (!(across > tolerance * tan_face)) return 0.0;
+        if (!(across > kMeshDeadZone * tan_face) && !(s > tan_face * (1.0 + kMeshNearRest))) return 0.0;
+        excess = s - tan_face;
+        double flux = slide_flux(nu, tan_face, s, p) / s * factor * normal;
+        if (available) {
+            // A face takes from its sand cell at most its share of the sand there.
+            const std::int64_t up = flux > 0.0 ? a : b;
+            if (up >= 0 && kind[up] == kSand) {
+                const double share = static_cast<double>(m.cell_face_start[up + 1] - m.cell_face_start[up]);
+                const double cap = available[up] * m.area[up] / (share * dt);
+                flux = flux > 0.0 ? std::min(flux, cap) : std::max(flux, -cap);
+            }
+        }
+        return flux;
+    }
+};
+
+void gradient_of(const Mesh &m, const double *h, const std::uint8_t *kind, std::int64_t c, double *gx, double *gy) {
+    double x = 0.0, y = 0.0;
+    const double hc = h[c];
+    for (std::int64_t k = m.grad_start[c]; k < m.grad_start[c + 1]; ++k) {
+        const std::int64_t n = m.grad_cells[k];
+        // A wall reads as the cell itself: no slope towards it.
+        if (kind[n] == kWall) continue;
+        const double dh = h[n] - hc;
+        x += m.grad_wx[k] * dh;
+        y += m.grad_wy[k] * dh;
+    }
+    gx[c] = x;
+    gy[c] = y;
+}
+
+// The net rate of cell c from its faces' fluxes, summed in the cell's face
+// order whichever faces a sub-step evaluated (the others carry 0).
+inline double net_rate(const Mesh &m, const double *flux, std::int64_t c) {
+    double rate = 0.0;
+    for (std::int64_t k = m.cell_face_start[c]; k < m.cell_face_start[c + 1]; ++k) {
+        const std::int64_t f = m.cell_faces[k];
+        rate += m.face_a[f] == c ? -flux[f] : flux[f];
+    }
+    return rate / m.area[c];
+}
+
+class MeshEngine final : public Engine {
+public:
+    double stable_dt(const Grid &grid) const override {
+        const double stiffness =
+            slide_flux_max_derivative(grid.mobility(), grid.min_repose_angle(), grid.flux_exponent());
+        return kMeshStepSafety * grid.geometry().mesh->step_scale / stiffness;
+    }
+
+    void prepare(Grid &grid) const override {
+        const Mesh &m = *grid.geometry().mesh;
+        MeshScratch &s = scratch_of(grid);
+        const std::size_t n = static_cast<std::size_t>(m.cells), nf = static_cast<std::size_t>(m.faces);
+        s.gx.resize(n, 0.0), s.gy.resize(n, 0.0);
+        if (s.flux.size() != nf) s.flux.assign(nf, 0.0);
+        s.face_seen.resize(nf, 0), s.cell_seen.resize(n, 0);
+        s.changed.resize(n, 0);
+        MeshActivity &act = grid.mesh_activity();
+        act.hot.resize(n, 0);
+        if (!grid.bed().empty()) s.available.resize(n, 0.0);
+        if (s.lists_current && s.masks_seen == grid.masks_version() && s.edges_seen == grid.edges_version()) return;
+        s.lists_current = true;
+        s.masks_seen = grid.masks_version();
+        s.edges_seen = grid.edges_version();
+        // Faces onto a sink: the outflow is summed over them alone, in one order.
+        s.sink_faces.clear();
+        const std::vector<std::uint8_t> &kind = grid.kinds();
+        for (std::int64_t f = 0; f < m.faces; ++f) {
+            const std::int64_t a = m.face_a[f], b = m.face_b[f];
+            if (b < 0 ? grid.edge_open(f) : (kind[a] == kOpen || kind[b] == kOpen)) s.sink_faces.push_back(f);
+        }
+        s.source_cells.clear();
+        const std::vector<double> &q = grid.source();
+        for (std::int64_t c = 0; c < static_cast<std::int64_t>(q.size()); ++c)
+            if (kind[c] == kSand && q[c] != 0.0) s.source_cells.push_back(c);
+    }
+
+    bool may_move(const Grid &grid) const override { return grid.mesh_activity().may_move(); }
+
+    // Every source cell takes its source at every sub-step and counts as driven.
+    bool drive_sources(Grid &, double, double, bool) const override { return true; }
+    void forget_driven(Grid &) const override {}
+
+    void advance(Grid &grid, const SubstepPlan &plan, const BookSubstep &book, StepInfo &info) const override {
+        const Mesh &m = *grid.geometry().mesh;
+        MeshScratch &s = scratch_of(grid);
+        const bool record = grid.records_face_fluxes();
+        if (record) std::fill(grid.face_fluxes().x.begin(), grid.face_fluxes().x.end(), 0.0);
+        if (!plan.something_may_move) {
+            info.at_rest = true;
+            return;
+        }
+        for (std::int64_t k = 0; k < plan.substeps; ++k) {
+            double visited = 0.0;
+            const SubstepSummary did = substep(grid, m, s, plan.sub_dt, record, visited);
+            info.cell_updates += visited;
+            if (!book(did)) break;
+        }
+    }
+
+    // Meshes relax by time-accurate sub-steps to rest: the stepper takes over.
+    bool relax_to_rest(Grid &, std::int64_t, double &cells_visited) const override {
+        cells_visited = 0.0;
+        return false;
+    }
+
+private:
+    SubstepSummary substep(Grid &grid, const Mesh &m, MeshScratch &s, double dt, bool record, double &visited) const {
+        MeshActivity &act = grid.mesh_activity();
+        const bool physics = grid.hysteresis() || !grid.bed().empty();
+        const bool dense = physics || act.all_hot || visit_all_cells() ||
+                           static_cast<double>(act.hot_list.size()) > kDenseShare * static_cast<double>(m.cells);
+        std::vector<double> &h = grid.heights_for_stepping();
+        std::vector<float> &residual = grid.residuals_for_stepping();
+        const std::vector<std::uint8_t> &kind = grid.kinds();
+        const std::vector<double> &q = grid.source();
+        SubstepSummary did;
+
+        FaceLaw law{m,
+                    h.data(),
+                    kind.data(),
+                    s.gx.data(),
+                    s.gy.data(),
+                    grid.edge_open_flags().empty() ? nullptr : grid.edge_open_flags().data(),
+                    grid.side_open(0),
+                    grid.side_levels(0).empty() ? nullptr : grid.side_levels(0).data(),
+                    grid.tan_field().empty() ? nullptr : grid.tan_field().data(),
+                    grid.hysteresis() ? grid.moving().data() : nullptr,
+                    nullptr,
+                    grid.mobility(),
+                    grid.tan_repose(),
+                    std::max(grid.rest_tolerance(), kMeshRestTolerance),
+                    grid.tan_static(),
+                    grid.flux_exponent(),
+                    dt,
+                    grid.scheme() == kIsotropic};
+        if (!grid.bed().empty()) {
+            prepare_bed(grid, m, s, dt, did);
+            law.available = s.available.data();
+        }
+        const int threads = thread_count(grid.threads());
+        double max_excess = 0.0;
+        bool moved = false;
+
+        if (dense) {
+            const std::int64_t n = m.cells, nf = m.faces;
+            const bool parallel = threads > 1 && n >= kCellsForThreads;
+            if (law.isotropic) {
+#pragma omp parallel for num_threads(threads) if (parallel) schedule(static)
+                for (std::int64_t c = 0; c < n; ++c) gradient_of(m, h.data(), kind.data(), c, s.gx.data(), s.gy.data());
+            }
+            double *flux = s.flux.data();
+#pragma omp parallel for num_threads(threads) if (parallel) schedule(static) reduction(max : max_excess) reduction(|| : moved)
+            for (std::int64_t f = 0; f < nf; ++f) {
+                double excess = 0.0;
+                const double v = law(f, excess);
+                flux[f] = v;
+                if (v != 0.0) {
+                    moved = true;
+                    max_excess = std::max(max_excess, excess);
+                }
+            }
+            s.flux_clean = false;
+            std::uint8_t *changed = s.changed.data();
+            const bool has_source = !q.empty();
+            const std::vector<double> &zb = grid.bed();
+            std::int64_t changed_cells = 0;
+#pragma omp parallel for num_threads(threads) if (parallel) schedule(static) reduction(+ : changed_cells)
+            for (std::int64_t c = 0; c < n; ++c) {
+                bool carried = false;
+                for (std::int64_t k = m.cell_face_start[c]; k < m.cell_face_start[c + 1]; ++k)
+                    carried = carried || flux[m.cell_faces[k]] != 0.0;
+                changed[c] = carried;
+                changed_cells += carried;
+                if (kind[c] != kSand) continue;
+                double rate = carried ? net_rate(m, flux, c) : 0.0;
+                if (has_source) rate += zb.empty() ? q[c] : source_applied(zb, h, q, c, dt);
+                if (rate != 0.0) add_with_residual(h[c], residual[c], dt * rate);
+                if (!zb.empty() && h[c] < zb[c]) {
+                    residual[c] = static_cast<float>(static_cast<double>(residual[c]) - (zb[c] - h[c]));
+                    h[c] = zb[c];
+                }
+            }
+            visited = static_cast<double>(n);
+            if (grid.hysteresis()) {
+                std::vector<std::uint8_t> &moving = grid.moving_for_stepping();
+                for (std::int64_t c = 0; c < n; ++c) moving[c] = kind[c] == kSand && changed[c];
+            }
+            // The next sub-step looks at the cells that changed and those whose
+            // gradients read them; where that is most of the mesh, at all.
+            const double reach = static_cast<double>(m.grad_cells.size()) / static_cast<double>(n) + 1.0;
+            const double woken = reach * static_cast<double>(changed_cells + static_cast<std::int64_t>(s.source_cells.size()));
+            if (woken > kDenseShare * static_cast<double>(n)) {
+                act.wake_all();
+            } else {
+                act.cool_all();
+                for (std::int64_t c = 0; c < n; ++c)
+                    if (changed[c]) act.wake_around(m, c);
+                for (const std::int64_t c : s.source_cells) act.wake_around(m, c);
+            }
+        } else {
+            // The faces of the hot cells, the cells whose gradients they read.
+            std::uint32_t stamp = next_stamp(s);
+            s.faces.clear();
+            s.gradient_cells.clear();
+            for (const std::int64_t c : act.hot_list)
+                for (std::int64_t k = m.cell_face_start[c]; k < m.cell_face_start[c + 1]; ++k) {
+                    const std::int64_t f = m.cell_faces[k];
+                    if (s.face_seen[f] == stamp) continue;
+                    s.face_seen[f] = stamp;
+                    s.faces.push_back(f);
+                    for (const std::int64_t e : {m.face_a[f], m.face_b[f]})
+                        if (e >= 0 && s.cell_seen[e] != stamp) {
+                            s.cell_seen[e] = stamp;
+                            s.gradient_cells.push_back(e);
+                        }
+                }
+            if (!s.flux_clean) {
+                std::fill(s.flux.begin(), s.flux.end(), 0.0);
+                s.flux_clean = true;
+            }
+            if (law.isotropic)
+                for (const std::int64_t c : s.gradient_cells) gradient_of(m, h.data(), kind.data(), c, s.gx.data(), s.gy.data());
+            // The cells to update: those of faces that carried sand, and the sources.
+            const std::uint32_t update_stamp = next_stamp(s);
+            s.update_cells.clear();
+            for (const std::int64_t f : s.faces) {
+                double excess = 0.0;
+                const double v = law(f, excess);
+                s.flux[f] = v;
+                if (v == 0.0) continue;
+                moved = true;
+                max_excess = std::max(max_excess, excess);
+                for (const std::int64_t e : {m.face_a[f], m.face_b[f]})
+                    if (e >= 0 && s.cell_seen[e] != update_stamp) {
+                        s.cell_seen[e] = update_stamp;
+                        s.update_cells.push_back(e);
+                    }
+            }
+            const std::size_t carried_cells = s.update_cells.size();
+            for (const std::int64_t c : s.source_cells)
+                if (s.cell_seen[c] != update_stamp) {
+                    s.cell_seen[c] = update_stamp;
+                    s.update_cells.push_back(c);
+                }
+            for (const std::int64_t c : s.update_cells) {
+                if (kind[c] != kSand) continue;
+                double rate = net_rate(m, s.flux.data(), c);
+                if (!q.empty()) rate += q[c];
+                if (rate != 0.0) add_with_residual(h[c], residual[c], dt * rate);
+            }
+            visited = static_cast<double>(s.gradient_cells.size() + s.update_cells.size() - carried_cells);
+            act.cool_all();
+            for (const std::int64_t c : s.update_cells) act.wake_around(m, c);
+        }
+        // What went into sinks, face by face in one order whatever the threads.
+        for (const std::int64_t f : s.sink_faces) {
+            const double v = s.flux[f];
+            if (v == 0.0) continue;
+            const std::int64_t a = m.face_a[f], b = m.face_b[f];
+            const double into_sink = b < 0 ? v * 1.0 : (kind[b] == kOpen ? v : -v);
+            did.outflow_rate += into_sink;
+            if (b < 0) did.side_outflow_rate[0] += v;
+            (void)a;
+        }
+        if (record) {
+            std::vector<double> &faces = grid.face_fluxes().x;
+            if (dense) {
+                for (std::int64_t f = 0; f < m.faces; ++f) faces[f] += s.flux[f] * dt;
+            } else {
+                for (const std::int64_t f : s.faces) faces[f] += s.flux[f] * dt;
+            }
+        }
+        if (!dense)
+            for (const std::int64_t f : s.faces) s.flux[f] = 0.0;
+        else
+            s.flux_clean = false;
+        did.moved = moved;
+        did.max_excess_slope = max_excess;
+        return did;
+    }
+
+    static std::uint32_t next_stamp(MeshScratch &s) {
+        if (++s.stamp == 0) {
+            std::fill(s.face_seen.begin(), s.face_seen.end(), 0);
+            std::fill(s.cell_seen.begin(), s.cell_seen.end(), 0);
+            s.stamp = 1;
+        }
+        return s.stamp;
+    }
+
+    // With a bed: the source a cell takes this sub-step (erosion at most the
+    // sand there), as prepare_bed found it.
+    static double source_applied(const std::vector<double> &zb, const std::vector<double> &h,
+                                 const std::vector<double> &q, std::int64_t c, double dt) {
+        const double asked = q[c] * dt;
+        if (asked >= 0.0) return q[c];
+        const double sand = std::max(0.0, h[c] - zb[c]);
+        return -std::min(-asked, sand) / dt;
+    }
+
+    // The sand above the bed that faces may take this sub-step, after the
+    // cell's own erosion; books what the source applied and what it could not.
+    static void prepare_bed(Grid &grid, const Mesh &m, MeshScratch &s, double dt, SubstepSummary &did) {
+        const std::vector<double> &zb = grid.bed(), &h = grid.heights(), &q = grid.source();
+        const std::vector<std::uint8_t> &kind = grid.kinds();
+        const double film = bed_film(grid);
+        CompensatedSum unmet, sourced;
+        for (std::int64_t c = 0; c < m.cells; ++c) {
+            if (kind[c] != kSand) {
+                s.available[c] = 0.0;
+                continue;
+            }
+            double sand = std::max(0.0, h[c] - zb[c]);
+            const double asked = q.empty() ? 0.0 : q[c] * dt;
+            double applied = asked;
+            if (asked < 0.0) {
+                applied = -std::min(-asked, sand);
+                unmet.add((applied - asked) * m.area[c]);
+                sand += applied;
+            }
+            sourced.add(applied * m.area[c]);
+            s.available[c] = sand > film ? sand : 0.0;
+        }
+        did.unmet_mass = unmet.value();
+        did.sourced_mass = sourced.value();
+    }
+};
+
+}  // namespace
+
+const Engine &mesh_engine() {
+    static const MeshEngine engine;
+    return engine;
+}
+
+}  // namespace dpsm

@@ -1,0 +1,618 @@
+/* Unstructured meshes (issue 18): the three constructors with their normal
+ * and bad inputs, the functions of dpsm.h on a mesh, and the numerics:
+ *
+ *  - a mesh keeps the host's cell order whatever order the library keeps
+ *    inside: the same mesh given in another order gives the same heights,
+ *    cell by cell, bit for bit;
+ *  - a graph of the cells of a polygon mesh steps as the polygons do;
+ *  - exact states: a plane below the angle of repose does not move, a flat
+ *    surface under a uniform source rises by q dt everywhere;
+ *  - the column collapse conserves mass to round-off, makes no new extremum,
+ *    and comes to rest;
+ *  - the active set changes no bit (DPSM_VISIT_ALL_CELLS=1 visits every cell);
+ *  - face fluxes add up to each cell's change of height, and the edge's faces
+ *    to the outflow. */
+#include <math.h>
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include <cmocka.h>
+
+#include "mesh_scenes.h"
+#include "test_support.h"
+
+static const double kDeg = 3.14159265358979323846 / 180.0;
+
+/* A failed create: the status, *out left NULL, and a message naming `what`. */
+#define EXPECT_CREATE_FAIL(call, out, code, fn, what)                                                               \
+    do {                                                                                                            \
+        (out) = (dpsm_grid *)&(out);                                                                                \
+        const int status_ = (call);                                                                                 \
+        REQUIRE(status_ == (code), "%s returned %s, expected %s (%s)", #call, dpsm_status_string(status_),          \
+                dpsm_status_string(code), dpsm_last_error(NULL));                                                   \
+        REQUIRE((out) == NULL, "%s left *out set", #call);                                                          \
+        REQUIRE(strstr(dpsm_last_error(NULL), (fn)) != NULL, "message '%s' does not name %s", dpsm_last_error(NULL), \
+                (fn));                                                                                              \
+        REQUIRE(strstr(dpsm_last_error(NULL), (what)) != NULL, "message '%s' does not name '%s'",                   \
+                dpsm_last_error(NULL), (what));                                                                     \
+    } while (0)
+
+/* A failed call on a mesh: the status and a message naming `what`. */
+#define EXPECT_FAIL_ON(g, call, code, what)                                                                   \
+    do {                                                                                                      \
+        const int status_ = (call);                                                                           \
+        REQUIRE(status_ == (code), "%s returned %s, expected %s (%s)", #call, dpsm_status_string(status_),    \
+                dpsm_status_string(code), dpsm_last_error(g));                                                \
+        REQUIRE(strstr(dpsm_last_error(g), (what)) != NULL, "message '%s' does not name '%s'", dpsm_last_error(g), \
+                (what));                                                                                      \
+    } while (0)
+
+/* A 2 x 2 square of unit quads: nodes 0..8 row by row. */
+static const double kQuadNodes[18] = {0, 0, 1, 0, 2, 0, 0, 1, 1, 1, 2, 1, 0, 2, 1, 2, 2, 2};
+static const int64_t kQuadStart[5] = {0, 4, 8, 12, 16};
+static const int64_t kQuadCells[16] = {0, 1, 4, 3, 1, 2, 5, 4, 3, 4, 7, 6, 4, 5, 8, 7};
+
+static double *column_heights(const mesh_scene *s, double radius, double height) {
+    double *h = calloc((size_t)s->cells, sizeof(double));
+    scene_disk_fractions(s, radius, h);
+    for (int64_t c = 0; c < s->cells; ++c) h[c] *= height;
+    return h;
+}
+
+/* ------------------------------------------------------------------------ */
+/* Constructors                                                              */
+/* ------------------------------------------------------------------------ */
+
+static void test_create_mesh_quads(void **state) {
+    (void)state;
+    dpsm_grid *g = NULL;
+    CHECK_OK(NULL, dpsm_create_mesh(9, kQuadNodes, 4, kQuadStart, kQuadCells, &g));
+    int64_t nx = 0, ny = 0, nfaces = 0;
+    CHECK_OK(g, dpsm_get_shape(g, &nx, &ny));
+    REQUIRE(nx == 4 && ny == 1, "shape (%lld, %lld), expected (4, 1)", (long long)nx, (long long)ny);
+    CHECK_OK(g, dpsm_get_face_count(g, &nfaces));
+    REQUIRE(nfaces == 12, "%lld faces, expected 4 interior and 8 on the edge", (long long)nfaces);
+    int64_t faces[24];
+    CHECK_OK(g, dpsm_get_mesh_faces(g, faces));
+    int interior = 0, edge = 0;
+    for (int f = 0; f < 12; ++f) {
+        REQUIRE(faces[2 * f] >= 0 && faces[2 * f] < 4, "face %d: a = %lld", f, (long long)faces[2 * f]);
+        if (faces[2 * f + 1] < 0) {
+            ++edge;
+            continue;
+        }
+        ++interior;
+        /* the two cells of an interior face are neighbours of the 2 x 2 square: they differ in one coordinate */
+        const int64_t a = faces[2 * f], b = faces[2 * f + 1];
+        REQUIRE((a % 2 == b % 2) != (a / 2 == b / 2), "face %d joins cells %lld and %lld, not neighbours", f,
+                (long long)a, (long long)b);
+        /* the host's order: faces appear cell by cell, so a face's a is the first cell that has it */
+        REQUIRE(a < b, "face %d: a = %lld after b = %lld", f, (long long)a, (long long)b);
+    }
+    REQUIRE(interior == 4 && edge == 8, "%d interior and %d edge faces", interior, edge);
+    /* The faces are numbered as they first appear: cell 0's four first. */
+    for (int f = 0; f < 4; ++f) REQUIRE(faces[2 * f] == 0, "face %d belongs to cell %lld, not 0", f, (long long)faces[2 * f]);
+    dpsm_destroy(g);
+}
+
+static void test_create_graph_and_dual(void **state) {
+    (void)state;
+    /* Two unit squares side by side as a graph: 1 interior face, 6 edges. */
+    const double cell_xy[4] = {0.5, 0.5, 1.5, 0.5}, area[2] = {1, 1};
+    const int64_t face_cells[14] = {0, 1, 0, -1, 0, -1, 0, -1, 1, -1, 1, -1, 1, -1};
+    const double face_xy[14] = {1, 0.5, 0, 0.5, 0.5, 0, 0.5, 1, 2, 0.5, 1.5, 0, 1.5, 1};
+    const double length[7] = {1, 1, 1, 1, 1, 1, 1};
+    dpsm_grid *g = NULL;
+    CHECK_OK(NULL, dpsm_create_graph(2, cell_xy, area, 7, face_cells, face_xy, length, &g));
+    int64_t nx = 0, ny = 0, nfaces = 0, got[14];
+    CHECK_OK(g, dpsm_get_shape(g, &nx, &ny));
+    REQUIRE(nx == 2 && ny == 1, "graph shape (%lld, %lld)", (long long)nx, (long long)ny);
+    CHECK_OK(g, dpsm_get_face_count(g, &nfaces));
+    REQUIRE(nfaces == 7, "%lld faces", (long long)nfaces);
+    CHECK_OK(g, dpsm_get_mesh_faces(g, got));
+    REQUIRE(memcmp(got, face_cells, sizeof got) == 0, "a graph's faces come back as the host gave them");
+    dpsm_destroy(g);
+
+    /* The dual of two triangles over 4 nodes: a cell per node, 5 edges and 4 boundary edges in halves. */
+    const double nodes[8] = {0, 0, 1, 0, 1, 1, 0, 1};
+    const int64_t tris[6] = {0, 1, 2, 0, 2, 3};
+    CHECK_OK(NULL, dpsm_create_dual_mesh(4, nodes, 2, tris, &g));
+    CHECK_OK(g, dpsm_get_shape(g, &nx, &ny));
+    REQUIRE(nx == 4, "the dual has one cell per node, not %lld", (long long)nx);
+    CHECK_OK(g, dpsm_get_face_count(g, &nfaces));
+    REQUIRE(nfaces == 13, "the dual has %lld faces, expected 5 + 8", (long long)nfaces);
+    /* The areas are a third of each node's triangles: a uniform height of 1 has the square's volume. */
+    const double ones[4] = {1, 1, 1, 1};
+    CHECK_OK(g, dpsm_set_heights(g, ones));
+    REQUIRE(fabs(mass_of(g, DPSM_MASS_TOTAL) - 1.0) < 1e-15, "the dual's cells cover the square: volume %.17g",
+            mass_of(g, DPSM_MASS_TOTAL));
+    dpsm_destroy(g);
+}
+
+static void test_bad_meshes(void **state) {
+    (void)state;
+    dpsm_grid *g = NULL;
+    const char *fn = "dpsm_create_mesh";
+    EXPECT_CREATE_FAIL(dpsm_create_mesh(9, NULL, 4, kQuadStart, kQuadCells, &g), g, DPSM_ERR_NULL_POINTER, fn, "node_xy");
+    EXPECT_CREATE_FAIL(dpsm_create_mesh(9, kQuadNodes, 4, NULL, kQuadCells, &g), g, DPSM_ERR_NULL_POINTER, fn, "cell_start");
+    EXPECT_CREATE_FAIL(dpsm_create_mesh(9, kQuadNodes, 4, kQuadStart, NULL, &g), g, DPSM_ERR_NULL_POINTER, fn, "cell_nodes");
+    REQUIRE(dpsm_create_mesh(9, kQuadNodes, 4, kQuadStart, kQuadCells, NULL) == DPSM_ERR_NULL_POINTER, "out NULL");
+    EXPECT_CREATE_FAIL(dpsm_create_mesh(0, kQuadNodes, 4, kQuadStart, kQuadCells, &g), g, DPSM_ERR_INVALID_SIZE, fn, "nnodes");
+    EXPECT_CREATE_FAIL(dpsm_create_mesh(9, kQuadNodes, 0, kQuadStart, kQuadCells, &g), g, DPSM_ERR_INVALID_SIZE, fn, "ncells");
+    int64_t cells[16];
+    memcpy(cells, kQuadCells, sizeof cells);
+    cells[6] = 9; /* cell 1's third node */
+    EXPECT_CREATE_FAIL(dpsm_create_mesh(9, kQuadNodes, 4, kQuadStart, cells, &g), g, DPSM_ERR_INVALID_VALUE, fn, "cell_nodes[6]");
+    memcpy(cells, kQuadCells, sizeof cells);
+    cells[9] = 3, cells[10] = 4; /* cell 2 becomes 3, 3, 4, 6 ... with a repeated node in a row */
+    EXPECT_CREATE_FAIL(dpsm_create_mesh(9, kQuadNodes, 4, kQuadStart, cells, &g), g, DPSM_ERR_INVALID_VALUE, fn, "cell 2");
+    /* fewer than 3 distinct nodes */
+    const int64_t start2[2] = {0, 4};
+    const int64_t two[4] = {0, 1, 0, 1};
+    EXPECT_CREATE_FAIL(dpsm_create_mesh(9, kQuadNodes, 1, start2, two, &g), g, DPSM_ERR_INVALID_VALUE, fn,
+                       "fewer than 3 distinct");
+    /* zero area: three nodes on a line */
+    const int64_t start3[2] = {0, 3};
+    const int64_t line[3] = {0, 1, 2};
+    EXPECT_CREATE_FAIL(dpsm_create_mesh(9, kQuadNodes, 1, start3, line, &g), g, DPSM_ERR_INVALID_VALUE, fn, "zero area");
+    /* an edge shared by three cells: three triangles on the edge 0-1 */
+    const double fan[8] = {0, 0, 1, 0, 0.5, 1, 0.5, -1};
+    const int64_t fan_start[4] = {0, 3, 6, 9};
+    const int64_t fan_cells[9] = {0, 1, 2, 0, 1, 3, 1, 0, 2};
+    EXPECT_CREATE_FAIL(dpsm_create_mesh(4, fan, 3, fan_start, fan_cells, &g), g, DPSM_ERR_INVALID_VALUE, fn,
+                       "shared by 3 cells");
+    double bad_nodes[18];
+    memcpy(bad_nodes, kQuadNodes, sizeof bad_nodes);
+    bad_nodes[7] = NAN; /* y of node 3 */
+    EXPECT_CREATE_FAIL(dpsm_create_mesh(9, bad_nodes, 4, kQuadStart, kQuadCells, &g), g, DPSM_ERR_INVALID_VALUE, fn, "node 3");
+    int64_t bad_start[5] = {1, 4, 8, 12, 16};
+    EXPECT_CREATE_FAIL(dpsm_create_mesh(9, kQuadNodes, 4, bad_start, kQuadCells, &g), g, DPSM_ERR_INVALID_VALUE, fn,
+                       "cell_start[0]");
+
+    fn = "dpsm_create_graph";
+    const double cell_xy[4] = {0.5, 0.5, 1.5, 0.5}, area[2] = {1, 1};
+    int64_t face_cells[14] = {0, 1, 0, -1, 0, -1, 0, -1, 1, -1, 1, -1, 1, -1};
+    const double face_xy[14] = {1, 0.5, 0, 0.5, 0.5, 0, 0.5, 1, 2, 0.5, 1.5, 0, 1.5, 1};
+    double length[7] = {1, 1, 1, 1, 1, 1, 1};
+    face_cells[9] = 2;
+    EXPECT_CREATE_FAIL(dpsm_create_graph(2, cell_xy, area, 7, face_cells, face_xy, length, &g), g, DPSM_ERR_INVALID_VALUE,
+                       fn, "face 4");
+    face_cells[9] = -1, face_cells[1] = 0;
+    EXPECT_CREATE_FAIL(dpsm_create_graph(2, cell_xy, area, 7, face_cells, face_xy, length, &g), g, DPSM_ERR_INVALID_VALUE,
+                       fn, "to itself");
+    face_cells[1] = 1;
+    const double same_xy[4] = {0.5, 0.5, 0.5, 0.5};
+    EXPECT_CREATE_FAIL(dpsm_create_graph(2, same_xy, area, 7, face_cells, face_xy, length, &g), g,
+                       DPSM_ERR_INVALID_VALUE, fn, "coincide");
+    const double no_area[2] = {1, 0};
+    EXPECT_CREATE_FAIL(dpsm_create_graph(2, cell_xy, no_area, 7, face_cells, face_xy, length, &g), g,
+                       DPSM_ERR_INVALID_VALUE, fn, "cell 1");
+    length[3] = -1;
+    EXPECT_CREATE_FAIL(dpsm_create_graph(2, cell_xy, area, 7, face_cells, face_xy, length, &g), g, DPSM_ERR_INVALID_VALUE,
+                       fn, "face_length[3]");
+    length[3] = 1;
+    /* cell 1 without its faces on the right: not closed */
+    EXPECT_CREATE_FAIL(dpsm_create_graph(2, cell_xy, area, 4, face_cells, face_xy, length, &g), g, DPSM_ERR_INVALID_VALUE,
+                       fn, "do not close");
+    EXPECT_CREATE_FAIL(dpsm_create_graph(2, cell_xy, area, 7, NULL, face_xy, length, &g), g, DPSM_ERR_NULL_POINTER, fn,
+                       "face_cells");
+
+    fn = "dpsm_create_dual_mesh";
+    const double nodes[10] = {0, 0, 1, 0, 1, 1, 0, 1, 5, 5};
+    const int64_t tris[6] = {0, 1, 2, 0, 2, 3};
+    EXPECT_CREATE_FAIL(dpsm_create_dual_mesh(5, nodes, 2, tris, &g), g, DPSM_ERR_INVALID_VALUE, fn, "node 4");
+    const int64_t flat[3] = {0, 1, 1};
+    EXPECT_CREATE_FAIL(dpsm_create_dual_mesh(4, nodes, 1, flat, &g), g, DPSM_ERR_INVALID_VALUE, fn, "triangle 0");
+    const int64_t out_of_range[6] = {0, 1, 2, 0, 2, 7};
+    EXPECT_CREATE_FAIL(dpsm_create_dual_mesh(4, nodes, 2, out_of_range, &g), g, DPSM_ERR_INVALID_VALUE, fn,
+                       "triangle_nodes[5]");
+    EXPECT_CREATE_FAIL(dpsm_create_dual_mesh(4, NULL, 2, tris, &g), g, DPSM_ERR_NULL_POINTER, fn, "node_xy");
+}
+
+/* ------------------------------------------------------------------------ */
+/* The functions of dpsm.h on a mesh                                         */
+/* ------------------------------------------------------------------------ */
+
+static void test_mesh_functions(void **state) {
+    (void)state;
+    dpsm_grid *g = NULL;
+    CHECK_OK(NULL, dpsm_create_mesh(9, kQuadNodes, 4, kQuadStart, kQuadCells, &g));
+    double h[4] = {1, 2, 3, 4};
+    EXPECT_FAIL_ON(g, dpsm_set_heights_region(g, 0, 0, 1, 1, h), DPSM_ERR_NOT_APPLICABLE, "mesh");
+    EXPECT_FAIL_ON(g, dpsm_add_heights_region(g, 0, 0, 1, 1, h), DPSM_ERR_NOT_APPLICABLE, "mesh");
+    EXPECT_FAIL_ON(g, dpsm_get_heights_region(g, 0, 0, 1, 1, h), DPSM_ERR_NOT_APPLICABLE, "mesh");
+    EXPECT_FAIL_ON(g, dpsm_set_boundary(g, DPSM_XMIN, DPSM_OPEN), DPSM_ERR_NOT_APPLICABLE, "DPSM_MESH_EDGE");
+    CHECK_OK(g, dpsm_set_boundary(g, DPSM_MESH_EDGE, DPSM_OPEN));
+    double bad[4] = {1, 2, NAN, 4};
+    EXPECT_FAIL_ON(g, dpsm_set_heights(g, bad), DPSM_ERR_INVALID_VALUE, "cell 2");
+    uint8_t kinds[4] = {0, 0, 7, 0};
+    EXPECT_FAIL_ON(g, dpsm_set_cell_kinds(g, kinds), DPSM_ERR_UNKNOWN_ENUM, "cell 2");
+    uint8_t edges[12];
+    memset(edges, DPSM_WALL, sizeof edges);
+    int64_t faces[24];
+    CHECK_OK(g, dpsm_get_mesh_faces(g, faces));
+    int64_t an_edge = -1, an_interior = -1;
+    for (int f = 0; f < 12; ++f) {
+        if (faces[2 * f + 1] < 0 && an_edge < 0) an_edge = f;
+        if (faces[2 * f + 1] >= 0 && an_interior < 0) an_interior = f;
+    }
+    edges[an_interior] = 99; /* ignored: not on the edge */
+    CHECK_OK(g, dpsm_set_edge_kinds(g, edges));
+    edges[an_edge] = 5;
+    char face_name[32];
+    snprintf(face_name, sizeof face_name, "face %lld", (long long)an_edge);
+    EXPECT_FAIL_ON(g, dpsm_set_edge_kinds(g, edges), DPSM_ERR_UNKNOWN_ENUM, face_name);
+    CHECK_OK(g, dpsm_set_edge_kinds(g, NULL));
+    double fy[4];
+    CHECK_OK(g, dpsm_set_face_flux_recording(g, 1));
+    double fx[12];
+    EXPECT_FAIL_ON(g, dpsm_get_face_fluxes(g, fx, fy), DPSM_ERR_INVALID_VALUE, "fy must be NULL");
+    CHECK_OK(g, dpsm_get_face_fluxes(g, fx, NULL));
+    double levels[12] = {0};
+    levels[an_edge] = INFINITY;
+    EXPECT_FAIL_ON(g, dpsm_set_side_levels(g, DPSM_MESH_EDGE, levels), DPSM_ERR_INVALID_VALUE, face_name);
+    EXPECT_FAIL_ON(g, dpsm_set_side_levels(g, DPSM_XMAX, levels), DPSM_ERR_NOT_APPLICABLE, "DPSM_MESH_EDGE");
+    double v = 0.0;
+    CHECK_OK(g, dpsm_get_side_outflow(g, DPSM_MESH_EDGE, &v));
+    dpsm_destroy(g);
+
+    /* The mesh functions on a grid. */
+    CHECK_OK(NULL, dpsm_create_2d(4, 4, 1.0, 1.0, &g));
+    int64_t n = 0;
+    EXPECT_FAIL_ON(g, dpsm_get_face_count(g, &n), DPSM_ERR_NOT_APPLICABLE, "not a mesh");
+    EXPECT_FAIL_ON(g, dpsm_get_mesh_faces(g, faces), DPSM_ERR_NOT_APPLICABLE, "not a mesh");
+    EXPECT_FAIL_ON(g, dpsm_set_edge_kinds(g, edges), DPSM_ERR_NOT_APPLICABLE, "not a mesh");
+    dpsm_destroy(g);
+    REQUIRE(dpsm_get_face_count(NULL, &n) == DPSM_ERR_NULL_POINTER, "NULL grid");
+    REQUIRE(dpsm_get_mesh_faces(NULL, faces) == DPSM_ERR_NULL_POINTER, "NULL grid");
+    REQUIRE(dpsm_set_edge_kinds(NULL, edges) == DPSM_ERR_NULL_POINTER, "NULL grid");
+}
+
+/* ------------------------------------------------------------------------ */
+/* Numerics                                                                  */
+/* ------------------------------------------------------------------------ */
+
+static dpsm_grid *column_mesh(const mesh_scene *s, int open) {
+    dpsm_grid *g = NULL;
+    CHECK_OK(NULL, scene_create(s, &g));
+    CHECK_OK(g, dpsm_set_repose_angle(g, 30.0 * kDeg));
+    if (open) CHECK_OK(g, dpsm_set_boundary(g, DPSM_MESH_EDGE, DPSM_OPEN));
+    double *h = column_heights(s, 1.0, 0.5);
+    CHECK_OK(g, dpsm_set_heights(g, h));
+    free(h);
+    return g;
+}
+
+static void test_column_rests_with_mass_and_bounds(void **state) {
+    (void)state;
+    const scene_kind kinds[4] = {SCENE_QUADS, SCENE_TRIANGLES, SCENE_HEXAGONS, SCENE_DUAL};
+    for (int k = 0; k < 4; ++k) {
+        mesh_scene s = scene_make(kinds[k], 24, 2.5, 7u);
+        dpsm_grid *g = column_mesh(&s, 0);
+        const double before = mass_of(g, DPSM_MASS_TOTAL);
+        int rested = 0;
+        double *h = calloc((size_t)s.cells, sizeof(double));
+        for (int call = 0; call < 200 && !rested; ++call) {
+            CHECK_OK(g, dpsm_step(g, 0.05));
+            rested = step_info_of(g, DPSM_INFO_AT_REST) > 0.0;
+            CHECK_OK(g, dpsm_get_heights(g, h));
+            REQUIRE(max_of(h, (size_t)s.cells) <= 0.5 && min_of(h, (size_t)s.cells) >= 0.0,
+                    "%s: a new extremum: heights in [%.17g, %.17g]", scene_name(kinds[k]), min_of(h, (size_t)s.cells),
+                    max_of(h, (size_t)s.cells));
+        }
+        REQUIRE(rested, "%s: the column collapse did not rest within t = 10", scene_name(kinds[k]));
+        const double after = mass_of(g, DPSM_MASS_TOTAL);
+        REQUIRE(fabs(after - before) <= 1e-13 * before, "%s: mass %.17g became %.17g", scene_name(kinds[k]), before,
+                after);
+        REQUIRE(ledger_residual(g) < 1e-13, "%s: the ledger does not close: %g", scene_name(kinds[k]), ledger_residual(g));
+        /* at rest, a later step changes nothing */
+        double *again = calloc((size_t)s.cells, sizeof(double));
+        CHECK_OK(g, dpsm_step(g, 1.0));
+        CHECK_OK(g, dpsm_get_heights(g, again));
+        REQUIRE(memcmp(h, again, sizeof(double) * (size_t)s.cells) == 0, "%s: a step at rest moved sand",
+                scene_name(kinds[k]));
+        REQUIRE(step_info_of(g, DPSM_INFO_CELL_UPDATES) == 0.0, "%s: a step at rest visited %g cells",
+                scene_name(kinds[k]), step_info_of(g, DPSM_INFO_CELL_UPDATES));
+        free(again);
+        free(h);
+        dpsm_destroy(g);
+        scene_free(&s);
+    }
+}
+
+static void test_exact_states(void **state) {
+    (void)state;
+    mesh_scene s = scene_make(SCENE_TRIANGLES, 16, 1.0, 3u);
+    dpsm_grid *g = NULL;
+    CHECK_OK(NULL, scene_create(&s, &g));
+    CHECK_OK(g, dpsm_set_repose_angle(g, 30.0 * kDeg));
+    /* A plane at 0.9 tan(theta) in a direction of no face in particular. */
+    double *h = calloc((size_t)s.cells, sizeof(double)), *after = calloc((size_t)s.cells, sizeof(double));
+    const double slope = 0.9 * tan(30.0 * kDeg);
+    for (int64_t c = 0; c < s.cells; ++c) h[c] = 2.0 + slope * (0.6 * s.cx[c] + 0.8 * s.cy[c]);
+    CHECK_OK(g, dpsm_set_heights(g, h));
+    CHECK_OK(g, dpsm_step(g, 1.0));
+    CHECK_OK(g, dpsm_get_heights(g, after));
+    REQUIRE(memcmp(h, after, sizeof(double) * (size_t)s.cells) == 0, "a plane below the angle of repose moved");
+    REQUIRE(step_info_of(g, DPSM_INFO_AT_REST) > 0.0, "a plane below the angle of repose is not at rest");
+    /* A flat surface under a uniform source rises by q dt everywhere. */
+    double *q = calloc((size_t)s.cells, sizeof(double)), *flat = calloc((size_t)s.cells, sizeof(double));
+    for (int64_t c = 0; c < s.cells; ++c) q[c] = 0.25, flat[c] = 1.0;
+    CHECK_OK(g, dpsm_set_heights(g, flat));
+    CHECK_OK(g, dpsm_set_source(g, q));
+    CHECK_OK(g, dpsm_step(g, 2.0));
+    CHECK_OK(g, dpsm_get_heights(g, after));
+    for (int64_t c = 0; c < s.cells; ++c)
+        REQUIRE(fabs(after[c] - 1.5) < 1e-14, "cell %lld: %.17g after a uniform source of 0.25 over 2, expected 1.5",
+                (long long)c, after[c]);
+    REQUIRE(ledger_residual(g) < 1e-14, "ledger %g", ledger_residual(g));
+    free(q), free(flat), free(h), free(after);
+    dpsm_destroy(g);
+    scene_free(&s);
+}
+
+/* The same mesh with its cells given in reverse order steps to the same heights, cell by cell. */
+static void test_host_order(void **state) {
+    (void)state;
+    mesh_scene s = scene_make(SCENE_TRIANGLES, 20, 2.5, 11u);
+    const int64_t n = s.cells;
+    int64_t *start = calloc((size_t)n + 1, sizeof(int64_t)), *nodes = calloc((size_t)s.cell_start[n], sizeof(int64_t));
+    int64_t k = 0;
+    for (int64_t c = 0; c < n; ++c) {
+        const int64_t from = n - 1 - c;
+        start[c] = k;
+        /* and each cell's nodes turned the other way */
+        for (int64_t v = s.cell_start[from + 1] - 1; v >= s.cell_start[from]; --v) nodes[k++] = s.cell_nodes[v];
+    }
+    start[n] = k;
+    double *h = column_heights(&s, 1.0, 0.5), *reversed = calloc((size_t)n, sizeof(double));
+    for (int64_t c = 0; c < n; ++c) reversed[c] = h[n - 1 - c];
+    dpsm_grid *a = NULL, *b = NULL;
+    CHECK_OK(NULL, dpsm_create_mesh(s.nnodes, s.node_xy, n, s.cell_start, s.cell_nodes, &a));
+    CHECK_OK(NULL, dpsm_create_mesh(s.nnodes, s.node_xy, n, start, nodes, &b));
+    CHECK_OK(a, dpsm_set_repose_angle(a, 30.0 * kDeg));
+    CHECK_OK(b, dpsm_set_repose_angle(b, 30.0 * kDeg));
+    CHECK_OK(a, dpsm_set_heights(a, h));
+    CHECK_OK(b, dpsm_set_heights(b, reversed));
+    for (int call = 0; call < 5; ++call) {
+        CHECK_OK(a, dpsm_step(a, 0.1));
+        CHECK_OK(b, dpsm_step(b, 0.1));
+    }
+    CHECK_OK(a, dpsm_get_heights(a, h));
+    CHECK_OK(b, dpsm_get_heights(b, reversed));
+    for (int64_t c = 0; c < n; ++c)
+        REQUIRE(fabs(h[c] - reversed[n - 1 - c]) <= 1e-12, "cell %lld: %.17g against %.17g given in reverse order",
+                (long long)c, h[c], reversed[n - 1 - c]);
+    free(start), free(nodes), free(h), free(reversed);
+    dpsm_destroy(a), dpsm_destroy(b);
+    scene_free(&s);
+}
+
+/* The cells of a quad mesh as a graph (built here from the lattice: x faces,
+ * y faces, the four sides) step as the polygons do. */
+static void test_graph_steps_as_polygons(void **state) {
+    (void)state;
+    const int n = 20;
+    const double half = 2.5, dx = 2.0 * half / n;
+    mesh_scene s = scene_make(SCENE_QUADS, n, half, 1u);
+    const int64_t nfaces = 2 * (int64_t)(n + 1) * n;
+    int64_t *face_cells = calloc((size_t)(2 * nfaces), sizeof(int64_t));
+    double *face_xy = calloc((size_t)(2 * nfaces), sizeof(double)), *length = calloc((size_t)nfaces, sizeof(double));
+    double *cell_xy = calloc((size_t)(2 * s.cells), sizeof(double));
+    for (int64_t c = 0; c < s.cells; ++c) cell_xy[2 * c] = -half + (c % n + 0.5) * dx, cell_xy[2 * c + 1] = -half + (c / n + 0.5) * dx;
+    int64_t f = 0;
+    for (int j = 0; j < n; ++j)
+        for (int i = 0; i <= n; ++i, ++f) { /* the face on the low x side of cell (i, j) */
+            const int64_t left = i > 0 ? (i - 1) + (int64_t)n * j : -1, right = i < n ? i + (int64_t)n * j : -1;
+            face_cells[2 * f] = left >= 0 ? left : right;
+            face_cells[2 * f + 1] = left >= 0 ? right : -1;
+            face_xy[2 * f] = -half + i * dx, face_xy[2 * f + 1] = -half + (j + 0.5) * dx, length[f] = dx;
+        }
+    for (int j = 0; j <= n; ++j)
+        for (int i = 0; i < n; ++i, ++f) {
+            const int64_t below = j > 0 ? i + (int64_t)n * (j - 1) : -1, above = j < n ? i + (int64_t)n * j : -1;
+            face_cells[2 * f] = below >= 0 ? below : above;
+            face_cells[2 * f + 1] = below >= 0 ? above : -1;
+            face_xy[2 * f] = -half + (i + 0.5) * dx, face_xy[2 * f + 1] = -half + j * dx, length[f] = dx;
+        }
+    dpsm_grid *poly = NULL, *graph = NULL;
+    CHECK_OK(NULL, scene_create(&s, &poly));
+    CHECK_OK(NULL, dpsm_create_graph(s.cells, cell_xy, s.area, nfaces, face_cells, face_xy, length, &graph));
+    double *h = column_heights(&s, 1.0, 0.5), *hg = calloc((size_t)s.cells, sizeof(double));
+    dpsm_grid *both[2] = {poly, graph};
+    for (int k = 0; k < 2; ++k) {
+        CHECK_OK(both[k], dpsm_set_repose_angle(both[k], 30.0 * kDeg));
+        CHECK_OK(both[k], dpsm_set_boundary(both[k], DPSM_MESH_EDGE, DPSM_OPEN));
+        CHECK_OK(both[k], dpsm_set_heights(both[k], h));
+        for (int call = 0; call < 10; ++call) CHECK_OK(both[k], dpsm_step(both[k], 0.1));
+    }
+    CHECK_OK(poly, dpsm_get_heights(poly, h));
+    CHECK_OK(graph, dpsm_get_heights(graph, hg));
+    for (int64_t c = 0; c < s.cells; ++c)
+        REQUIRE(fabs(h[c] - hg[c]) <= 1e-12, "cell %lld: polygons %.17g, graph %.17g", (long long)c, h[c], hg[c]);
+    REQUIRE(fabs(mass_of(poly, DPSM_MASS_OUTFLOW) - mass_of(graph, DPSM_MASS_OUTFLOW)) <= 1e-12,
+            "outflow: polygons %.17g, graph %.17g", mass_of(poly, DPSM_MASS_OUTFLOW), mass_of(graph, DPSM_MASS_OUTFLOW));
+    free(face_cells), free(face_xy), free(length), free(cell_xy), free(h), free(hg);
+    dpsm_destroy(poly), dpsm_destroy(graph);
+    scene_free(&s);
+}
+
+/* A pile and a source on a corner, stepped with the active set and with every cell visited. */
+static void run_active_scene(const mesh_scene *s, double *h_out, double *ledger_out) {
+    dpsm_grid *g = column_mesh(s, 1);
+    double *q = calloc((size_t)s->cells, sizeof(double));
+    for (int64_t c = 0; c < s->cells; ++c)
+        if (s->cx[c] > 1.8 && s->cy[c] > 1.8) q[c] = 0.3;
+    for (int call = 0; call < 12; ++call) {
+        if (call == 6) CHECK_OK(g, dpsm_set_source(g, q));
+        CHECK_OK(g, dpsm_step(g, 0.07));
+    }
+    CHECK_OK(g, dpsm_get_heights(g, h_out));
+    ledger_out[0] = mass_of(g, DPSM_MASS_TOTAL);
+    ledger_out[1] = mass_of(g, DPSM_MASS_OUTFLOW);
+    ledger_out[2] = mass_of(g, DPSM_MASS_SOURCED);
+    free(q);
+    dpsm_destroy(g);
+}
+
+static void test_active_set_same_bits(void **state) {
+    (void)state;
+    const scene_kind kinds[2] = {SCENE_TRIANGLES, SCENE_DUAL};
+    for (int k = 0; k < 2; ++k) {
+        mesh_scene s = scene_make(kinds[k], 40, 2.5, 5u);
+        double *a = calloc((size_t)s.cells, sizeof(double)), *b = calloc((size_t)s.cells, sizeof(double));
+        double la[3], lb[3];
+        run_active_scene(&s, a, la);
+        setenv("DPSM_VISIT_ALL_CELLS", "1", 1);
+        run_active_scene(&s, b, lb);
+        unsetenv("DPSM_VISIT_ALL_CELLS");
+        for (int64_t c = 0; c < s.cells; ++c)
+            REQUIRE(memcmp(&a[c], &b[c], sizeof(double)) == 0, "%s cell %lld: %.17g with the active set, %.17g without",
+                    scene_name(kinds[k]), (long long)c, a[c], b[c]);
+        REQUIRE(memcmp(la, lb, sizeof la) == 0, "%s: the ledger differs with the active set", scene_name(kinds[k]));
+        free(a), free(b);
+        scene_free(&s);
+    }
+}
+
+static void test_fluxes_match_height_changes(void **state) {
+    (void)state;
+    mesh_scene s = scene_make(SCENE_HEXAGONS, 20, 2.5, 1u);
+    dpsm_grid *g = NULL;
+    CHECK_OK(NULL, scene_create(&s, &g));
+    CHECK_OK(g, dpsm_set_repose_angle(g, 30.0 * kDeg));
+    CHECK_OK(g, dpsm_set_boundary(g, DPSM_MESH_EDGE, DPSM_OPEN));
+    CHECK_OK(g, dpsm_set_face_flux_recording(g, 1));
+    /* A steep ridge across the edge, so that sand leaves too. */
+    double *h = calloc((size_t)s.cells, sizeof(double)), *after = calloc((size_t)s.cells, sizeof(double));
+    for (int64_t c = 0; c < s.cells; ++c) h[c] = fmax(0.0, 1.5 - 1.2 * fabs(s.cy[c] - 0.3 * s.cx[c]));
+    CHECK_OK(g, dpsm_set_heights(g, h));
+    int64_t nfaces = 0;
+    CHECK_OK(g, dpsm_get_face_count(g, &nfaces));
+    int64_t *faces = calloc((size_t)(2 * nfaces), sizeof(int64_t));
+    double *fx = calloc((size_t)nfaces, sizeof(double)), *net = calloc((size_t)s.cells, sizeof(double));
+    CHECK_OK(g, dpsm_get_mesh_faces(g, faces));
+    const double outflow_before = mass_of(g, DPSM_MASS_OUTFLOW);
+    CHECK_OK(g, dpsm_step(g, 0.2));
+    CHECK_OK(g, dpsm_get_heights(g, after));
+    CHECK_OK(g, dpsm_get_face_fluxes(g, fx, NULL));
+    double edge = 0.0, scale = 0.0;
+    for (int64_t f = 0; f < nfaces; ++f) {
+        const int64_t a = faces[2 * f], b = faces[2 * f + 1];
+        net[a] -= fx[f];
+        if (b >= 0)
+            net[b] += fx[f];
+        else
+            edge += fx[f];
+        scale = fmax(scale, fabs(fx[f]));
+    }
+    REQUIRE(scale > 0.0, "nothing moved");
+    for (int64_t c = 0; c < s.cells; ++c)
+        REQUIRE(fabs(net[c] - (after[c] - h[c]) * s.area[c]) <= 1e-12 * scale,
+                "cell %lld: its faces carried %.17g, its volume changed by %.17g", (long long)c, net[c],
+                (after[c] - h[c]) * s.area[c]);
+    const double outflow = mass_of(g, DPSM_MASS_OUTFLOW) - outflow_before;
+    double side = 0.0;
+    CHECK_OK(g, dpsm_get_side_outflow(g, DPSM_MESH_EDGE, &side));
+    REQUIRE(outflow > 0.0 && fabs(edge - outflow) <= 1e-12 * scale, "the edge's faces carried %.17g, outflow %.17g",
+            edge, outflow);
+    REQUIRE(fabs(side - mass_of(g, DPSM_MASS_OUTFLOW)) <= 1e-15 * fabs(side), "DPSM_MESH_EDGE's outflow %.17g",
+            side);
+    free(h), free(after), free(faces), free(fx), free(net);
+    dpsm_destroy(g);
+    scene_free(&s);
+}
+
+/* A mesh saved in the middle of a run and loaded again continues bit for bit
+ * as the one that was not saved, on each constructor's mesh. */
+static void test_restart_on_meshes(void **state) {
+    (void)state;
+    const scene_kind kinds[3] = {SCENE_TRIANGLES, SCENE_HEXAGONS, SCENE_DUAL};
+    char path[64];
+    snprintf(path, sizeof path, "test_mesh_restart_%d.dpsm", (int)getpid());
+    for (int k = 0; k < 3; ++k) {
+        mesh_scene s = scene_make(kinds[k], 20, 2.5, 9u);
+        dpsm_grid *a = column_mesh(&s, 0), *b = NULL;
+        int64_t nfaces = 0;
+        CHECK_OK(a, dpsm_get_face_count(a, &nfaces));
+        int64_t *faces = calloc((size_t)(2 * nfaces), sizeof(int64_t));
+        CHECK_OK(a, dpsm_get_mesh_faces(a, faces));
+        /* some edge faces open at a level, a source, a wall cell */
+        uint8_t *edges = malloc((size_t)nfaces);
+        double *levels = calloc((size_t)nfaces, sizeof(double));
+        for (int64_t f = 0; f < nfaces; ++f) {
+            edges[f] = (f % 3 == 0) ? DPSM_OPEN : DPSM_WALL;
+            levels[f] = 0.2 * (double)(f % 5); /* higher than the empty cells beside: sand comes in */
+        }
+        CHECK_OK(a, dpsm_set_edge_kinds(a, edges));
+        CHECK_OK(a, dpsm_set_side_levels(a, DPSM_MESH_EDGE, levels));
+        double *q = calloc((size_t)s.cells, sizeof(double));
+        uint8_t *cell_kinds = calloc((size_t)s.cells, 1);
+        q[s.cells / 3] = 0.5;
+        cell_kinds[s.cells / 2] = DPSM_CELL_WALL;
+        CHECK_OK(a, dpsm_set_source(a, q));
+        CHECK_OK(a, dpsm_set_cell_kinds(a, cell_kinds));
+        CHECK_OK(a, dpsm_set_face_flux_recording(a, 1));
+        CHECK_OK(a, dpsm_step(a, 0.2));
+        CHECK_OK(a, dpsm_save(a, path));
+        CHECK_OK(NULL, dpsm_load(path, &b));
+        int64_t nx = 0, ny = 0, nf = 0;
+        CHECK_OK(b, dpsm_get_shape(b, &nx, &ny));
+        CHECK_OK(b, dpsm_get_face_count(b, &nf));
+        REQUIRE(nx == s.cells && ny == 1 && nf == nfaces, "%s: the loaded mesh has %lld cells and %lld faces",
+                scene_name(kinds[k]), (long long)nx, (long long)nf);
+        int64_t *faces_b = calloc((size_t)(2 * nfaces), sizeof(int64_t));
+        CHECK_OK(b, dpsm_get_mesh_faces(b, faces_b));
+        REQUIRE(memcmp(faces, faces_b, sizeof(int64_t) * (size_t)(2 * nfaces)) == 0, "%s: the faces differ after loading",
+                scene_name(kinds[k]));
+        for (int call = 0; call < 3; ++call) {
+            CHECK_OK(a, dpsm_step(a, 0.2));
+            CHECK_OK(b, dpsm_step(b, 0.2));
+        }
+        double *ha = calloc((size_t)s.cells, sizeof(double)), *hb = calloc((size_t)s.cells, sizeof(double));
+        CHECK_OK(a, dpsm_get_heights(a, ha));
+        CHECK_OK(b, dpsm_get_heights(b, hb));
+        REQUIRE(memcmp(ha, hb, sizeof(double) * (size_t)s.cells) == 0, "%s: a loaded mesh steps differently",
+                scene_name(kinds[k]));
+        double *fa = calloc((size_t)nfaces, sizeof(double)), *fb = calloc((size_t)nfaces, sizeof(double));
+        CHECK_OK(a, dpsm_get_face_fluxes(a, fa, NULL));
+        CHECK_OK(b, dpsm_get_face_fluxes(b, fb, NULL));
+        REQUIRE(memcmp(fa, fb, sizeof(double) * (size_t)nfaces) == 0, "%s: face fluxes differ", scene_name(kinds[k]));
+        const int quantities[5] = {DPSM_MASS_TOTAL, DPSM_MASS_SOURCED, DPSM_MASS_EXTERNAL, DPSM_MASS_OUTFLOW, DPSM_MASS_UNMET};
+        for (int m = 0; m < 5; ++m)
+            REQUIRE(mass_of(a, quantities[m]) == mass_of(b, quantities[m]), "%s: ledger figure %d differs",
+                    scene_name(kinds[k]), quantities[m]);
+        double side_a = 0, side_b = 0;
+        CHECK_OK(a, dpsm_get_side_outflow(a, DPSM_MESH_EDGE, &side_a));
+        CHECK_OK(b, dpsm_get_side_outflow(b, DPSM_MESH_EDGE, &side_b));
+        REQUIRE(side_a == side_b && side_a != 0.0, "%s: edge outflow %.17g and %.17g", scene_name(kinds[k]), side_a, side_b);
+        free(faces), free(faces_b), free(edges), free(levels), free(q), free(cell_kinds), free(ha), free(hb), free(fa),
+            free(fb);
+        dpsm_destroy(a), dpsm_destroy(b);
+        scene_free(&s);
+    }
+    remove(path);
+}
+
+int main(void) {
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_create_mesh_quads),
+        cmocka_unit_test(test_create_graph_and_dual),
+        cmocka_unit_test(test_bad_meshes),
+        cmocka_unit_test(test_mesh_functions),
+        cmocka_unit_test(test_column_rests_with_mass_and_bounds),
+        cmocka_unit_test(test_exact_states),
+        cmocka_unit_test(test_host_order),
+        cmocka_unit_test(test_graph_steps_as_polygons),
+        cmocka_unit_test(test_active_set_same_bits),
+        cmocka_unit_test(test_fluxes_match_height_changes),
+        cmocka_unit_test(test_restart_on_meshes),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
