@@ -35,6 +35,12 @@
  *     (dpsm_save) and loaded (dpsm_load) reads back bit for bit, and after the
  *     same step matches the grid bit for bit (all but the cell updates, which
  *     count the work of looking at every tile once more after a load).
+ * Opcode kMeshOp (251) builds an unstructured mesh of its own instead (op_mesh:
+ * polygons, a finite-volume graph or a median dual over a jittered lattice,
+ * sometimes with one defect the constructor must refuse with the exact
+ * status), runs a few calls and steps on it with checks of their own (ledger,
+ * no new extremum, face fluxes against the harness's own cell areas, restart
+ * bit for bit) and destroys it; its comment tells its bytes.
  * A violated check prints what it saw and calls abort(), which libFuzzer (or
  * the replay driver, fuzz_replay.c) reports with the input.
  *
@@ -1474,6 +1480,969 @@ static void op_destroy(reader_t *r) {
 }
 
 /* ------------------------------------------------------------------------ */
+/* Meshes                                                                    */
+/* ------------------------------------------------------------------------ */
+
+/* op_mesh (opcode kMeshOp): a mesh of its own, built, exercised and destroyed
+ * within the operation (it takes no slot). Its bytes:
+ *
+ *   kind      % 3: dpsm_create_mesh, dpsm_create_graph, dpsm_create_dual_mesh;
+ *             / 3 % 3: a lattice of quads, of triangles, or of both mixed
+ *             (the dual always takes triangles)
+ *   nx, ny    2 + b % 7 squares a side
+ *   dx, dy    kMeshSpacings[b % 5]
+ *   jitter    (b % 5) * 0.06 of the spacing, each node (below 1/4: every
+ *             cell stays convex and well shaped)
+ *   seed      u16: the generator of the jitter, of the diagonals, of each
+ *             polygon's orientation and first node, of a graph's face order
+ *             and of the defect's place
+ *   defect    b >= 0xc0: plant defect (b & 0x3f) % n (mesh_construct lists
+ *             them), which the constructor must refuse with the exact status
+ *             and *out NULL; otherwise the mesh must be made
+ *   nops      b % 16: the operations on the mesh that follow (none on a
+ *             refused one), each an opcode byte (% 10, see mesh_operation)
+ *             and its arguments.
+ *
+ * A made mesh must have the shape (ncells, 1) and the faces this harness
+ * derives from what it gave (for polygons: in order of first appearance,
+ * cell by cell, edge by edge; a graph's faces as given; the dual's by node
+ * pair, then the halves of the boundary edges). Its cell areas (shoelace; a
+ * third of each node's triangles for the dual) must make up DPSM_MASS_TOTAL.
+ * After every operation: heights finite, the ledger closes to 1e-9 of the
+ * largest mass seen. After every step: held cells unchanged; without a
+ * source and with every held level equal (open edge faces, open cells) no
+ * sand cell leaves the range of the sand and the held levels before it;
+ * with face fluxes recorded, each sand cell's faces bring its change of
+ * height times its area less its source (to 1e-9 of the largest face
+ * volume), wall cells' faces and wall edge faces carry nothing, the open edge
+ * faces carry what dpsm_get_side_outflow(DPSM_MESH_EDGE) booked, and with the
+ * open cells make up OUTFLOW; where the step's byte asks, a copy through
+ * dpsm_save/dpsm_load takes the same step to bit-identical heights and
+ * ledger. A step of a scene that may flow for ever (a source on a sand cell,
+ * held levels that differ) needing more sub-steps than the limit must fail
+ * with DPSM_ERR_WORK_LIMIT and change nothing. */
+enum { kMeshOp = 251 };
+enum { MESH_POLYGONS = 0, MESH_GRAPH = 1, MESH_DUAL = 2 };
+#define MESH_MAX_SUBSTEPS 20000
+
+static const double kMeshSpacings[] = {1.0, 0.5, 2.0, 0.25, 4.0};
+static const double kMeshHeights[] = {0.0, 1.0, 3.0, 10.0, -1.0, 0.5, 30.0, 100.0, -3.0, 1e3, 0.25, 7.0};
+static const double kMeshSources[] = {0.0, 1e-3, -1e-3, 0.1, -0.1, 1.0, 0.0, 1e-9};
+
+typedef struct {
+    uint64_t s;
+} prng_t;
+
+static uint64_t prng_next(prng_t *p) {
+    uint64_t x = p->s;
+    x ^= x >> 12;
+    x ^= x << 25;
+    x ^= x >> 27;
+    p->s = x;
+    return x * 0x2545F4914F6CDD1DULL;
+}
+static double prng_unit(prng_t *p) { return (double)(prng_next(p) >> 11) * (1.0 / 9007199254740992.0); }
+static unsigned prng_below(prng_t *p, unsigned n) { return (unsigned)(prng_next(p) % n); }
+
+static void *xcalloc(size_t n, size_t size) {
+    void *p = calloc(n ? n : 1, size);
+    if (!p) die("out of memory");
+    return p;
+}
+
+/* A mesh as this harness built it, in the host's numbering. */
+typedef struct {
+    int kind;
+    int64_t nnodes;
+    double *node_xy;
+    int64_t npoly;                    /* the lattice's polygons (the dual's triangles) */
+    int64_t *poly_start, *poly_nodes; /* CSR, as given to dpsm_create_mesh */
+    int64_t ncells;
+    double *area, *cx, *cy;           /* per cell */
+    int64_t nfaces;
+    int64_t *face_cells;              /* the faces the library must list */
+    double *face_xy, *face_length;    /* graph: as given */
+} mesh_t;
+
+static void mesh_free(mesh_t *m) {
+    free(m->node_xy);
+    free(m->poly_start);
+    free(m->poly_nodes);
+    free(m->area);
+    free(m->cx);
+    free(m->cy);
+    free(m->face_cells);
+    free(m->face_xy);
+    free(m->face_length);
+    memset(m, 0, sizeof *m);
+}
+
+/* Twice the signed area of polygon k, and its centroid. */
+static double polygon_geometry(const mesh_t *m, int64_t k, double *gx, double *gy) {
+    const int64_t k0 = m->poly_start[k], count = m->poly_start[k + 1] - k0;
+    const double ox = m->node_xy[2 * m->poly_nodes[k0]], oy = m->node_xy[2 * m->poly_nodes[k0] + 1];
+    double twice = 0.0, mx = 0.0, my = 0.0;
+    for (int64_t e = 0; e < count; ++e) {
+        const int64_t u = m->poly_nodes[k0 + e], v = m->poly_nodes[k0 + (e + 1) % count];
+        const double px = m->node_xy[2 * u] - ox, py = m->node_xy[2 * u + 1] - oy;
+        const double qx = m->node_xy[2 * v] - ox, qy = m->node_xy[2 * v + 1] - oy;
+        const double w = px * qy - py * qx;
+        twice += w;
+        mx += w / 3.0 * (px + qx);
+        my += w / 3.0 * (py + qy);
+    }
+    *gx = ox + mx / twice;
+    *gy = oy + my / twice;
+    return twice;
+}
+
+/* The jittered lattice and its polygons: quads, triangles (either diagonal)
+ * or both, each polygon in either orientation and from any first node. */
+static void mesh_build(mesh_t *m, int kind, int lattice, int64_t nx, int64_t ny, double dx, double dy, double jitter,
+                       prng_t *p) {
+    memset(m, 0, sizeof *m);
+    m->kind = kind;
+    const int64_t nxn = nx + 1, nyn = ny + 1;
+    m->nnodes = nxn * nyn;
+    m->node_xy = xcalloc((size_t)(2 * m->nnodes), sizeof(double));
+    for (int64_t j = 0; j < nyn; ++j)
+        for (int64_t i = 0; i < nxn; ++i) {
+            const int64_t n = i + nxn * j;
+            m->node_xy[2 * n] = ((double)i + jitter * (2.0 * prng_unit(p) - 1.0)) * dx;
+            m->node_xy[2 * n + 1] = ((double)j + jitter * (2.0 * prng_unit(p) - 1.0)) * dy;
+        }
+    m->poly_start = xcalloc((size_t)(2 * nx * ny + 1), sizeof(int64_t));
+    m->poly_nodes = xcalloc((size_t)(6 * nx * ny), sizeof(int64_t));
+    int64_t np = 0, at = 0;
+    for (int64_t j = 0; j < ny; ++j)
+        for (int64_t i = 0; i < nx; ++i) {
+            const int64_t n00 = i + nxn * j, n10 = n00 + 1, n01 = n00 + nxn, n11 = n01 + 1;
+            const int quad = kind != MESH_DUAL && (lattice == 0 || (lattice == 2 && prng_below(p, 2)));
+            int64_t v[2][4];
+            int counts[2], pieces;
+            if (quad) {
+                pieces = 1, counts[0] = 4;
+                v[0][0] = n00, v[0][1] = n10, v[0][2] = n11, v[0][3] = n01;
+            } else if (prng_below(p, 2)) {
+                pieces = 2, counts[0] = counts[1] = 3;
+                v[0][0] = n00, v[0][1] = n10, v[0][2] = n11;
+                v[1][0] = n00, v[1][1] = n11, v[1][2] = n01;
+            } else {
+                pieces = 2, counts[0] = counts[1] = 3;
+                v[0][0] = n00, v[0][1] = n10, v[0][2] = n01;
+                v[1][0] = n10, v[1][1] = n11, v[1][2] = n01;
+            }
+            for (int k = 0; k < pieces; ++k) {
+                const int c = counts[k], reverse = prng_below(p, 4) == 0, first = (int)prng_below(p, (unsigned)c);
+                for (int e = 0; e < c; ++e) {
+                    const int s = reverse ? (first - e + 2 * c) % c : (first + e) % c;
+                    m->poly_nodes[at++] = v[k][s];
+                }
+                m->poly_start[++np] = at;
+            }
+        }
+    m->npoly = np;
+}
+
+/* A face map over node pairs: index + 1 of the face of edge (lo, hi), 0: none. */
+static int64_t *edge_slot(int64_t *map, int64_t nnodes, int64_t u, int64_t v) {
+    const int64_t lo = u < v ? u : v, hi = u < v ? v : u;
+    return &map[lo * nnodes + hi];
+}
+
+/* The cells, areas and faces the library must find. */
+static void mesh_derive(mesh_t *m, prng_t *p) {
+    int64_t *map = xcalloc((size_t)(m->nnodes * m->nnodes), sizeof(int64_t));
+    if (m->kind != MESH_DUAL) {
+        m->ncells = m->npoly;
+        m->area = xcalloc((size_t)m->ncells, sizeof(double));
+        m->cx = xcalloc((size_t)m->ncells, sizeof(double));
+        m->cy = xcalloc((size_t)m->ncells, sizeof(double));
+        m->face_cells = xcalloc((size_t)(2 * m->poly_start[m->npoly]), sizeof(int64_t));
+        m->face_xy = xcalloc((size_t)(2 * m->poly_start[m->npoly]), sizeof(double));
+        m->face_length = xcalloc((size_t)m->poly_start[m->npoly], sizeof(double));
+        for (int64_t c = 0; c < m->ncells; ++c) {
+            m->area[c] = 0.5 * fabs(polygon_geometry(m, c, &m->cx[c], &m->cy[c]));
+            const int64_t k0 = m->poly_start[c], count = m->poly_start[c + 1] - k0;
+            for (int64_t e = 0; e < count; ++e) {
+                const int64_t u = m->poly_nodes[k0 + e], v = m->poly_nodes[k0 + (e + 1) % count];
+                int64_t *slot = edge_slot(map, m->nnodes, u, v);
+                if (*slot) {
+                    m->face_cells[2 * (*slot - 1) + 1] = c;
+                    continue;
+                }
+                const int64_t f = m->nfaces++;
+                *slot = f + 1;
+                m->face_cells[2 * f] = c, m->face_cells[2 * f + 1] = -1;
+                const double ux = m->node_xy[2 * u], uy = m->node_xy[2 * u + 1];
+                const double vx = m->node_xy[2 * v], vy = m->node_xy[2 * v + 1];
+                m->face_xy[2 * f] = 0.5 * (ux + vx), m->face_xy[2 * f + 1] = 0.5 * (uy + vy);
+                m->face_length[f] = hypot(vx - ux, vy - uy);
+            }
+        }
+        if (m->kind == MESH_GRAPH) {
+            /* The host's own order: faces shuffled, interior faces either way round. */
+            for (int64_t f = m->nfaces - 1; f > 0; --f) {
+                const int64_t g = (int64_t)prng_below(p, (unsigned)(f + 1));
+                int64_t tc[2] = {m->face_cells[2 * f], m->face_cells[2 * f + 1]};
+                double txy[2] = {m->face_xy[2 * f], m->face_xy[2 * f + 1]}, tl = m->face_length[f];
+                m->face_cells[2 * f] = m->face_cells[2 * g], m->face_cells[2 * f + 1] = m->face_cells[2 * g + 1];
+                m->face_xy[2 * f] = m->face_xy[2 * g], m->face_xy[2 * f + 1] = m->face_xy[2 * g + 1];
+                m->face_length[f] = m->face_length[g];
+                m->face_cells[2 * g] = tc[0], m->face_cells[2 * g + 1] = tc[1];
+                m->face_xy[2 * g] = txy[0], m->face_xy[2 * g + 1] = txy[1];
+                m->face_length[g] = tl;
+            }
+            for (int64_t f = 0; f < m->nfaces; ++f)
+                if (m->face_cells[2 * f + 1] >= 0 && prng_below(p, 2)) {
+                    const int64_t t = m->face_cells[2 * f];
+                    m->face_cells[2 * f] = m->face_cells[2 * f + 1], m->face_cells[2 * f + 1] = t;
+                }
+        }
+    } else {
+        /* One cell per node, a third of each of its triangles; faces by node
+         * pair, then each boundary edge's two halves, the lower node's first. */
+        m->ncells = m->nnodes;
+        m->area = xcalloc((size_t)m->ncells, sizeof(double));
+        m->cx = xcalloc((size_t)m->ncells, sizeof(double));
+        m->cy = xcalloc((size_t)m->ncells, sizeof(double));
+        for (int64_t n = 0; n < m->nnodes; ++n) m->cx[n] = m->node_xy[2 * n], m->cy[n] = m->node_xy[2 * n + 1];
+        for (int64_t t = 0; t < m->npoly; ++t) {
+            const int64_t *v = m->poly_nodes + 3 * t;
+            const double px = m->node_xy[2 * v[0]], py = m->node_xy[2 * v[0] + 1];
+            const double qx = m->node_xy[2 * v[1]] - px, qy = m->node_xy[2 * v[1] + 1] - py;
+            const double rx = m->node_xy[2 * v[2]] - px, ry = m->node_xy[2 * v[2] + 1] - py;
+            const double area = 0.5 * fabs(qx * ry - qy * rx);
+            for (int k = 0; k < 3; ++k) {
+                m->area[v[k]] += area / 3.0;
+                ++*edge_slot(map, m->nnodes, v[k], v[(k + 1) % 3]);
+            }
+        }
+        int64_t edges = 0, boundary = 0;
+        for (int64_t k = 0; k < m->nnodes * m->nnodes; ++k)
+            if (map[k]) ++edges, boundary += map[k] == 1;
+        m->face_cells = xcalloc((size_t)(2 * (edges + 2 * boundary)), sizeof(int64_t));
+        for (int64_t lo = 0; lo < m->nnodes; ++lo)
+            for (int64_t hi = lo + 1; hi < m->nnodes; ++hi)
+                if (map[lo * m->nnodes + hi]) {
+                    m->face_cells[2 * m->nfaces] = lo, m->face_cells[2 * m->nfaces + 1] = hi;
+                    ++m->nfaces;
+                }
+        for (int64_t lo = 0; lo < m->nnodes; ++lo)
+            for (int64_t hi = lo + 1; hi < m->nnodes; ++hi)
+                if (map[lo * m->nnodes + hi] == 1) {
+                    m->face_cells[2 * m->nfaces] = lo, m->face_cells[2 * m->nfaces + 1] = -1;
+                    m->face_cells[2 * m->nfaces + 2] = hi, m->face_cells[2 * m->nfaces + 3] = -1;
+                    m->nfaces += 2;
+                }
+    }
+    free(map);
+}
+
+static const char *const kMeshFunctions[] = {"dpsm_create_mesh", "dpsm_create_graph", "dpsm_create_dual_mesh"};
+
+/* Calls the constructor on a copy of the mesh's arrays with defect `defect`
+ * planted (-1: none). Returns the status; *want receives the one expected. */
+static int mesh_construct(const mesh_t *m, int defect, prng_t *p, dpsm_grid **grid, int *want, const char **what) {
+    const int64_t total = m->poly_start[m->npoly];
+    /* Room for one more polygon or node (the defects that add one). */
+    double *xy = xcalloc((size_t)(2 * m->nnodes + 2), sizeof(double));
+    memcpy(xy, m->node_xy, sizeof(double) * (size_t)(2 * m->nnodes));
+    int64_t *start = xcalloc((size_t)(m->npoly + 2), sizeof(int64_t));
+    memcpy(start, m->poly_start, sizeof(int64_t) * (size_t)(m->npoly + 1));
+    int64_t *nodes = xcalloc((size_t)(total + 4), sizeof(int64_t));
+    memcpy(nodes, m->poly_nodes, sizeof(int64_t) * (size_t)total);
+    int64_t nnodes = m->nnodes, npoly = m->npoly, ncells = m->ncells, nfaces = m->nfaces;
+    double *cell_xy = xcalloc((size_t)(2 * m->ncells), sizeof(double)), *area = xcalloc((size_t)m->ncells, sizeof(double));
+    for (int64_t c = 0; c < m->ncells; ++c) cell_xy[2 * c] = m->cx[c], cell_xy[2 * c + 1] = m->cy[c], area[c] = m->area[c];
+    int64_t *fc = xcalloc((size_t)(2 * m->nfaces), sizeof(int64_t));
+    memcpy(fc, m->face_cells, sizeof(int64_t) * (size_t)(2 * m->nfaces));
+    double *fxy = NULL, *flen = NULL;
+    if (m->kind == MESH_GRAPH) {
+        fxy = xcalloc((size_t)(2 * m->nfaces), sizeof(double));
+        flen = xcalloc((size_t)m->nfaces, sizeof(double));
+        memcpy(fxy, m->face_xy, sizeof(double) * (size_t)(2 * m->nfaces));
+        memcpy(flen, m->face_length, sizeof(double) * (size_t)m->nfaces);
+    }
+    static const double kBadCoordinates[] = {NAN, INFINITY, -INFINITY, 1e51};
+    const int64_t cell = (int64_t)prng_below(p, (unsigned)(m->kind == MESH_DUAL ? m->npoly : m->ncells));
+    const int64_t k0 = start[cell], count = start[cell + 1] - k0; /* polygon (triangle) `cell` */
+    int null_out = 0;
+    *want = DPSM_OK;
+    *what = "none";
+    if (defect >= 0 && m->kind == MESH_POLYGONS) {
+        *want = DPSM_ERR_INVALID_VALUE;
+        switch (defect % 11) {
+            case 0: *what = "node index out of range"; nodes[k0 + prng_below(p, (unsigned)count)] = prng_below(p, 2) ? nnodes : -1; break;
+            case 1: /* a b a (b): two distinct nodes */
+                *what = "fewer than 3 distinct nodes";
+                for (int64_t e = 2; e < count; ++e) nodes[k0 + e] = nodes[k0 + e - 2];
+                break;
+            case 2: *what = "a cell of 2 nodes in cell_start"; start[1] = 2; break;
+            case 3: { /* every node of the cell on one line */
+                *what = "collinear nodes";
+                const double ox = xy[2 * nodes[k0]], oy = xy[2 * nodes[k0] + 1];
+                const double ux = 0.3 + prng_unit(p), uy = prng_unit(p) - 0.5;
+                for (int64_t e = 1; e < count; ++e) xy[2 * nodes[k0 + e]] = ox + (double)e * ux, xy[2 * nodes[k0 + e] + 1] = oy + (double)e * uy;
+                break;
+            }
+            case 4: *what = "a coordinate not finite or out of range"; xy[prng_below(p, (unsigned)(2 * nnodes))] = kBadCoordinates[prng_below(p, 4)]; break;
+            case 5: *what = "cell_start[0] != 0"; start[0] = prng_below(p, 2) ? 1 : -1; break;
+            case 6: /* the cell again: its interior edges then belong to 3 cells */
+                *what = "an edge of 3 cells";
+                for (int64_t e = 0; e < count; ++e) nodes[total + e] = nodes[k0 + e];
+                start[npoly + 1] = total + count;
+                ++npoly;
+                break;
+            case 7: *what = "a node repeated in consecutive places"; nodes[k0 + 1] = nodes[k0]; break;
+            case 8: *what = "a count below 1"; *want = DPSM_ERR_INVALID_SIZE; if (prng_below(p, 2)) nnodes = 0; else npoly = -(int64_t)prng_below(p, 2); break;
+            case 9: *what = "a NULL array"; *want = DPSM_ERR_NULL_POINTER; switch (prng_below(p, 3)) { case 0: free(xy); xy = NULL; break; case 1: free(start); start = NULL; break; default: free(nodes); nodes = NULL; } break;
+            default: *what = "a NULL out"; *want = DPSM_ERR_NULL_POINTER; null_out = 1; break;
+        }
+    } else if (defect >= 0 && m->kind == MESH_GRAPH) {
+        *want = DPSM_ERR_INVALID_VALUE;
+        const int64_t f = (int64_t)prng_below(p, (unsigned)nfaces);
+        int64_t interior = -1; /* an interior face from f on */
+        for (int64_t k = 0; k < nfaces && interior < 0; ++k)
+            if (fc[2 * ((f + k) % nfaces) + 1] >= 0) interior = (f + k) % nfaces;
+        switch (defect % 11) {
+            case 0: *what = "a face joining a cell to itself"; fc[2 * f + 1] = fc[2 * f]; break;
+            case 1: {
+                *what = "a face cell out of range";
+                static const int64_t wild[] = {-1, -2, 0, INT64_MIN, INT64_MAX};
+                const unsigned w = prng_below(p, 5);
+                if (w == 0) fc[2 * f] = -1;
+                else if (w == 1) fc[2 * f + 1] = -2;
+                else if (w == 2) fc[2 * f + prng_below(p, 2)] = ncells;
+                else fc[2 * f] = wild[w];
+                break;
+            }
+            case 2: { static const double bad[] = {0.0, -0.0, -1.0, NAN, INFINITY, 1e51}; *what = "a bad face length"; flen[f] = bad[prng_below(p, 6)]; break; }
+            case 3: { static const double bad[] = {0.0, -0.0, -1.0, NAN, INFINITY, 1e51}; *what = "a bad cell area"; area[prng_below(p, (unsigned)ncells)] = bad[prng_below(p, 6)]; break; }
+            case 4: {
+                *what = "coincident centres";
+                const int64_t a = fc[2 * interior], b = fc[2 * interior + 1];
+                cell_xy[2 * b] = cell_xy[2 * a], cell_xy[2 * b + 1] = cell_xy[2 * a + 1];
+                break;
+            }
+            case 5: { /* cell 0 (a corner) without its faces on the domain edge */
+                *what = "a cell its faces do not close";
+                int64_t kept = 0;
+                for (int64_t k = 0; k < nfaces; ++k) {
+                    if ((fc[2 * k] == 0 && fc[2 * k + 1] < 0) || (fc[2 * k + 1] == 0 && fc[2 * k] < 0)) continue;
+                    fc[2 * kept] = fc[2 * k], fc[2 * kept + 1] = fc[2 * k + 1];
+                    fxy[2 * kept] = fxy[2 * k], fxy[2 * kept + 1] = fxy[2 * k + 1], flen[kept] = flen[k];
+                    ++kept;
+                }
+                nfaces = kept;
+                break;
+            }
+            case 6:
+                *what = "a coordinate not finite or out of range";
+                if (prng_below(p, 2)) cell_xy[prng_below(p, (unsigned)(2 * ncells))] = kBadCoordinates[prng_below(p, 4)];
+                else fxy[prng_below(p, (unsigned)(2 * nfaces))] = kBadCoordinates[prng_below(p, 4)];
+                break;
+            case 7: { /* an edge face with its midpoint at its cell's centre */
+                *what = "an edge face at its cell's centre";
+                int64_t e = -1;
+                for (int64_t k = 0; k < nfaces && e < 0; ++k)
+                    if (fc[2 * ((f + k) % nfaces) + 1] < 0) e = (f + k) % nfaces;
+                fxy[2 * e] = cell_xy[2 * fc[2 * e]], fxy[2 * e + 1] = cell_xy[2 * fc[2 * e] + 1];
+                break;
+            }
+            case 8: *what = "a count below 1"; *want = DPSM_ERR_INVALID_SIZE; if (prng_below(p, 2)) ncells = 0; else nfaces = -(int64_t)prng_below(p, 2); break;
+            case 9: {
+                *what = "a NULL array";
+                *want = DPSM_ERR_NULL_POINTER;
+                switch (prng_below(p, 5)) {
+                    case 0: free(cell_xy); cell_xy = NULL; break;
+                    case 1: free(area); area = NULL; break;
+                    case 2: free(fc); fc = NULL; break;
+                    case 3: free(fxy); fxy = NULL; break;
+                    default: free(flen); flen = NULL; break;
+                }
+                break;
+            }
+            default: *what = "a NULL out"; *want = DPSM_ERR_NULL_POINTER; null_out = 1; break;
+        }
+    } else if (defect >= 0) {
+        *want = DPSM_ERR_INVALID_VALUE;
+        int64_t *tri = nodes + 3 * cell;
+        switch (defect % 9) {
+            case 0: {
+                *what = "a triangle with a repeated node";
+                const unsigned k = prng_below(p, 3);
+                tri[k] = tri[(k + 1 + prng_below(p, 2)) % 3];
+                break;
+            }
+            case 1: /* a node no triangle names */
+                *what = "a node in no triangle";
+                xy[2 * nnodes] = -1.0 - prng_unit(p), xy[2 * nnodes + 1] = -1.0;
+                ++nnodes;
+                break;
+            case 2: *what = "node index out of range"; tri[prng_below(p, 3)] = prng_below(p, 2) ? nnodes : -1; break;
+            case 3: /* the third node on the line of the other two */
+                *what = "collinear nodes";
+                xy[2 * tri[2]] = 0.5 * (xy[2 * tri[0]] + xy[2 * tri[1]]);
+                xy[2 * tri[2] + 1] = 0.5 * (xy[2 * tri[0] + 1] + xy[2 * tri[1] + 1]);
+                break;
+            case 4: *what = "a coordinate not finite or out of range"; xy[prng_below(p, (unsigned)(2 * nnodes))] = kBadCoordinates[prng_below(p, 4)]; break;
+            case 5: /* the triangle again: its interior edges then belong to 3 triangles */
+                *what = "an edge of 3 triangles";
+                for (int k = 0; k < 3; ++k) nodes[3 * npoly + k] = tri[k];
+                ++npoly;
+                break;
+            case 6: *what = "a count below 1"; *want = DPSM_ERR_INVALID_SIZE; if (prng_below(p, 2)) nnodes = 0; else npoly = -(int64_t)prng_below(p, 2); break;
+            case 7: *what = "a NULL array"; *want = DPSM_ERR_NULL_POINTER; if (prng_below(p, 2)) { free(xy); xy = NULL; } else { free(nodes); nodes = NULL; } break;
+            default: *what = "a NULL out"; *want = DPSM_ERR_NULL_POINTER; null_out = 1; break;
+        }
+    }
+    *grid = (dpsm_grid *)grid; /* not NULL: a failure must set NULL */
+    dpsm_grid **out = null_out ? NULL : grid;
+    int st;
+    if (m->kind == MESH_POLYGONS)
+        st = dpsm_create_mesh(nnodes, xy, npoly, start, nodes, out);
+    else if (m->kind == MESH_GRAPH)
+        st = dpsm_create_graph(ncells, cell_xy, area, nfaces, fc, fxy, flen, out);
+    else
+        st = dpsm_create_dual_mesh(nnodes, xy, npoly, nodes, out);
+    if (null_out) *grid = NULL;
+    free(xy);
+    free(start);
+    free(nodes);
+    free(cell_xy);
+    free(area);
+    free(fc);
+    free(fxy);
+    free(flen);
+    return st;
+}
+
+/* What the harness knows of a live mesh. */
+typedef struct {
+    const mesh_t *m;
+    dpsm_grid *g;
+    uint8_t *kinds;     /* per cell */
+    uint8_t *edge_open; /* per face: open edge faces */
+    double *levels;     /* per face */
+    double *source;     /* per cell; NULL: none */
+    int record;         /* face fluxes recorded */
+    int64_t max_substeps;
+    double mass_scale;
+    prng_t *p;
+} mesh_state_t;
+
+typedef struct {
+    double *h;
+    double mass[5], edge_out, stable_dt;
+} msnap_t;
+
+static void mesh_snap(const mesh_state_t *ms, msnap_t *s) {
+    s->h = xcalloc((size_t)ms->m->ncells, sizeof(double));
+    const dpsm_grid *g = ms->g;
+    if (dpsm_get_heights(g, s->h) != DPSM_OK) die("dpsm_get_heights failed on a mesh: %s", dpsm_last_error(g));
+    for (int q = 0; q < 5; ++q)
+        if (dpsm_get_mass(g, q, &s->mass[q]) != DPSM_OK) die("dpsm_get_mass failed on a mesh");
+    if (dpsm_get_side_outflow(g, DPSM_MESH_EDGE, &s->edge_out) != DPSM_OK)
+        die("dpsm_get_side_outflow(DPSM_MESH_EDGE) failed on a mesh: %s", dpsm_last_error(g));
+    if (dpsm_stable_dt(g, &s->stable_dt) != DPSM_OK || !(s->stable_dt > 0.0)) die("dpsm_stable_dt failed on a mesh");
+}
+
+static void mesh_same(const mesh_state_t *ms, const msnap_t *a, const msnap_t *b, const char *what) {
+    for (int64_t c = 0; c < ms->m->ncells; ++c)
+        if (memcmp(&a->h[c], &b->h[c], sizeof(double)) != 0)
+            die("%s: the height of cell %lld differs: %.17g vs %.17g", what, (long long)c, a->h[c], b->h[c]);
+    for (int q = 0; q < 5; ++q)
+        if (memcmp(&a->mass[q], &b->mass[q], sizeof(double)) != 0)
+            die("%s: mass figure %d differs: %.17g vs %.17g", what, q, a->mass[q], b->mass[q]);
+    if (memcmp(&a->edge_out, &b->edge_out, sizeof(double)) != 0)
+        die("%s: the edge's outflow differs: %.17g vs %.17g", what, a->edge_out, b->edge_out);
+    if (memcmp(&a->stable_dt, &b->stable_dt, sizeof(double)) != 0)
+        die("%s: stable_dt differs: %.17g vs %.17g", what, a->stable_dt, b->stable_dt);
+}
+
+/* Finite heights; the ledger closes; the sand cells' heights times the
+ * harness's own areas make up TOTAL. */
+static void mesh_check_state(mesh_state_t *ms, const msnap_t *s) {
+    const mesh_t *m = ms->m;
+    double gross = 0.0, total = 0.0;
+    for (int64_t c = 0; c < m->ncells; ++c) {
+        if (!isfinite(s->h[c])) die("the height of mesh cell %lld is %g", (long long)c, s->h[c]);
+        gross += fabs(s->h[c]) * m->area[c];
+        if (ms->kinds[c] == DPSM_CELL_SAND) total += s->h[c] * m->area[c];
+    }
+    for (int q = 0; q < 5; ++q)
+        if (!isfinite(s->mass[q])) die("mass figure %d is %g", q, s->mass[q]);
+    ms->mass_scale = fmax(ms->mass_scale, gross);
+    double scale = fmax(1.0, ms->mass_scale);
+    for (int q = 0; q < 4; ++q) scale = fmax(scale, fabs(s->mass[q]));
+    const double residual = fabs(s->mass[0] - (s->mass[1] + s->mass[2] - s->mass[3]));
+    if (residual > 1e-9 * scale)
+        die("the mesh's ledger does not close: total %.17g, sourced %.17g, external %.17g, outflow %.17g: residual "
+            "%.3g of %.3g",
+            s->mass[0], s->mass[1], s->mass[2], s->mass[3], residual, scale);
+    if (fabs(s->mass[0] - total) > 1e-9 * scale)
+        die("DPSM_MASS_TOTAL is %.17g, the sand cells' heights times their areas %.17g", s->mass[0], total);
+}
+
+static void mesh_expect(mesh_state_t *ms, int st, int want, const char *fn, const msnap_t *before) {
+    expect_status(st, want, fn, ms->g);
+    if (st != DPSM_OK) {
+        check_failed(NULL, ms->g, NULL, st, fn);
+        msnap_t after;
+        mesh_snap(ms, &after);
+        mesh_same(ms, before, &after, "a failed call changed the mesh");
+        free(after.h);
+    } else if (*dpsm_last_error(ms->g)) {
+        die("%s succeeded but left the message \"%s\"", fn, dpsm_last_error(ms->g));
+    }
+}
+
+#define MESH_CALL(ms, want, fn, call)              \
+    do {                                           \
+        msnap_t before_;                           \
+        mesh_snap((ms), &before_);                 \
+        g_op = (fn);                               \
+        const int st_ = (call);                    \
+        mesh_expect((ms), st_, (want), (fn), &before_); \
+        free(before_.h);                           \
+    } while (0)
+
+static int mesh_source_active(const mesh_state_t *ms) {
+    if (!ms->source) return 0;
+    for (int64_t c = 0; c < ms->m->ncells; ++c)
+        if (ms->kinds[c] == DPSM_CELL_SAND && ms->source[c] != 0.0) return 1;
+    return 0;
+}
+
+/* The held levels (open edge faces, open cells): their range; 0 if none. */
+static int mesh_held_range(const mesh_state_t *ms, const double *h, double *lo, double *hi) {
+    int any = 0;
+    for (int64_t f = 0; f < ms->m->nfaces; ++f)
+        if (ms->m->face_cells[2 * f + 1] < 0 && ms->edge_open[f]) {
+            const double v = ms->levels[f];
+            *lo = any ? fmin(*lo, v) : v, *hi = any ? fmax(*hi, v) : v, any = 1;
+        }
+    for (int64_t c = 0; c < ms->m->ncells; ++c)
+        if (ms->kinds[c] == DPSM_CELL_OPEN) *lo = any ? fmin(*lo, h[c]) : h[c], *hi = any ? fmax(*hi, h[c]) : h[c], any = 1;
+    return any;
+}
+
+/* Per cell values by a pattern: constant, a central pile, a ramp in x, or
+ * each its own; (mode & 0xc0) == 0xc0 plants a NaN or infinity (returns 1). */
+static int mesh_fill(reader_t *r, const mesh_state_t *ms, double *a, const double *table, size_t ntable) {
+    const mesh_t *m = ms->m;
+    const unsigned mode = u8(r);
+    const double v = table[u8(r) % ntable], w = table[u8(r) % ntable];
+    double x0 = m->cx[0], x1 = x0, y0 = m->cy[0], y1 = y0;
+    for (int64_t c = 0; c < m->ncells; ++c)
+        x0 = fmin(x0, m->cx[c]), x1 = fmax(x1, m->cx[c]), y0 = fmin(y0, m->cy[c]), y1 = fmax(y1, m->cy[c]);
+    for (int64_t c = 0; c < m->ncells; ++c) {
+        const double u = (m->cx[c] - x0) / (x1 - x0), t = (m->cy[c] - y0) / (y1 - y0);
+        switch (mode % 4) {
+            case 0: a[c] = v; break;
+            case 1: a[c] = fabs(u - 0.5) < 0.25 && fabs(t - 0.5) < 0.25 ? v : w; break;
+            case 2: a[c] = v + w * u; break;
+            default: a[c] = table[prng_below(ms->p, (unsigned)ntable)]; break;
+        }
+    }
+    if ((mode & 0xc0) == 0xc0) {
+        static const double bad[] = {NAN, INFINITY, -INFINITY};
+        a[prng_below(ms->p, (unsigned)m->ncells)] = bad[u8(r) % 3];
+        return 1;
+    }
+    return 0;
+}
+
+/* One step of the mesh and every check after it. */
+static void mesh_step(mesh_state_t *ms, reader_t *r) {
+    const mesh_t *m = ms->m;
+    const unsigned b = u8(r);
+    const double dt = 1e-3 * pow(10.0, 4.0 * (double)(b & 0x7f) / 127.0); /* 1e-3 .. 10 */
+    const int through_restart = (b & 0x80) != 0;
+    msnap_t before;
+    mesh_snap(ms, &before);
+    const int sourced = mesh_source_active(ms);
+    double held_lo = 0.0, held_hi = 0.0;
+    const int held = mesh_held_range(ms, before.h, &held_lo, &held_hi);
+    const int limited = sourced || (held && held_lo != held_hi);
+    const double needed = ceil(dt / before.stable_dt), limit = (double)ms->max_substeps;
+    int want = limited && needed > limit ? DPSM_ERR_WORK_LIMIT : DPSM_OK;
+    const int either = limited && fabs(needed - limit) <= 1.0;
+    /* Bounded work: a scene at rest by itself stops early, but how early depends on it. */
+    const double cost = (want == DPSM_OK || either ? fmax(needed, 1.0) : 1.0) * (double)m->ncells * (through_restart ? 2 : 1);
+    if (g_work + cost > kWorkBudget) {
+        free(before.h);
+        return;
+    }
+    g_work += cost;
+    double lo = held ? held_lo : INFINITY, hi = held ? held_hi : -INFINITY;
+    for (int64_t c = 0; c < m->ncells; ++c)
+        if (ms->kinds[c] == DPSM_CELL_SAND) lo = fmin(lo, before.h[c]), hi = fmax(hi, before.h[c]);
+
+    dpsm_grid *copy = NULL;
+    if (through_restart) {
+        g_op = "dpsm_save";
+        const char *path = restart_path();
+        if (dpsm_save(ms->g, path) != DPSM_OK) die("dpsm_save(%s) of a mesh failed: %s", path, dpsm_last_error(ms->g));
+        g_op = "dpsm_load";
+        if (dpsm_load(path, &copy) != DPSM_OK || !copy) die("dpsm_load(%s) of a mesh failed: %s", path, dpsm_last_error(NULL));
+        int64_t sx = 0, sy = 0, nf = 0;
+        if (dpsm_get_shape(copy, &sx, &sy) != DPSM_OK || sx != m->ncells || sy != 1 ||
+            dpsm_get_face_count(copy, &nf) != DPSM_OK || nf != m->nfaces)
+            die("the loaded mesh is %lld x %lld with %lld faces, not %lld x 1 with %lld", (long long)sx, (long long)sy,
+                (long long)nf, (long long)m->ncells, (long long)m->nfaces);
+        mesh_state_t other = *ms;
+        other.g = copy;
+        msnap_t loaded;
+        mesh_snap(&other, &loaded);
+        mesh_same(ms, &before, &loaded, "a mesh loaded from a restart file");
+        free(loaded.h);
+    }
+    g_op = "dpsm_step";
+    const int st = dpsm_step(ms->g, dt);
+    trace("dpsm_step(%g = %g stable steps) on a mesh of %lld cells, %s", dt, dt / before.stable_dt,
+          (long long)m->ncells, limited ? "driven" : "not driven");
+    if (either && (st == DPSM_OK || st == DPSM_ERR_WORK_LIMIT)) want = st;
+    mesh_expect(ms, st, want, "dpsm_step", &before);
+    if (st != DPSM_OK) {
+        if (copy && dpsm_step(copy, dt) != st) die("the loaded mesh's step did not fail as the mesh's did");
+        dpsm_destroy(copy);
+        free(before.h);
+        return;
+    }
+    msnap_t after;
+    mesh_snap(ms, &after);
+    mesh_check_state(ms, &after);
+    double info[5];
+    for (int i = 0; i < 5; ++i)
+        if (dpsm_get_step_info(ms->g, i, &info[i]) != DPSM_OK) die("dpsm_get_step_info failed on a mesh");
+    for (int64_t c = 0; c < m->ncells; ++c) {
+        if (ms->kinds[c] != DPSM_CELL_SAND && memcmp(&after.h[c], &before.h[c], sizeof(double)) != 0)
+            die("the held height of mesh cell %lld changed from %.17g to %.17g", (long long)c, before.h[c], after.h[c]);
+        if (!sourced && !(held && held_lo != held_hi) && ms->kinds[c] == DPSM_CELL_SAND && hi >= lo) {
+            const double magnitude = fmax(fmax(fabs(hi), fabs(lo)), DBL_MIN);
+            if ((after.h[c] - hi) / magnitude > 4 * DBL_EPSILON || (lo - after.h[c]) / magnitude > 4 * DBL_EPSILON)
+                die("new extremum on a mesh without a source: cell %lld at %.17g outside [%.17g, %.17g]", (long long)c,
+                    after.h[c], lo, hi);
+        }
+    }
+    if (ms->record) {
+        g_op = "dpsm_get_face_fluxes";
+        double *fx = xcalloc((size_t)m->nfaces, sizeof(double));
+        const int fst = dpsm_get_face_fluxes(ms->g, fx, NULL);
+        if (fst != DPSM_OK) die("face fluxes are recorded, but after a step on a mesh: %s (%s)", dpsm_status_string(fst), dpsm_last_error(ms->g));
+        double *in = xcalloc((size_t)m->ncells, sizeof(double)), *gross = xcalloc((size_t)m->ncells, sizeof(double));
+        double largest = 0.0, edge = 0.0, edge_gross = 0.0;
+        for (int64_t f = 0; f < m->nfaces; ++f) {
+            const int64_t a = m->face_cells[2 * f], c = m->face_cells[2 * f + 1];
+            const double v = fx[f];
+            if (!isfinite(v)) die("face %lld carried %g", (long long)f, v);
+            largest = fmax(largest, fabs(v));
+            in[a] -= v, gross[a] += fabs(v);
+            if (c >= 0) {
+                in[c] += v, gross[c] += fabs(v);
+                if (v != 0.0 && (ms->kinds[a] == DPSM_CELL_WALL || ms->kinds[c] == DPSM_CELL_WALL ||
+                                 (ms->kinds[a] != DPSM_CELL_SAND && ms->kinds[c] != DPSM_CELL_SAND)))
+                    die("face %lld between cells %lld and %lld (kinds %d, %d) carried %g", (long long)f, (long long)a,
+                        (long long)c, ms->kinds[a], ms->kinds[c], v);
+            } else {
+                if (v != 0.0 && (!ms->edge_open[f] || ms->kinds[a] == DPSM_CELL_WALL))
+                    die("edge face %lld (%s, cell %lld of kind %d) carried %g", (long long)f,
+                        ms->edge_open[f] ? "open" : "a wall", (long long)a, ms->kinds[a], v);
+                edge += v, edge_gross += fabs(v);
+            }
+        }
+        const double rel_steps = 16.0 * DBL_EPSILON * fmax(info[DPSM_INFO_SUBSTEPS], 1.0);
+        const double time = info[DPSM_INFO_TIME_INTEGRATED];
+        double into_open = 0.0, scale_all = 0.0;
+        for (int64_t c = 0; c < m->ncells; ++c) {
+            if (ms->kinds[c] == DPSM_CELL_OPEN) into_open += in[c];
+            if (ms->kinds[c] != DPSM_CELL_SAND) continue;
+            const double q = ms->source ? ms->source[c] * time * m->area[c] : 0.0;
+            const double change = (after.h[c] - before.h[c]) * m->area[c] - q;
+            const double tol = 1e-9 * largest + rel_steps * ((fabs(before.h[c]) + fabs(after.h[c])) * m->area[c] + fabs(q) + gross[c]) + DBL_MIN;
+            scale_all += (fabs(before.h[c]) + fabs(after.h[c])) * m->area[c] + fabs(q) + gross[c];
+            if (fabs(change - in[c]) > tol)
+                die("mesh cell %lld (area %.17g) changed by %.17g less its source %.17g; its faces brought %.17g: off "
+                    "by %.3g, largest face %.3g",
+                    (long long)c, m->area[c], (after.h[c] - before.h[c]) * m->area[c], q, in[c], change - in[c], largest);
+        }
+        const double booked = after.edge_out - before.edge_out;
+        const double edge_tol = 1e-9 * fmax(largest, edge_gross) + rel_steps * (edge_gross + fabs(before.edge_out) + fabs(after.edge_out)) + DBL_MIN;
+        if (fabs(edge - booked) > edge_tol)
+            die("the mesh's edge faces carried %.17g out, dpsm_get_side_outflow(DPSM_MESH_EDGE) grew by %.17g", edge, booked);
+        const double outflow = after.mass[3] - before.mass[3];
+        const double out_tol = 1e-9 * fmax(largest, 1e-300) * (double)m->nfaces +
+                               rel_steps * (scale_all + fabs(before.mass[3]) + fabs(after.mass[3])) + DBL_MIN;
+        if (fabs(outflow - booked - into_open) > out_tol)
+            die("OUTFLOW grew by %.17g; the edge took %.17g, the open cells %.17g", outflow, booked, into_open);
+        free(fx);
+        free(in);
+        free(gross);
+    }
+    if (copy) {
+        g_op = "dpsm_step (loaded mesh)";
+        if (dpsm_step(copy, dt) != DPSM_OK) die("the loaded mesh's step failed: %s", dpsm_last_error(copy));
+        mesh_state_t other = *ms;
+        other.g = copy;
+        msnap_t stepped;
+        mesh_snap(&other, &stepped);
+        mesh_same(ms, &after, &stepped, "a mesh loaded from a restart file, after a step");
+        free(stepped.h);
+        dpsm_destroy(copy);
+    }
+    free(after.h);
+    free(before.h);
+}
+
+/* One operation on a live mesh: its opcode byte % 10, then its arguments. */
+static void mesh_operation(mesh_state_t *ms, reader_t *r) {
+    const mesh_t *m = ms->m;
+    const int64_t n = m->ncells, nf = m->nfaces;
+    const unsigned op = u8(r) % 10;
+    switch (op) {
+        case 0: { /* heights: mode, v, w (kMeshHeights), [a byte for the bad value] */
+            double *h = xcalloc((size_t)n, sizeof(double));
+            const int planted = mesh_fill(r, ms, h, kMeshHeights, COUNT(kMeshHeights));
+            MESH_CALL(ms, planted ? DPSM_ERR_INVALID_VALUE : DPSM_OK, "dpsm_set_heights", dpsm_set_heights(ms->g, h));
+            free(h);
+            break;
+        }
+        case 1: { /* source: b (% 3 == 0: none), then as heights (kMeshSources) */
+            const int none = u8(r) % 3 == 0;
+            double *q = xcalloc((size_t)n, sizeof(double));
+            const int planted = none ? 0 : mesh_fill(r, ms, q, kMeshSources, COUNT(kMeshSources));
+            MESH_CALL(ms, planted ? DPSM_ERR_INVALID_VALUE : DPSM_OK, "dpsm_set_source", dpsm_set_source(ms->g, none ? NULL : q));
+            if (!planted) {
+                free(ms->source);
+                ms->source = none ? NULL : q;
+                if (!none) q = NULL;
+            }
+            free(q);
+            break;
+        }
+        case 2: { /* cell kinds: b % 4: 0 NULL (all sand), 1 mostly sand, 2 one open cell, 3 one wall; b >= 0xe0 plants a bad kind */
+            const unsigned b = u8(r);
+            uint8_t *k = NULL;
+            int want = DPSM_OK;
+            if (b % 4) {
+                k = xcalloc((size_t)n, 1);
+                for (int64_t c = 0; c < n; ++c) {
+                    const unsigned x = prng_below(ms->p, 10);
+                    k[c] = b % 4 != 1 ? DPSM_CELL_SAND : x < 8 ? DPSM_CELL_SAND : x < 9 ? DPSM_CELL_WALL : DPSM_CELL_OPEN;
+                }
+                if (b % 4 >= 2) k[prng_below(ms->p, (unsigned)n)] = b % 4 == 2 ? DPSM_CELL_OPEN : DPSM_CELL_WALL;
+                if (b >= 0xe0) {
+                    static const uint8_t bad[] = {3, 4, 200, 255};
+                    k[prng_below(ms->p, (unsigned)n)] = bad[b % 4];
+                    want = DPSM_ERR_UNKNOWN_ENUM;
+                }
+            }
+            MESH_CALL(ms, want, "dpsm_set_cell_kinds", dpsm_set_cell_kinds(ms->g, k));
+            if (want == DPSM_OK) {
+                if (k) memcpy(ms->kinds, k, (size_t)n);
+                else memset(ms->kinds, DPSM_CELL_SAND, (size_t)n);
+            }
+            free(k);
+            break;
+        }
+        case 3: { /* dpsm_set_boundary: b % 8: 0 open, 1 wall, 2 a grid's side, 3 side 5, 4 a bad kind, else open/wall */
+            const unsigned b = u8(r);
+            int side = DPSM_MESH_EDGE, kind = b % 2 ? DPSM_WALL : DPSM_OPEN, want = DPSM_OK;
+            if (b % 8 == 2) side = (int)(b / 8 % 4), want = DPSM_ERR_NOT_APPLICABLE;
+            else if (b % 8 == 3) side = 5, want = DPSM_ERR_UNKNOWN_ENUM;
+            else if (b % 8 == 4) kind = 2, want = DPSM_ERR_UNKNOWN_ENUM;
+            MESH_CALL(ms, want, "dpsm_set_boundary", dpsm_set_boundary(ms->g, side, kind));
+            if (want == DPSM_OK)
+                for (int64_t f = 0; f < nf; ++f) ms->edge_open[f] = m->face_cells[2 * f + 1] < 0 && kind == DPSM_OPEN;
+            break;
+        }
+        case 4: { /* dpsm_set_edge_kinds: b % 4: 0 NULL, 1 all open, else each edge face at random; interior faces
+                   * get any value (ignored); b >= 0xe0 plants a bad kind on an edge face */
+            const unsigned b = u8(r);
+            uint8_t *k = NULL;
+            int want = DPSM_OK;
+            if (b % 4) {
+                k = xcalloc((size_t)nf, 1);
+                for (int64_t f = 0; f < nf; ++f)
+                    k[f] = m->face_cells[2 * f + 1] >= 0 ? (uint8_t)prng_next(ms->p)
+                           : b % 4 == 1 || prng_below(ms->p, 2) ? DPSM_OPEN : DPSM_WALL;
+                if (b >= 0xe0) {
+                    int64_t f = (int64_t)prng_below(ms->p, (unsigned)nf);
+                    while (m->face_cells[2 * f + 1] >= 0) f = (f + 1) % nf;
+                    k[f] = (uint8_t)(2 + b % 200);
+                    want = DPSM_ERR_UNKNOWN_ENUM;
+                }
+            }
+            MESH_CALL(ms, want, "dpsm_set_edge_kinds", dpsm_set_edge_kinds(ms->g, k));
+            if (want == DPSM_OK)
+                for (int64_t f = 0; f < nf; ++f) ms->edge_open[f] = m->face_cells[2 * f + 1] < 0 && k && k[f] == DPSM_OPEN;
+            free(k);
+            break;
+        }
+        case 5: { /* dpsm_set_side_levels(DPSM_MESH_EDGE): b % 4: 0 NULL, 1 all one level, 2 one face
+                   * apart, 3 each its own; b >= 0xe0 plants a bad level on an edge face; levels from kMeshHeights */
+            const unsigned b = u8(r);
+            const double v = kMeshHeights[u8(r) % COUNT(kMeshHeights)], w = kMeshHeights[u8(r) % COUNT(kMeshHeights)];
+            double *levels = NULL;
+            int want = DPSM_OK;
+            if (b % 4) {
+                levels = xcalloc((size_t)nf, sizeof(double));
+                for (int64_t f = 0; f < nf; ++f)
+                    levels[f] = b % 4 == 3 ? kMeshHeights[prng_below(ms->p, COUNT(kMeshHeights))] : v;
+                if (b % 4 == 2) levels[prng_below(ms->p, (unsigned)nf)] = w;
+                if (b >= 0xe0) {
+                    static const double bad[] = {NAN, INFINITY, -INFINITY, 1e51};
+                    int64_t f = (int64_t)prng_below(ms->p, (unsigned)nf);
+                    while (m->face_cells[2 * f + 1] >= 0) f = (f + 1) % nf;
+                    levels[f] = bad[b % 4];
+                    want = DPSM_ERR_INVALID_VALUE;
+                }
+            }
+            MESH_CALL(ms, want, "dpsm_set_side_levels", dpsm_set_side_levels(ms->g, DPSM_MESH_EDGE, levels));
+            if (want == DPSM_OK)
+                for (int64_t f = 0; f < nf; ++f) ms->levels[f] = levels ? levels[f] : 0.0;
+            free(levels);
+            break;
+        }
+        case 6: { /* face fluxes: b % 4: 0 recording off, 1 on, 2 read with an fy, 3 read with a NULL fx */
+            const unsigned b = u8(r);
+            if (b % 4 < 2) {
+                MESH_CALL(ms, DPSM_OK, "dpsm_set_face_flux_recording", dpsm_set_face_flux_recording(ms->g, (int)(b % 4)));
+                ms->record = (int)(b % 4);
+            } else {
+                double *fx = xcalloc((size_t)nf, sizeof(double)), fy[1];
+                MESH_CALL(ms, b % 4 == 2 ? DPSM_ERR_INVALID_VALUE : DPSM_ERR_NULL_POINTER, "dpsm_get_face_fluxes",
+                          dpsm_get_face_fluxes(ms->g, b % 4 == 2 ? fx : NULL, b % 4 == 2 ? fy : NULL));
+                MESH_CALL(ms, ms->record ? DPSM_OK : DPSM_ERR_NOT_APPLICABLE, "dpsm_get_face_fluxes",
+                          dpsm_get_face_fluxes(ms->g, fx, NULL));
+                free(fx);
+            }
+            break;
+        }
+        case 7: { /* what a mesh does not have: blocks of cells, a grid's sides */
+            const unsigned b = u8(r);
+            double v[4] = {1.0, 1.0, 1.0, 1.0}, out = 0.0;
+            const int64_t i0 = (int64_t)(b % 3), ni = 1 + (int64_t)(b / 3 % 2);
+            MESH_CALL(ms, DPSM_ERR_NOT_APPLICABLE, "dpsm_set_heights_region", dpsm_set_heights_region(ms->g, i0, 0, ni, 1, v));
+            MESH_CALL(ms, DPSM_ERR_NOT_APPLICABLE, "dpsm_add_heights_region", dpsm_add_heights_region(ms->g, i0, 0, ni, 1, v));
+            MESH_CALL(ms, DPSM_ERR_NOT_APPLICABLE, "dpsm_get_heights_region", dpsm_get_heights_region(ms->g, i0, 0, ni, 1, v));
+            MESH_CALL(ms, DPSM_ERR_NOT_APPLICABLE, "dpsm_get_side_outflow", dpsm_get_side_outflow(ms->g, (int)(b % 4), &out));
+            MESH_CALL(ms, DPSM_ERR_UNKNOWN_ENUM, "dpsm_get_side_outflow", dpsm_get_side_outflow(ms->g, 5 + (int)(b % 3), &out));
+            MESH_CALL(ms, DPSM_ERR_NOT_APPLICABLE, "dpsm_set_side_levels", dpsm_set_side_levels(ms->g, (int)(b % 4), v));
+            /* The mesh functions without a mesh. */
+            int64_t count = 0;
+            static const char *const names[] = {"dpsm_get_face_count", "dpsm_get_mesh_faces", "dpsm_set_edge_kinds"};
+            for (int k = 0; k < 3; ++k) {
+                g_op = names[k];
+                const int got = k == 0 ? dpsm_get_face_count(NULL, &count)
+                                : k == 1 ? dpsm_get_mesh_faces(NULL, &count) : dpsm_set_edge_kinds(NULL, NULL);
+                expect_status(got, DPSM_ERR_NULL_POINTER, g_op, NULL);
+                check_failed(NULL, NULL, NULL, got, g_op);
+            }
+            break;
+        }
+        case 8: { /* dpsm_set_max_substeps */
+            static const int64_t values[] = {1, 3, 50, MESH_MAX_SUBSTEPS};
+            const int64_t v = values[u8(r) % COUNT(values)];
+            MESH_CALL(ms, DPSM_OK, "dpsm_set_max_substeps", dpsm_set_max_substeps(ms->g, v));
+            ms->max_substeps = v;
+            break;
+        }
+        default:
+            mesh_step(ms, r);
+            break;
+    }
+    msnap_t now;
+    mesh_snap(ms, &now);
+    mesh_check_state(ms, &now);
+    free(now.h);
+}
+
+static void op_mesh(reader_t *r) {
+    g_op = "mesh";
+    const unsigned kind_byte = u8(r);
+    const int kind = (int)(kind_byte % 3), lattice = kind == MESH_DUAL ? 1 : (int)(kind_byte / 3 % 3);
+    const int64_t nx = 2 + (int64_t)(u8(r) % 7), ny = 2 + (int64_t)(u8(r) % 7);
+    const double dx = kMeshSpacings[u8(r) % COUNT(kMeshSpacings)], dy = kMeshSpacings[u8(r) % COUNT(kMeshSpacings)];
+    const double jitter = 0.06 * (double)(u8(r) % 5);
+    const unsigned seed = u16(r);
+    const unsigned defect_byte = u8(r), nops = u8(r) % 16;
+    prng_t p = {0x9E3779B97F4A7C15ULL ^ ((uint64_t)seed * 0x100000001B3ULL + 1u)};
+    mesh_t m;
+    mesh_build(&m, kind, lattice, nx, ny, dx, dy, jitter, &p);
+    mesh_derive(&m, &p);
+    const int defect = (defect_byte & 0xc0) == 0xc0 ? (int)(defect_byte & 0x3f) : -1;
+    const char *fn = kMeshFunctions[kind], *what;
+    dpsm_grid *g;
+    int want;
+    g_op = fn;
+    const int st = mesh_construct(&m, defect, &p, &g, &want, &what);
+    trace("%s (%lld x %lld %s, defect: %s) -> %s", fn, (long long)nx, (long long)ny,
+          lattice == 0 ? "quads" : lattice == 1 ? "triangles" : "mixed", what, dpsm_status_string(st));
+    if (st != want)
+        die("%s with %s returned %s, expected %s (%s)", fn, what, dpsm_status_string(st), dpsm_status_string(want),
+            dpsm_last_error(NULL));
+    if (st != DPSM_OK) {
+        check_failed(NULL, NULL, NULL, st, fn);
+        if (g != NULL) die("%s failed (%s) but did not set *out to NULL", fn, what);
+        mesh_free(&m);
+        return;
+    }
+    if (*dpsm_last_error(NULL)) die("%s succeeded but left the message \"%s\"", fn, dpsm_last_error(NULL));
+    /* The shape, and the faces the harness expects. */
+    int64_t sx = 0, sy = 0, nf = 0;
+    if (dpsm_get_shape(g, &sx, &sy) != DPSM_OK || sx != m.ncells || sy != 1)
+        die("the mesh's shape is %lld x %lld, not %lld x 1", (long long)sx, (long long)sy, (long long)m.ncells);
+    if (dpsm_get_face_count(g, &nf) != DPSM_OK || nf != m.nfaces)
+        die("the mesh has %lld faces, not %lld", (long long)nf, (long long)m.nfaces);
+    int64_t *faces = xcalloc((size_t)(2 * nf), sizeof(int64_t));
+    uint8_t *seen = xcalloc((size_t)m.ncells, 1);
+    if (dpsm_get_mesh_faces(g, faces) != DPSM_OK) die("dpsm_get_mesh_faces failed: %s", dpsm_last_error(g));
+    for (int64_t f = 0; f < nf; ++f) {
+        const int64_t a = faces[2 * f], b = faces[2 * f + 1];
+        if (a < 0 || a >= m.ncells || b < -1 || b >= m.ncells || a == b)
+            die("face %lld joins cells %lld and %lld of %lld", (long long)f, (long long)a, (long long)b, (long long)m.ncells);
+        if (a != m.face_cells[2 * f] || b != m.face_cells[2 * f + 1])
+            die("face %lld joins cells %lld and %lld; the harness expected %lld and %lld", (long long)f, (long long)a,
+                (long long)b, (long long)m.face_cells[2 * f], (long long)m.face_cells[2 * f + 1]);
+        seen[a] = 1;
+        if (b >= 0) seen[b] = 1;
+    }
+    for (int64_t c = 0; c < m.ncells; ++c)
+        if (!seen[c]) die("mesh cell %lld is in no face", (long long)c);
+    free(faces);
+    free(seen);
+    {
+        static const char *const names[] = {"dpsm_get_face_count", "dpsm_get_mesh_faces"};
+        for (int k = 0; k < 2; ++k) {
+            g_op = names[k];
+            const int got = k == 0 ? dpsm_get_face_count(g, NULL) : dpsm_get_mesh_faces(g, NULL);
+            expect_status(got, DPSM_ERR_NULL_POINTER, g_op, g);
+            check_failed(NULL, g, NULL, got, g_op);
+        }
+    }
+    mesh_state_t ms = {0};
+    ms.m = &m;
+    ms.g = g;
+    ms.p = &p;
+    ms.kinds = xcalloc((size_t)m.ncells, 1);
+    ms.edge_open = xcalloc((size_t)m.nfaces, 1);
+    ms.levels = xcalloc((size_t)m.nfaces, sizeof(double));
+    ms.max_substeps = MESH_MAX_SUBSTEPS;
+    g_op = "dpsm_set_max_substeps";
+    if (dpsm_set_max_substeps(g, MESH_MAX_SUBSTEPS) != DPSM_OK) die("dpsm_set_max_substeps failed on a mesh");
+    for (unsigned k = 0; k < nops && more(r); ++k) mesh_operation(&ms, r);
+    dpsm_destroy(g);
+    free(ms.kinds);
+    free(ms.edge_open);
+    free(ms.levels);
+    free(ms.source);
+    mesh_free(&m);
+}
+
+/* ------------------------------------------------------------------------ */
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
     reader_t r = {data, size, 0};
@@ -1484,8 +2453,10 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
         ++g_opcount;
         /* Bytes from kLaterOps on name the operations added later, so that
          * older inputs (the corpus' regression_* files) replay as they did. */
-        const unsigned byte = u8(&r), op = byte >= kLaterOps ? 25 : byte % 25;
-        if (op < 2)
+        const unsigned byte = u8(&r), op = byte == kMeshOp ? 26 : byte >= kLaterOps ? 25 : byte % 25;
+        if (op == 26)
+            op_mesh(&r);
+        else if (op < 2)
             op_create(&r);
         else if (op < 9)
             op_parameter(&r, op - 2);

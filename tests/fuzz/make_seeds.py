@@ -25,6 +25,7 @@ COUPLING = 250
 #   which 3 dpsm_get_face_fluxes: b % 3: 0 the arrays the grid takes, 1 no fx,
 #            2 the other fy (none in 2D, one on a line)
 # NULL_GRID, 250 .. 253: the four coupling functions with a NULL grid
+# MESH (251) is op_mesh: a mesh of its own (see the meshes below)
 # RELAX, slot, dt byte (0xe0 + 0..6: a bad dt; else 1): one step relaxed to rest
 # PHYSICS, slot, which (0 bed, 1 angle field, 2 flux exponent, 3 static angle), then:
 #   bed: mode (0 removes; else a fill pattern of depths below the surface follows;
@@ -253,6 +254,110 @@ seed("coupling_relax_2d", create(0, "2d", 9, 9), all_open(0, "2d"), coupling(0, 
 seed("coupling_large_2d", create(0, "2d", 71, 65), coupling(0, 2, RECORD_ON), all_open(0, "2d"),
      region(SET_REGION, 0, 30, 30, 4, 4, 0, 30.0, 0.0), step(0, 10.0), step(0, 100.0),
      region(SET_REGION, 0, 2, 2, 2, 2, 0, 10.0, 0.0), step(0, 100.0), coupling(0, 3, 0))
+
+# Meshes (op_mesh in fuzz_api.c): byte MESH, then kind (% 3: 0 polygons, 1
+# graph, 2 dual; / 3: 0 quads, 1 triangles, 2 mixed), nx - 2, ny - 2, two
+# kMeshSpacings indices, jitter (x 0.06), a u16 seed, a defect byte (0xc0 + k
+# plants defect k, which the constructor must refuse; else a valid mesh) and
+# the number of operations on the mesh, each an opcode byte and arguments:
+MESH = 251
+MESH_KIND = {"polygons": 0, "graph": 1, "dual": 2}
+MESH_LATTICE = {"quads": 0, "triangles": 1, "mixed": 2}
+MESH_SPACING = {1.0: 0, 0.5: 1, 2.0: 2, 0.25: 3, 4.0: 4}
+# kMeshHeights and kMeshSources indices
+MH = {0.0: 0, 1.0: 1, 3.0: 2, 10.0: 3, -1.0: 4, 0.5: 5, 30.0: 6, 100.0: 7, -3.0: 8, 1e3: 9, 0.25: 10, 7.0: 11}
+MQ = {0.0: 0, 1e-3: 1, -1e-3: 2, 0.1: 3, -0.1: 4, 1.0: 5, 1e-9: 7}
+
+
+def mesh(kind, lattice, nx, ny, dx=1.0, dy=1.0, jitter=3, seed=1, defect=None, ops=()):
+    return [MESH, MESH_KIND[kind] + 3 * MESH_LATTICE[lattice], nx - 2, ny - 2, MESH_SPACING[dx], MESH_SPACING[dy],
+            jitter, seed & 0xFF, seed >> 8, 0 if defect is None else 0xC0 + defect, len(ops)] + sum(ops, [])
+
+
+def m_fill(mode, v, w, table, plant=None):
+    """mode 0 const v, 1 a central pile of v on w, 2 ramp v + w*x, 3 each cell its own; plant: 0 NaN, 1 Inf, 2 -Inf"""
+    return [mode | (0xC0 if plant is not None else 0), table[v], table[w]] + ([plant] if plant is not None else [])
+
+
+def m_heights(mode, v, w=0.0, plant=None):
+    return [0] + m_fill(mode, v, w, MH, plant)
+
+
+def m_source(mode=0, v=0.0, w=0.0, plant=None, none=False):
+    return [1, 0] if none else [1, 1] + m_fill(mode, v, w, MQ, plant)
+
+
+def m_kinds(b):  # b % 4: 0 all sand, 1 mostly sand, 2 one open cell, 3 one wall; b >= 0xe0: a bad kind
+    return [2, b]
+
+
+def m_boundary(b):  # b % 8: 0 open, 1 wall, 2 a grid's side, 3 side 5, 4 a bad kind
+    return [3, b]
+
+
+def m_edge_kinds(b):  # b % 4: 0 NULL, 1 all open, 2-3 at random; b >= 0xe0: a bad kind on an edge face
+    return [4, b]
+
+
+def m_levels(b, v=0.0, w=0.0):  # b % 4: 0 NULL, 1 all v, 2 one face at w, 3 each its own; b >= 0xe0: a bad level
+    return [5, b, MH[v], MH[w]]
+
+
+def m_fluxes(b):  # b % 4: 0 recording off, 1 on, 2 read with an fy, 3 read with a NULL fx
+    return [6, b]
+
+
+def m_absent(b=0):  # the _region functions, a grid's sides, mesh functions on NULL
+    return [7, b]
+
+
+def m_max_substeps(k):  # {1, 3, 50, 20000}[k]
+    return [8, k]
+
+
+def m_step(k, restart=False):  # dt = 1e-3 * 10^(4 k / 127): k = 127 is 10, 95 about 1, 64 about 0.1
+    return [9, k | (0x80 if restart else 0)]
+
+
+seed("mesh_polygons",
+     mesh("polygons", "quads", 6, 5, jitter=4, seed=7, ops=[
+         m_heights(1, 10.0, 0.0), m_fluxes(1), m_step(95), m_step(127, restart=True), m_boundary(0),
+         m_step(95, restart=True), m_kinds(2), m_step(127), m_edge_kinds(2), m_levels(1, 1.0), m_step(127, True),
+         m_absent(5), m_fluxes(2), m_fluxes(3), m_step(64)]),
+     mesh("polygons", "mixed", 8, 8, dx=0.5, dy=2.0, seed=300, ops=[
+         m_heights(2, 0.0, 30.0), m_kinds(1), m_fluxes(1), m_step(127, True), m_edge_kinds(1), m_step(127),
+         m_levels(3), m_max_substeps(2), m_step(127), m_step(64, True), m_levels(0), m_heights(3, 0.0),
+         m_step(127)]),
+     mesh("polygons", "triangles", 2, 2, jitter=0, ops=[m_heights(1, 3.0, 0.0), m_step(127), m_boundary(0),
+                                                        m_step(127, True)]))
+seed("mesh_graph",
+     mesh("graph", "triangles", 5, 4, seed=11, ops=[
+         m_heights(1, 30.0, 1.0), m_fluxes(1), m_step(127, True), m_boundary(0), m_step(127), m_source(1, 0.1),
+         m_step(64), m_max_substeps(1), m_step(127), m_step(10, True), m_source(none=True), m_kinds(3),
+         m_step(127, True), m_absent(1), m_step(127)]),
+     mesh("graph", "quads", 7, 3, dx=2.0, dy=0.5, jitter=2, seed=999, ops=[
+         m_heights(2, 0.0, 10.0), m_fluxes(1), m_edge_kinds(3), m_levels(2, 0.0, 3.0), m_step(127, True),
+         m_max_substeps(0), m_step(127), m_max_substeps(3), m_step(127), m_kinds(1), m_step(127, True)]),
+     mesh("graph", "mixed", 4, 8, seed=4242, ops=[m_heights(3, 0.0), m_fluxes(1), m_step(127), m_step(127, True)]))
+seed("mesh_dual",
+     mesh("dual", "triangles", 7, 6, seed=5, ops=[
+         m_heights(1, 10.0, 0.0), m_fluxes(1), m_step(127, True), m_boundary(0), m_step(127), m_kinds(2),
+         m_step(127, True), m_source(0, 1e-3), m_step(95), m_max_substeps(0), m_step(127), m_source(none=True),
+         m_edge_kinds(2), m_step(127, True), m_step(127)]),
+     mesh("dual", "triangles", 3, 8, dx=0.25, dy=4.0, jitter=4, seed=77, ops=[
+         m_heights(2, 1.0, 100.0), m_boundary(0), m_levels(1, 100.0), m_fluxes(1), m_step(127, True),
+         m_levels(2, 1.0, 0.0), m_step(64), m_step(127)]))
+seed("mesh_bad_polygons", *[mesh("polygons", ("quads", "triangles", "mixed")[k % 3], 3 + k % 4, 2 + k % 3,
+                                  seed=k + 1, defect=k) for k in range(11)],
+     mesh("polygons", "quads", 3, 3, ops=[m_heights(0, 1.0, plant=0), m_absent(2)]))
+seed("mesh_bad_graph", *[mesh("graph", ("quads", "triangles", "mixed")[k % 3], 2 + k % 4, 3 + k % 3,
+                               seed=k + 20, defect=k) for k in range(11)],
+     mesh("graph", "triangles", 3, 3, ops=[m_source(0, 0.1, plant=1), m_kinds(0xE1), m_boundary(3),
+                                          m_boundary(4), m_boundary(2)]))
+seed("mesh_bad_dual", *[mesh("dual", "triangles", 2 + k % 5, 2 + k % 4, seed=k + 40, defect=k) for k in range(9)],
+     mesh("dual", "triangles", 4, 4, ops=[m_heights(1, 3.0, 0.0), m_edge_kinds(0xE2), m_levels(0xE1, 1.0),
+                                          m_levels(0xE3, 1.0), m_heights(3, 0.0, plant=2), m_fluxes(0x02),
+                                          m_step(127)]))
 
 rng = random.Random(20240611)
 for k in range(8):
