@@ -507,8 +507,10 @@ DPSM_API int dpsm_set_boundary(dpsm_grid *g, int side, int kind);
  * @param levels  one finite value per boundary face, within the supported
  *                range: `ny` values for ::DPSM_XMIN and ::DPSM_XMAX (face `j`
  *                beside cell `(0, j)` or `(nx-1, j)`), `nx` for ::DPSM_YMIN and
- *                ::DPSM_YMAX; on a 1D or axisymmetric grid one value. NULL
- *                returns the side to 0.
+ *                ::DPSM_YMAX; on a 1D or axisymmetric grid one value; on a
+ *                mesh (side ::DPSM_MESH_EDGE) one per face, those of faces
+ *                between two cells finite but not used. NULL returns the side
+ *                to 0.
  * @return ::DPSM_OK, ::DPSM_ERR_NULL_POINTER, ::DPSM_ERR_UNKNOWN_ENUM,
  *         ::DPSM_ERR_NOT_APPLICABLE (a side the grid does not have) or
  *         ::DPSM_ERR_INVALID_VALUE (the message names the face).

@@ -236,13 +236,16 @@ std::shared_ptr<const Mesh> assemble(MeshInput &&input, const RawCells &cells, c
     for (std::int64_t c = 0; c < m.cells; ++c) m.cell_face_start[c + 1] += m.cell_face_start[c];
     m.cell_faces.resize(m.cell_face_start[m.cells]);
     m.other.resize(m.cell_faces.size());
+    m.into.resize(m.cell_faces.size());
     std::vector<std::int64_t> fill(m.cell_face_start.begin(), m.cell_face_start.end() - 1);
     for (std::size_t f = 0; f < nf; ++f) {
         const std::int64_t a = m.face_a[f], b = m.face_b[f];
         m.cell_faces[fill[a]] = static_cast<std::int64_t>(f);
+        m.into[fill[a]] = -1.0;
         m.other[fill[a]++] = b;
         if (b >= 0) {
             m.cell_faces[fill[b]] = static_cast<std::int64_t>(f);
+            m.into[fill[b]] = 1.0;
             m.other[fill[b]++] = a;
         }
     }

@@ -39,6 +39,9 @@ struct Mesh {
     // in increasing face order; a face's other cell is `other` at the same
     // place (-1 on the domain edge).
     std::vector<std::int64_t> cell_face_start, cell_faces, other;
+    // At the same place: +1 where the face's flux (from its a to its b)
+    // enters the cell, -1 where it leaves.
+    std::vector<double> into;
     // The least-squares gradient of cell c is the sum over
     // grad_cells[grad_start[c] .. grad_start[c + 1]) of (grad_wx, grad_wy) *
     // (h_n - h_c): over the cells across its faces, and on meshes whose

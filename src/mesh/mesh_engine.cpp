@@ -148,12 +148,16 @@ void gradient_of(const Mesh &m, const double *h, const std::uint8_t *kind, std::
 
 // The net rate of cell c from its faces' fluxes, summed in the cell's face
 // order whichever faces a sub-step evaluated (the others carry 0).
-inline double net_rate(const Mesh &m, const double *flux, std::int64_t c) {
+// Whether any face carried sand is returned in `carried`.
+inline double net_rate(const Mesh &m, const double *flux, std::int64_t c, bool &carried) {
     double rate = 0.0;
+    bool any = false;
     for (std::int64_t k = m.cell_face_start[c]; k < m.cell_face_start[c + 1]; ++k) {
-        const std::int64_t f = m.cell_faces[k];
-        rate += m.face_a[f] == c ? -flux[f] : flux[f];
+        const double v = flux[m.cell_faces[k]];
+        any = any || v != 0.0;
+        rate += m.into[k] * v;
     }
+    carried = any;
     return rate / m.area[c];
 }
 
@@ -286,12 +290,10 @@ private:
 #pragma omp parallel for num_threads(threads) if (parallel) schedule(static) reduction(+ : changed_cells)
             for (std::int64_t c = 0; c < n; ++c) {
                 bool carried = false;
-                for (std::int64_t k = m.cell_face_start[c]; k < m.cell_face_start[c + 1]; ++k)
-                    carried = carried || flux[m.cell_faces[k]] != 0.0;
+                double rate = net_rate(m, flux, c, carried);
                 changed[c] = carried;
                 changed_cells += carried;
                 if (kind[c] != kSand) continue;
-                double rate = carried ? net_rate(m, flux, c) : 0.0;
                 if (has_source) rate += zb.empty() ? q[c] : source_applied(zb, h, q, c, dt);
                 if (rate != 0.0) add_with_residual(h[c], residual[c], dt * rate);
                 if (!zb.empty() && h[c] < zb[c]) {
@@ -363,7 +365,8 @@ private:
                 }
             for (const std::int64_t c : s.update_cells) {
                 if (kind[c] != kSand) continue;
-                double rate = net_rate(m, s.flux.data(), c);
+                bool carried = false;
+                double rate = net_rate(m, s.flux.data(), c, carried);
                 if (!q.empty()) rate += q[c];
                 if (rate != 0.0) add_with_residual(h[c], residual[c], dt * rate);
             }
