@@ -32,7 +32,8 @@ const char *scene_name(scene_kind kind) {
 }
 
 /* The lattice of (n+1)^2 nodes over the square, jittered inside by up to
- * `jitter` of the spacing (nodes on the sides move along them only). */
+ * `jitter` of the spacing along each axis (nodes on the sides move along
+ * them only). */
 static void lattice_nodes(mesh_scene *s, int n, double half, double jitter, unsigned seed) {
     const double h = 2.0 * half / n;
     s->nnodes = (int64_t)(n + 1) * (n + 1);
@@ -96,6 +97,34 @@ static void make_lattice_polygons(mesh_scene *s, int n, int triangles) {
             }
         }
     s->cell_start[p] = k;
+}
+
+/* Triangles over the lattice jittered by up to 0.3 of the spacing along each
+ * axis, each square split along its shorter diagonal (as a Delaunay
+ * triangulation would); a node of a triangle with less than a quarter of the
+ * unjittered area moves halfway back to its lattice place until none is
+ * left, as a mesh generator keeps its triangles from slivers (whose small
+ * sub-step would set the pace of the whole mesh). */
+static void jittered_triangles(mesh_scene *s, int n, double half, unsigned seed) {
+    lattice_nodes(s, n, half, 0.3, seed);
+    const double h = 2.0 * half / n;
+    for (int round = 0; round < 20; ++round) {
+        free(s->cell_start), free(s->cell_nodes);
+        make_lattice_polygons(s, n, 1);
+        int moved = 0;
+        for (int64_t t = 0; t < s->npolygons; ++t) {
+            double cx, cy;
+            if (polygon_area(s->node_xy, s->cell_nodes + 3 * t, 3, &cx, &cy) >= 0.125 * h * h) continue;
+            for (int v = 0; v < 3; ++v) {
+                const int64_t k = s->cell_nodes[3 * t + v];
+                const int64_t i = k % (n + 1), j = k / (n + 1);
+                s->node_xy[2 * k] = 0.5 * (s->node_xy[2 * k] + (-half + i * h));
+                s->node_xy[2 * k + 1] = 0.5 * (s->node_xy[2 * k + 1] + (-half + j * h));
+            }
+            moved = 1;
+        }
+        if (!moved) break;
+    }
 }
 
 /* Pointy-top hexagons of width w (flat sides left and right) whose centres lie
@@ -236,8 +265,7 @@ mesh_scene scene_make(scene_kind kind, int n, double half, unsigned seed) {
             polygon_cells(&s);
             break;
         case SCENE_TRIANGLES:
-            lattice_nodes(&s, n, half, 0.3, seed);
-            make_lattice_polygons(&s, n, 1);
+            jittered_triangles(&s, n, half, seed);
             polygon_cells(&s);
             break;
         case SCENE_HEXAGONS:
@@ -245,8 +273,7 @@ mesh_scene scene_make(scene_kind kind, int n, double half, unsigned seed) {
             polygon_cells(&s);
             break;
         case SCENE_DUAL: {
-            lattice_nodes(&s, n, half, 0.3, seed);
-            make_lattice_polygons(&s, n, 1);
+            jittered_triangles(&s, n, half, seed);
             /* triangles as 3 nodes each, cell_start unused by the dual */
             dual_cells(&s);
             break;
