@@ -360,8 +360,10 @@ int cmd_mesh(int argc, char **argv) {
                updates, 100.0 * updates / s.cells);
         fflush(stdout);
     }
-    /* Idle: the same mesh at rest. */
+    /* Idle: the same mesh at rest (a gentle plane; the edge closed, or the
+     * plane would drain over it). */
     for (int64_t c = 0; c < s.cells; ++c) h[c] = 0.1 * s.cx[c];
+    CHECK(g, dpsm_set_boundary(g, DPSM_MESH_EDGE, DPSM_WALL));
     CHECK(g, dpsm_set_heights(g, h));
     CHECK(g, dpsm_step(g, dt));
     double best = 1e300;
