@@ -308,14 +308,16 @@ private:
             }
             // The next sub-step looks at the cells that changed and those whose
             // gradients read them; where that is most of the mesh, at all.
-            const double reach = static_cast<double>(m.grad_cells.size()) / static_cast<double>(n) + 1.0;
-            const double woken = reach * static_cast<double>(changed_cells + static_cast<std::int64_t>(s.source_cells.size()));
-            if (woken > kDenseShare * static_cast<double>(n)) {
+            const std::size_t most = static_cast<std::size_t>(kDenseShare * static_cast<double>(n));
+            if (static_cast<std::size_t>(changed_cells) + s.source_cells.size() > most) {
                 act.wake_all();
             } else {
                 act.cool_all();
-                for (std::int64_t c = 0; c < n; ++c)
-                    if (changed[c]) act.wake_around(m, c);
+                for (std::int64_t c = 0; c < n && !act.all_hot; ++c)
+                    if (changed[c]) {
+                        act.wake_around(m, c);
+                        if (act.hot_list.size() > most) act.wake_all();
+                    }
                 for (const std::int64_t c : s.source_cells) act.wake_around(m, c);
             }
         } else {
