@@ -326,6 +326,39 @@ static void test_column_rests_with_mass_and_bounds(void **state) {
     }
 }
 
+/* A rough surface (random heights) on skewed cells, stepped at the stable
+ * sub-step: every sand cell stays within the range of the heights before each
+ * step (the flux's factor held within the sub-step's bound). */
+static void test_no_new_extremum_on_rough_surfaces(void **state) {
+    (void)state;
+    const scene_kind kinds[3] = {SCENE_TRIANGLES, SCENE_DUAL, SCENE_HEXAGONS};
+    for (int k = 0; k < 3; ++k) {
+        mesh_scene s = scene_make(kinds[k], 24, 1.0, 17u);
+        dpsm_grid *g = NULL;
+        CHECK_OK(NULL, scene_create(&s, &g));
+        double *h = calloc((size_t)s.cells, sizeof(double));
+        unsigned seed = 99u;
+        for (int64_t c = 0; c < s.cells; ++c) {
+            seed = seed * 1103515245u + 12345u;
+            h[c] = 0.12 * ((seed >> 8) & 0xFFFF) / 65536.0; /* slopes near where the flux law is stiffest */
+        }
+        CHECK_OK(g, dpsm_set_heights(g, h));
+        double dt = 0.0;
+        CHECK_OK(g, dpsm_stable_dt(g, &dt));
+        for (int step = 0; step < 30; ++step) {
+            const double lo = min_of(h, (size_t)s.cells), hi = max_of(h, (size_t)s.cells);
+            CHECK_OK(g, dpsm_step(g, dt));
+            CHECK_OK(g, dpsm_get_heights(g, h));
+            REQUIRE(min_of(h, (size_t)s.cells) >= lo && max_of(h, (size_t)s.cells) <= hi,
+                    "%s, step %d: heights [%.17g, %.17g] left [%.17g, %.17g]", scene_name(kinds[k]), step,
+                    min_of(h, (size_t)s.cells), max_of(h, (size_t)s.cells), lo, hi);
+        }
+        free(h);
+        dpsm_destroy(g);
+        scene_free(&s);
+    }
+}
+
 static void test_exact_states(void **state) {
     (void)state;
     mesh_scene s = scene_make(SCENE_TRIANGLES, 16, 1.0, 3u);
@@ -628,6 +661,7 @@ int main(void) {
         cmocka_unit_test(test_bad_meshes),
         cmocka_unit_test(test_mesh_functions),
         cmocka_unit_test(test_column_rests_with_mass_and_bounds),
+        cmocka_unit_test(test_no_new_extremum_on_rough_surfaces),
         cmocka_unit_test(test_exact_states),
         cmocka_unit_test(test_host_order),
         cmocka_unit_test(test_graph_steps_as_polygons),
