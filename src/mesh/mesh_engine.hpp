@@ -14,10 +14,9 @@ namespace dpsm {
 class Engine;
 class Grid;
 
-// Near rest, a face nearly parallel to the steepest slope (its two-point
-// part, the height difference over the distance of its cells, at most this
-// share of tan(theta)) carries nothing unless its slope exceeds tan(theta)
-// by more than kMeshNearRest. Such a face would otherwise keep draining its
+// Near rest, a face nearly parallel to the steepest slope (the slope across
+// it, along its normal, at most this share of tan(theta)) carries nothing
+// unless its slope exceeds tan(theta) by more than kMeshNearRest. Such a face would otherwise keep draining its
 // small height difference for ever (geometrically, never to zero) while the
 // error of the reconstructed gradients holds its slope a little above the
 // threshold; while the pile still flows (slopes well above the threshold)
@@ -31,7 +30,7 @@ constexpr double kMeshNearRest = 1e-2;
 // pile their error is of the order of the cell size (about 1 % of tan(theta)
 // at 4,000 cells), and chasing the last 1e-6 of the slope within that error
 // took the column collapse 50 time units to rest on 7,200 jittered triangles
-// where it takes 4 at 1e-3.
+// where it takes 1.8 at 1e-4 (docs/guide_meshes.md).
 constexpr double kMeshRestTolerance = 1e-4;
 
 // The sub-step is this share of the largest monotone one, so that every
