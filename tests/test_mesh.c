@@ -260,6 +260,8 @@ static void test_mesh_functions(void **state) {
     EXPECT_FAIL_ON(g, dpsm_set_side_levels(g, DPSM_XMAX, levels), DPSM_ERR_NOT_APPLICABLE, "DPSM_MESH_EDGE");
     double v = 0.0;
     CHECK_OK(g, dpsm_get_side_outflow(g, DPSM_MESH_EDGE, &v));
+    EXPECT_FAIL_ON(g, dpsm_get_face_count(g, NULL), DPSM_ERR_NULL_POINTER, "nfaces");
+    EXPECT_FAIL_ON(g, dpsm_get_mesh_faces(g, NULL), DPSM_ERR_NULL_POINTER, "face_cells");
     dpsm_destroy(g);
 
     /* The mesh functions on a grid. */

@@ -102,7 +102,7 @@ std::vector<std::int64_t> hilbert_order(const std::vector<Vec> &centre) {
 void gradient_weights(Mesh &m) {
     const double mean_neighbours =
         static_cast<double>(m.cell_faces.size()) / static_cast<double>(m.cells);  // edges count: an upper figure
-    m.grad_rings = mean_neighbours < 4.0 ? 2 : 1;
+    const int rings = mean_neighbours < 4.0 ? 2 : 1;
     m.grad_start.assign(m.cells + 1, 0);
     m.grad_cells.clear();
     std::vector<std::int64_t> seen(m.cells, -1), ring;
@@ -113,7 +113,7 @@ void gradient_weights(Mesh &m) {
             const std::int64_t n = m.other[k];
             if (n >= 0 && seen[n] != c) seen[n] = c, ring.push_back(n);
         }
-        if (m.grad_rings > 1) {
+        if (rings > 1) {
             const std::size_t first = ring.size();
             for (std::size_t r = 0; r < first; ++r)
                 for (std::int64_t k = m.cell_face_start[ring[r]]; k < m.cell_face_start[ring[r] + 1]; ++k) {
@@ -177,7 +177,7 @@ std::shared_ptr<const Mesh> assemble(MeshInput &&input, const RawCells &cells, c
     std::sort(keyed.begin(), keyed.end());
     const std::size_t nf = faces.size();
     m.host_face.resize(nf), m.face_of_host.resize(nf), m.face_a.resize(nf), m.face_b.resize(nf);
-    m.distance.resize(nf), m.conductance.resize(nf), m.length.resize(nf), m.tangent_x.resize(nf),
+    m.distance.resize(nf), m.conductance.resize(nf), m.tangent_x.resize(nf),
         m.tangent_y.resize(nf), m.orthogonal.resize(nf), m.skew.resize(nf), m.host_sign.resize(nf);
     double smallest = 0.0;
     for (std::size_t f = 0; f < nf; ++f) {
@@ -219,7 +219,6 @@ std::shared_ptr<const Mesh> assemble(MeshInput &&input, const RawCells &cells, c
                      ca.x, ", ", ca.y, ")");
         }
         m.distance[f] = d;
-        m.length[f] = raw.length;
         m.tangent_x[f] = -e.y, m.tangent_y[f] = e.x;
         m.orthogonal[f] = std::max(0.0, dot(nl, e));
         m.skew[f] = dot(nl, Vec{m.tangent_x[f], m.tangent_y[f]});

@@ -47,11 +47,10 @@ struct Mesh {
     // (h_n - h_c): over the cells across its faces, and on meshes whose
     // cells have fewer than 4 neighbours (triangles) also over theirs, so
     // that the fit is not set by 3 points alone; none where they do not span
-    // the plane. grad_rings is how many rings of neighbours that reaches (1
-    // or 2): how far a change of height reaches into the slopes of faces.
+    // the plane. The cells a change of height reaches through gradients are
+    // the same list (the stencil is symmetric), which the active set wakes.
     std::vector<std::int64_t> grad_start, grad_cells;
     std::vector<double> grad_wx, grad_wy;
-    int grad_rings = 1;
 
     // Per face, in the library's order: cells a < b (b == -1 on the domain
     // edge), the centre-to-centre distance d (on the domain edge twice the
@@ -63,7 +62,7 @@ struct Mesh {
     // the line between its cells, as on a graph); conductance = |L n| / d
     // bounds what a face may carry per unit height difference and slope law.
     std::vector<std::int64_t> face_a, face_b;
-    std::vector<double> distance, length, tangent_x, tangent_y, orthogonal, skew, conductance;
+    std::vector<double> distance, tangent_x, tangent_y, orthogonal, skew, conductance;
     // The direction from a to b relative to the host's face (+1 or -1): a
     // host reads a face's flux as positive from its own cell a to its b.
     std::vector<signed char> host_sign;

@@ -39,7 +39,6 @@ struct MeshScratch final : EngineState {
     std::vector<std::int64_t> faces, gradient_cells, update_cells, source_cells;
     std::vector<std::int64_t> sink_faces;  // faces onto open edges or open cells
     std::vector<double> available;         // bed: the sand a face may take
-    std::vector<std::uint8_t> moving_next;
     std::vector<std::uint8_t> changed;     // dense: per cell, a face of it carried sand
     bool flux_clean = true;
     // The masks and edges sink_faces and source_cells were found for.
