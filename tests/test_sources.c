@@ -211,6 +211,53 @@ static void test_source_that_steepens_within_the_step(void **state) {
     dpsm_destroy(b);
 }
 
+/* Erosion beside an open cell (the fuzzer's ledger_2x1_bed_erosion): the
+ * sand first slides into the open cell until its face rests, then the
+ * erosion digs it below the open cell's level, so that face steepens the
+ * other way and sand flows back. Judged at the start of the step, before
+ * the sand moved, the source could steepen nothing (1.501 less the erosion
+ * of the step stays within tan(theta) dx of the open cell); the step must
+ * judge it again once the sand has moved. One call of n sub-steps against
+ * n calls of one (about 14 time units), on a line and on a 2D row; the
+ * ledger closes. */
+static void test_source_that_steepens_after_sand_moved(void **state) {
+    (void)state;
+    for (int dim = 1; dim <= 2; ++dim) {
+        double one[2], many[2];
+        const int n = dim == 1 ? 100 : 200; /* the 2D sub-step is half the 1D one */
+        for (int calls = 1; calls <= n; calls += n - 1) {
+            dpsm_grid *g = NULL;
+            if (dim == 1)
+                CHECK_OK(NULL, dpsm_create_1d(2, 0.5, &g));
+            else
+                CHECK_OK(NULL, dpsm_create_2d(2, 1, 0.5, 0.5, &g));
+            const double h[2] = {0.0, 1.501}, q[2] = {0.0, -0.1};
+            const uint8_t kinds[2] = {DPSM_CELL_OPEN, DPSM_CELL_SAND};
+            CHECK_OK(g, dpsm_set_heights(g, h));
+            CHECK_OK(g, dpsm_set_cell_kinds(g, kinds));
+            CHECK_OK(g, dpsm_set_source(g, q));
+            double stable;
+            CHECK_OK(g, dpsm_stable_dt(g, &stable));
+            const double dt = 0.999 * stable * n / calls;
+            for (int k = 0; k < calls; ++k) CHECK_OK(g, dpsm_step(g, dt));
+            if (calls == 1)
+                REQUIRE(step_info_of(g, DPSM_INFO_SUBSTEPS) == n, "dim %d: %g sub-steps", dim,
+                        step_info_of(g, DPSM_INFO_SUBSTEPS));
+            else
+                REQUIRE(step_info_of(g, DPSM_INFO_SUBSTEPS) == 1.0, "dim %d: a call of %g sub-steps", dim,
+                        step_info_of(g, DPSM_INFO_SUBSTEPS));
+            CHECK_OK(g, dpsm_get_heights(g, calls == 1 ? one : many));
+            REQUIRE(fabs(ledger_residual(g)) < 1e-13, "dim %d, %d calls: the ledger is %.3g open", dim, calls,
+                    ledger_residual(g));
+            dpsm_destroy(g);
+        }
+        REQUIRE(fabs(one[1] - many[1]) < 1e-12, "dim %d: one call leaves %.17g, sub-stepping %.17g", dim, one[1],
+                many[1]);
+        /* Dug below the open cell: held by the inflow at about tan(theta) dx and a little more. */
+        REQUIRE(many[1] < -0.2, "dim %d: the sand cell ends at %.6f, not below the open cell", dim, many[1]);
+    }
+}
+
 /* The issue's scene: a source of 1e-300 in a corner cell of the benchmark
  * cone does not turn off the early stop: the same sub-steps as without it,
  * the same heights but in that corner, where the source lands in closed
@@ -298,6 +345,7 @@ int main(void) {
         cmocka_unit_test(test_closed_form_bit_for_bit_where_no_face_moves),
         cmocka_unit_test(test_closed_form_to_round_off),
         cmocka_unit_test(test_source_that_steepens_within_the_step),
+        cmocka_unit_test(test_source_that_steepens_after_sand_moved),
         cmocka_unit_test(test_negligible_source_costs_nothing),
         cmocka_unit_test(test_work_limit_only_for_a_driving_source),
     };

@@ -26,6 +26,9 @@ struct SubstepSummary {
     double max_excess_slope = 0.0;     // largest |grad h| - tan(theta) over faces that carried sand, where found
     double unmet_mass = 0.0;           // erosion asked for where no sand lay above the bed
     double sourced_mass = 0.0;         // with a bed: what the source put on (or took from) the sand
+    // A lazy source may still make a face steep before the step ends: sand
+    // moved near it after the step's start judged it (no rest before the end).
+    bool source_may_steepen = false;
 };
 
 // Books one sub-step in the ledger; false once the surface is found at rest

@@ -140,7 +140,7 @@ void step_in_time(Grid &grid, double dt, std::int64_t most) {
     const double sub_dt = plan.sub_dt;
     const BookSubstep book = [&](const SubstepSummary &did) {
         info.max_excess_slope = did.max_excess_slope;
-        if (!did.moved && !driven) {
+        if (!did.moved && !driven && !did.source_may_steepen) {
             info.at_rest = true;
             return false;
         }

@@ -159,6 +159,28 @@ bool ActiveSet::any_driven() const {
 
 void ActiveSet::drive_every_source() { driven_ = source_; }
 
+bool ActiveSet::drive_sources_near_moves() {
+    bool any = false;
+    for (std::int64_t t = 0; t < tiles(); ++t) {
+        if (!has_source(t)) continue;
+        const CellBox tile = tile_cells(t);
+        const CellBox region = has_remote_source(t) ? tile : sources_near(t).grown_within(1, tile);
+        if (region.empty()) continue;
+        auto drive_near = [&](const CellBox &moved) {
+            const CellBox near = moved.grown(1).grown_within(0, region);
+            if (near.empty()) return;
+            driven_[t].add(near);
+            any = true;
+        };
+        const std::int64_t ti = t % tiles_x_, tj = t / tiles_x_;
+        for (std::int64_t uj = std::max<std::int64_t>(0, tj - 1); uj <= std::min(tiles_y_ - 1, tj + 1); ++uj)
+            for (std::int64_t ui = std::max<std::int64_t>(0, ti - 1); ui <= std::min(tiles_x_ - 1, ti + 1); ++ui)
+                drive_near(hot_[ui + tiles_x_ * uj]);
+        if (!remote_.empty()) drive_near(remote_[t]);
+    }
+    return any;
+}
+
 void ActiveSet::forget_driven() { std::fill(driven_.begin(), driven_.end(), CellBox{}); }
 
 void ActiveSet::end_of_step() {

@@ -88,6 +88,13 @@ public:
     const CellBox &driven(std::int64_t t) const { return driven_[t]; }
     bool any_driven() const;
     void drive_every_source();  // every source's cells are driven (sources applied at each sub-step)
+    // Lazy sources: drive_sources judged a source by the heights at the
+    // start of the step, as if only sources changed them. Where sand has
+    // moved since (the hot boxes, here and beyond a distributed block's
+    // edge), that judgement no longer holds: the source cells there and
+    // their neighbours are driven for the rest of the step. Returns whether
+    // any cell is driven this way.
+    bool drive_sources_near_moves();
     void end_of_step();         // the driven boxes join the hot ones and are cleared
     void forget_driven();       // a refused step: the driven boxes are cleared
     // This tile's cells with a source in it; and whether a source of a

@@ -46,13 +46,20 @@ public:
     void advance(Grid &grid, const SubstepPlan &plan, const BookSubstep &book, StepInfo &info) const override {
         if (plan.something_may_move) {
             std::vector<SubstepSummary> levels;
+            bool source_may_steepen = false;
             for (std::int64_t k = 0; k < plan.substeps && !info.at_rest; k += ActiveSet::kMaxLevels) {
                 const int count = static_cast<int>(std::min<std::int64_t>(ActiveSet::kMaxLevels, plan.substeps - k));
                 // The step reports the largest excess slope of its last sub-step.
                 const bool last_sweep = k + count >= plan.substeps;
                 const double visited = static_cast<double>(
                     tiled_sweep(grid, count, plan.sub_dt, levels, last_sweep, true, static_cast<double>(k)));
-                for (const SubstepSummary &level : levels) {
+                if (plan.lazy_sources) {
+                    // Collective on a distributed grid: every rank takes the same sub-steps.
+                    const bool near_moves = grid.active_set().drive_sources_near_moves();
+                    source_may_steepen = source_may_steepen || grid.global_sum(near_moves ? 1.0 : 0.0) > 0.0;
+                }
+                for (SubstepSummary &level : levels) {
+                    level.source_may_steepen = source_may_steepen;
                     if (!book(level)) break;
                     info.cell_updates += visited;
                 }
@@ -92,16 +99,20 @@ public:
             std::fill(faces.begin(), faces.end(), 0.0);
         }
         for (std::int64_t k = 0; k < plan.substeps; ++k) {
-            const SubstepSummary sweep = slide_rates_1d(grid, plan.sub_dt, grid.records_face_fluxes());
+            SubstepSummary sweep = slide_rates_1d(grid, plan.sub_dt, grid.records_face_fluxes());
             // Once nothing moves, a source that cannot make a face steep by the
-            // end of the step is the rest of it, in closed form.
+            // end of the step is the rest of it, in closed form. One that can
+            // (the start of the step judged it before sand moved) keeps stepping.
             const double left = static_cast<double>(plan.substeps - k);
-            if (!sweep.moved && plan.lazy_sources && !source_may_steepen_1d(grid, left * plan.sub_dt)) {
-                apply_source_1d(grid, left, plan.sub_dt);
-                info.cell_updates += cells;
-                info.max_excess_slope = 0.0;
-                info.at_rest = true;
-                break;
+            if (!sweep.moved && plan.lazy_sources) {
+                if (!source_may_steepen_1d(grid, left * plan.sub_dt)) {
+                    apply_source_1d(grid, left, plan.sub_dt);
+                    info.cell_updates += cells;
+                    info.max_excess_slope = 0.0;
+                    info.at_rest = true;
+                    break;
+                }
+                sweep.source_may_steepen = true;
             }
             if (!book(sweep)) break;
             apply_rates(grid, plan.sub_dt);

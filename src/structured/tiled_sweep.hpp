@@ -17,7 +17,11 @@
 // waits, and catch_up_sources applies it at the end of the step in closed
 // form. A cell's stored height thus depends on when sand moved across its
 // faces, not on which sweeps visited it, and results stay independent of
-// the active set and the threads.
+// the active set and the threads. drive_sources judges the heights as if
+// only sources changed them: where sand moves near a source during the
+// step, the source cells there are driven for the rest of it
+// (ActiveSet::drive_sources_near_moves), and the step does not end at rest
+// before its end.
 #pragma once
 
 #include <cstdint>
