@@ -274,6 +274,9 @@ static const command kCommands[] = {
     {"mesh-accuracy", cmd_mesh_accuracy,
      "[threads [levels [mesh]]]  column collapse (a = 0.5, 30 deg) to rest on quadrilaterals, jittered triangles, hexagons and"
      " the median dual at about 4,000, 16,000, 65,000 cells: L1 error, order, runout; the cone on triangles"},
+    {"lts", cmd_lts,
+     "[m]  local time stepping study: quadtree meshes of cells h..8h (m = 256 fine cells across) against uniform"
+     " squares of the same count, column collapse to rest: sub-steps, cell updates now and with local time steps"},
     {"steps", cmd_steps, "explicit sub-steps against the bounded exchange at dt -> infinity: time and error to rest"},
     {"sts", cmd_sts, "time-accurate super-time-stepping against forward Euler: cone, column per call, steep plane"},
     {"work-precision", cmd_work_precision,

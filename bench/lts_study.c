@@ -1,0 +1,299 @@
+/* Local time stepping on meshes whose cells span a factor of 8 in size
+ * (dpsm-bench lts): what the smallest cell's pace costs today, and what
+ * local time stepping would save, against a uniform mesh of the same cell
+ * count.
+ *
+ * The meshes are quadtrees of squares on [-2.5, 2.5]^2, sizes h, 2h, 4h
+ * and 8h by distance from a point (2:1 balanced; a large square's edge
+ * beside two small ones carries their shared corner as a fifth node, so
+ * every face joins two cells). Two placements of the fine cells: around the
+ * column (refined where the sand moves) and around a far corner (refined
+ * where it does not: a pipeline's or a building's surroundings). On each,
+ * and on a uniform square mesh with as many cells, the column collapse of
+ * mesh-accuracy (a = 0.5, 30 degrees, open edge) is stepped to rest in calls
+ * of 0.05.
+ *
+ * Today every cell takes the mesh's one sub-step, the smallest cell's
+ * stable bound (times 0.9). Local time stepping would let a cell take the
+ * largest power-of-two multiple of that sub-step within its own bound. Its
+ * cost is estimated, not run: per call, the cells whose height changed and
+ * their neighbours (what an active set must visit) each take the call's
+ * time over their class's sub-step, summed over the calls (a lower bound:
+ * the class interfaces' bookkeeping is left out). A cell's own bound is its
+ * area over the sum of its faces' length over centre distance (the
+ * two-point part of what the engine uses, mesh/mesh.cpp); the mesh's
+ * smallest such bound is printed against dpsm_stable_dt to show how close
+ * that is. The counts are machine-independent; seconds are the library's
+ * (1 thread), beside those of the uniform mesh in the same run. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "bench_util.h"
+#include "mesh_scenes.h"
+
+static const double kPi = 3.14159265358979323846;
+static const double kHalf = 2.5;
+
+/* ---- the quadtree ---------------------------------------------------------- */
+
+typedef struct {
+    int m;          /* lattice points per side less one: the domain is m fine cells wide */
+    double h;       /* fine cell size */
+    double px, py;  /* the refinement's centre */
+    double r1, r2, r3; /* within r1: h; r2: 2h; r3: 4h; beyond: 8h */
+    int64_t count, capacity;
+    int *i0, *j0, *size; /* leaves: lower-left lattice corner and size in fine cells */
+} quadtree;
+
+static int wanted_size(const quadtree *q, int i0, int j0, int size) {
+    /* the distance from the centre to the nearest point of the square */
+    const double x0 = -kHalf + i0 * q->h, y0 = -kHalf + j0 * q->h, w = size * q->h;
+    const double dx = fmax(0.0, fmax(x0 - q->px, q->px - (x0 + w))), dy = fmax(0.0, fmax(y0 - q->py, q->py - (y0 + w)));
+    const double r = hypot(dx, dy);
+    return r < q->r1 ? 1 : r < q->r2 ? 2 : r < q->r3 ? 4 : 8;
+}
+
+static void add_leaf(quadtree *q, int i0, int j0, int size) {
+    if (size > wanted_size(q, i0, j0, size)) {
+        const int half = size / 2;
+        add_leaf(q, i0, j0, half);
+        add_leaf(q, i0 + half, j0, half);
+        add_leaf(q, i0, j0 + half, half);
+        add_leaf(q, i0 + half, j0 + half, half);
+        return;
+    }
+    if (q->count == q->capacity) {
+        q->capacity = q->capacity ? 2 * q->capacity : 1024;
+        q->i0 = realloc(q->i0, sizeof(int) * (size_t)q->capacity);
+        q->j0 = realloc(q->j0, sizeof(int) * (size_t)q->capacity);
+        q->size = realloc(q->size, sizeof(int) * (size_t)q->capacity);
+        if (!q->i0 || !q->j0 || !q->size) {
+            fprintf(stderr, "out of memory\n");
+            exit(1);
+        }
+    }
+    q->i0[q->count] = i0, q->j0[q->count] = j0, q->size[q->count] = size;
+    ++q->count;
+}
+
+/* The quadtree's leaves as polygons: each square's corners and every leaf
+ * corner lying on its edges, counter-clockwise. */
+static mesh_scene quadtree_scene(quadtree *q) {
+    for (int j = 0; j < q->m; j += 8)
+        for (int i = 0; i < q->m; i += 8) add_leaf(q, i, j, 8);
+    const int64_t side = q->m + 1;
+    int64_t *node_of = xcalloc((size_t)(side * side), sizeof(int64_t));
+    mesh_scene s;
+    memset(&s, 0, sizeof s);
+    s.kind = SCENE_QUADS;
+    for (int64_t c = 0; c < q->count; ++c)
+        for (int corner = 0; corner < 4; ++corner) {
+            const int64_t i = q->i0[c] + (corner == 1 || corner == 2) * q->size[c];
+            const int64_t j = q->j0[c] + (corner >= 2) * q->size[c];
+            if (!node_of[i + side * j]) node_of[i + side * j] = ++s.nnodes;
+        }
+    s.node_xy = xcalloc((size_t)(2 * s.nnodes), sizeof(double));
+    for (int64_t j = 0; j < side; ++j)
+        for (int64_t i = 0; i < side; ++i) {
+            const int64_t k = node_of[i + side * j];
+            if (!k) continue;
+            s.node_xy[2 * (k - 1)] = -kHalf + (double)i * q->h;
+            s.node_xy[2 * (k - 1) + 1] = -kHalf + (double)j * q->h;
+        }
+    s.npolygons = s.cells = q->count;
+    s.cell_start = xcalloc((size_t)s.cells + 1, sizeof(int64_t));
+    s.cell_nodes = xcalloc((size_t)(32 * s.cells), sizeof(int64_t));
+    s.cx = xcalloc((size_t)s.cells, sizeof(double));
+    s.cy = xcalloc((size_t)s.cells, sizeof(double));
+    s.area = xcalloc((size_t)s.cells, sizeof(double));
+    int64_t k = 0;
+    static const int walk[4][2] = {{1, 0}, {0, 1}, {-1, 0}, {0, -1}};
+    for (int64_t c = 0; c < s.cells; ++c) {
+        s.cell_start[c] = k;
+        int64_t i = q->i0[c], j = q->j0[c];
+        for (int edge = 0; edge < 4; ++edge)
+            for (int step = 0; step < q->size[c]; ++step) {
+                if (node_of[i + side * j]) s.cell_nodes[k++] = node_of[i + side * j] - 1;
+                i += walk[edge][0], j += walk[edge][1];
+            }
+        const double w = q->size[c] * q->h;
+        s.cx[c] = -kHalf + q->i0[c] * q->h + 0.5 * w;
+        s.cy[c] = -kHalf + q->j0[c] * q->h + 0.5 * w;
+        s.area[c] = w * w;
+    }
+    s.cell_start[s.cells] = k;
+    free(node_of);
+    return s;
+}
+
+/* ---- the study ------------------------------------------------------------- */
+
+typedef struct {
+    const char *name;
+    int64_t cells;
+    double smallest, largest; /* cell sizes */
+    double sub_dt, own_bound_ratio; /* dpsm_stable_dt; the two-point estimate of it over it */
+    double substeps, rest_time, l1, seconds;
+    double updates;      /* the library's cell updates (its active set) */
+    double active_now;   /* cells an active set must visit, at the mesh's one sub-step */
+    double active_lts;   /* the same cells, each at its own class's sub-step */
+    double full_now, full_lts; /* every cell, at the one sub-step and at its class's */
+    int classes[4];      /* cells per class: sub-step 1, 2, 4, 8+ times the smallest */
+} lts_result;
+
+static double column_foot(double alpha) { return (0.5 + sqrt(4.0 * alpha * alpha - 0.25 / 3.0)) / (2.0 * alpha); }
+
+/* Each cell's sub-step class: the largest power of two k with k times the
+ * mesh's sub-step within the cell's own bound (capped at 64). */
+static void own_classes(const mesh_scene *s, dpsm_grid *g, double *klass, double *ratio) {
+    int64_t nfaces = 0;
+    CHECK(g, dpsm_get_face_count(g, &nfaces));
+    int64_t *faces = xcalloc((size_t)(2 * nfaces), sizeof(int64_t));
+    CHECK(g, dpsm_get_mesh_faces(g, faces));
+    double *sum = xcalloc((size_t)s->cells, sizeof(double));
+    for (int64_t f = 0; f < nfaces; ++f) {
+        const int64_t a = faces[2 * f], b = faces[2 * f + 1];
+        const double wa = sqrt(s->area[a]);
+        if (b < 0) {
+            sum[a] += 1.0; /* length wa over the distance wa to the mirrored cell */
+            continue;
+        }
+        const double length = fmin(wa, sqrt(s->area[b]));
+        const double distance = hypot(s->cx[a] - s->cx[b], s->cy[a] - s->cy[b]);
+        sum[a] += length / distance, sum[b] += length / distance;
+    }
+    double smallest = INFINITY;
+    for (int64_t c = 0; c < s->cells; ++c) smallest = fmin(smallest, s->area[c] / sum[c]);
+    for (int64_t c = 0; c < s->cells; ++c) {
+        double k = 1.0;
+        while (2.0 * k <= 64.0 && 2.0 * k * smallest <= s->area[c] / sum[c] * (1.0 + 1e-12)) k *= 2.0;
+        klass[c] = k;
+    }
+    /* the library's sub-step is 0.9 / stiffness times its own smallest bound */
+    double sub_dt = 0.0;
+    CHECK(g, dpsm_stable_dt(g, &sub_dt));
+    *ratio = 0.9 * smallest / (DPSM_DEFAULT_MOBILITY * cos(30.0 * kPi / 180.0)) / sub_dt; /* stiffness nu cos(theta) */
+    free(faces);
+    free(sum);
+}
+
+static lts_result run(const char *name, const mesh_scene *s) {
+    lts_result r;
+    memset(&r, 0, sizeof r);
+    r.name = name;
+    r.cells = s->cells;
+    r.smallest = INFINITY;
+    for (int64_t c = 0; c < s->cells; ++c) {
+        r.smallest = fmin(r.smallest, sqrt(s->area[c]));
+        r.largest = fmax(r.largest, sqrt(s->area[c]));
+    }
+    const double theta = 30.0 * kPi / 180.0, alpha = tan(theta), foot = column_foot(alpha);
+    double *h = xcalloc((size_t)s->cells, sizeof(double)), *before = xcalloc((size_t)s->cells, sizeof(double));
+    double *klass = xcalloc((size_t)s->cells, sizeof(double));
+    unsigned char *active = xcalloc((size_t)s->cells, 1);
+    scene_disk_fractions(s, 1.0, h);
+    for (int64_t c = 0; c < s->cells; ++c) h[c] *= 0.5;
+    dpsm_grid *g = NULL;
+    CHECK(NULL, scene_create(s, &g));
+    CHECK(g, dpsm_set_threads(g, 1));
+    CHECK(g, dpsm_set_repose_angle(g, theta));
+    CHECK(g, dpsm_set_boundary(g, DPSM_MESH_EDGE, DPSM_OPEN));
+    CHECK(g, dpsm_set_heights(g, h));
+    CHECK(g, dpsm_stable_dt(g, &r.sub_dt));
+    own_classes(s, g, klass, &r.own_bound_ratio);
+    for (int64_t c = 0; c < s->cells; ++c) r.classes[klass[c] >= 8.0 ? 3 : klass[c] >= 4.0 ? 2 : klass[c] >= 2.0]++;
+    int64_t nfaces = 0;
+    CHECK(g, dpsm_get_face_count(g, &nfaces));
+    int64_t *faces = xcalloc((size_t)(2 * nfaces), sizeof(int64_t));
+    CHECK(g, dpsm_get_mesh_faces(g, faces));
+    const double call = 0.05;
+    double seconds = 0.0;
+    while (r.rest_time < 20.0) {
+        memcpy(before, h, sizeof(double) * (size_t)s->cells);
+        const double t0 = now_seconds();
+        CHECK(g, dpsm_step(g, call));
+        seconds += now_seconds() - t0;
+        double substeps = 0.0, integrated = 0.0, updates = 0.0, at_rest = 0.0;
+        CHECK(g, dpsm_get_step_info(g, DPSM_INFO_SUBSTEPS, &substeps));
+        CHECK(g, dpsm_get_step_info(g, DPSM_INFO_TIME_INTEGRATED, &integrated));
+        CHECK(g, dpsm_get_step_info(g, DPSM_INFO_CELL_UPDATES, &updates));
+        CHECK(g, dpsm_get_step_info(g, DPSM_INFO_AT_REST, &at_rest));
+        CHECK(g, dpsm_get_heights(g, h));
+        r.substeps += substeps, r.updates += updates, r.rest_time += integrated;
+        memset(active, 0, (size_t)s->cells);
+        for (int64_t c = 0; c < s->cells; ++c) active[c] = h[c] != before[c];
+        for (int64_t f = 0; f < nfaces; ++f) {
+            const int64_t a = faces[2 * f], b = faces[2 * f + 1];
+            if (b >= 0 && (active[a] & 1) != (active[b] & 1)) active[a] |= 2, active[b] |= 2;
+        }
+        for (int64_t c = 0; c < s->cells; ++c) {
+            const double own = ceil(substeps / klass[c]);
+            r.full_now += substeps, r.full_lts += own;
+            if (active[c]) r.active_now += substeps, r.active_lts += own;
+        }
+        if (at_rest > 0.0) break;
+    }
+    r.seconds = seconds;
+    double err = 0.0;
+    for (int64_t c = 0; c < s->cells; ++c) {
+        const double exact = fmin(0.5, fmax(0.0, alpha * (foot - hypot(s->cx[c], s->cy[c]))));
+        err += fabs(h[c] - exact) * s->area[c];
+    }
+    r.l1 = err / (kPi * 0.5);
+    dpsm_destroy(g);
+    free(h), free(before), free(klass), free(active), free(faces);
+    return r;
+}
+
+static void print_result(const lts_result *r, const lts_result *uniform) {
+    printf("%-22s %7lld %6.4f-%6.4f %9.3e %5.3f %6.0f %5.2f %6.3f%% %7.2f %6.2f | %9.3e %9.3e %9.3e %9.3e %9.3e | %5.2f "
+           "%5.2f %5.2f | %d/%d/%d/%d\n",
+           r->name, (long long)r->cells, r->smallest, r->largest, r->sub_dt, r->own_bound_ratio, r->substeps,
+           r->rest_time, 100.0 * r->l1, r->seconds, r->seconds / uniform->seconds, r->updates, r->active_now,
+           r->active_lts, r->full_now, r->full_lts, r->updates / uniform->updates, r->active_lts / uniform->active_now,
+           r->full_lts / uniform->full_now, r->classes[0], r->classes[1], r->classes[2], r->classes[3]);
+}
+
+int cmd_lts(int argc, char **argv) {
+    const int m = argc > 0 ? atoi(argv[0]) : 256; /* fine cells across the domain */
+    if (m < 64 || m % 8 != 0) {
+        fprintf(stderr, "lts: the fine cells across (%d) must be a multiple of 8, at least 64\n", m);
+        return 2;
+    }
+    printf("# local time stepping: quadtree meshes with cells of h..8h (h = %.5f) against uniform squares of the same "
+           "count; column collapse (a = 0.5, 30 deg, open edge) in calls of 0.05 to rest, 1 thread\n",
+           2.0 * kHalf / m);
+    printf("# own/lib: the two-point estimate of the smallest cell's bound over dpsm_stable_dt; seconds/uni: against "
+           "the uniform mesh of the same count, same run\n");
+    printf("# cell updates: lib = the library's (its active set); active = changed cells and neighbours x sub-steps, at "
+           "the one sub-step (now) and each at its class's (lts); full = every cell\n");
+    printf("# ratios to the uniform mesh: lib/uni (library against library), lts/uni (active, lts against the uniform's "
+           "active), full lts/uni; classes: cells whose own bound allows 1/2/4/8+ times the sub-step\n");
+    printf("%-22s %7s %13s %9s %5s %6s %5s %7s %7s %6s | %9s %9s %9s %9s %9s | %5s %5s %5s | %s\n", "mesh", "cells",
+           "sizes", "sub_dt", "own/l", "steps", "rest", "L1", "seconds", "s/uni", "lib", "act now", "act lts",
+           "full now", "full lts", "lib/u", "lts/u", "full", "classes");
+    const double h = 2.0 * kHalf / m;
+    const struct {
+        const char *name;
+        double px, py, r1;
+    } placements[] = {{"graded, fine at pile", 0.0, 0.0, 1.6}, {"graded, fine at corner", kHalf, kHalf, 1.6}};
+    for (size_t p = 0; p < sizeof placements / sizeof placements[0]; ++p) {
+        quadtree q;
+        memset(&q, 0, sizeof q);
+        q.m = m, q.h = h, q.px = placements[p].px, q.py = placements[p].py;
+        q.r1 = placements[p].r1, q.r2 = q.r1 + 0.4, q.r3 = q.r1 + 0.8;
+        mesh_scene graded = quadtree_scene(&q);
+        const int n = (int)lround(sqrt((double)graded.cells));
+        mesh_scene uniform = scene_make(SCENE_QUADS, n, kHalf, 1u);
+        const lts_result ru = run("uniform, same count", &uniform);
+        const lts_result rg = run(placements[p].name, &graded);
+        print_result(&rg, &ru);
+        print_result(&ru, &ru);
+        scene_free(&graded);
+        scene_free(&uniform);
+        free(q.i0), free(q.j0), free(q.size);
+    }
+    return 0;
+}
