@@ -277,12 +277,359 @@ static void test_mesh_functions(void **state) {
 }
 
 /* ------------------------------------------------------------------------ */
+/* Indices from 1: the _indexed constructors                                 */
+/* ------------------------------------------------------------------------ */
+
+/* The n x n cells of scene_make(SCENE_QUADS, n, half, ...) as a graph,
+ * built from the lattice: x faces, y faces, the four sides (from 0). */
+typedef struct {
+    int64_t ncells, nfaces;
+    int64_t *face_cells;
+    double *cell_xy, *area, *face_xy, *length;
+} quad_graph;
+
+static quad_graph quad_graph_make(int n, double half) {
+    const double dx = 2.0 * half / n;
+    quad_graph q;
+    q.ncells = (int64_t)n * n;
+    q.nfaces = 2 * (int64_t)(n + 1) * n;
+    q.face_cells = calloc((size_t)(2 * q.nfaces), sizeof(int64_t));
+    q.face_xy = calloc((size_t)(2 * q.nfaces), sizeof(double));
+    q.length = calloc((size_t)q.nfaces, sizeof(double));
+    q.cell_xy = calloc((size_t)(2 * q.ncells), sizeof(double));
+    q.area = calloc((size_t)q.ncells, sizeof(double));
+    for (int64_t c = 0; c < q.ncells; ++c) {
+        q.cell_xy[2 * c] = -half + (c % n + 0.5) * dx, q.cell_xy[2 * c + 1] = -half + (c / n + 0.5) * dx;
+        q.area[c] = dx * dx;
+    }
+    int64_t f = 0;
+    for (int j = 0; j < n; ++j)
+        for (int i = 0; i <= n; ++i, ++f) { /* the face on the low x side of cell (i, j) */
+            const int64_t left = i > 0 ? (i - 1) + (int64_t)n * j : -1, right = i < n ? i + (int64_t)n * j : -1;
+            q.face_cells[2 * f] = left >= 0 ? left : right;
+            q.face_cells[2 * f + 1] = left >= 0 ? right : -1;
+            q.face_xy[2 * f] = -half + i * dx, q.face_xy[2 * f + 1] = -half + (j + 0.5) * dx, q.length[f] = dx;
+        }
+    for (int j = 0; j <= n; ++j)
+        for (int i = 0; i < n; ++i, ++f) {
+            const int64_t below = j > 0 ? i + (int64_t)n * (j - 1) : -1, above = j < n ? i + (int64_t)n * j : -1;
+            q.face_cells[2 * f] = below >= 0 ? below : above;
+            q.face_cells[2 * f + 1] = below >= 0 ? above : -1;
+            q.face_xy[2 * f] = -half + (i + 0.5) * dx, q.face_xy[2 * f + 1] = -half + j * dx, q.length[f] = dx;
+        }
+    return q;
+}
+
+static void quad_graph_free(quad_graph *q) {
+    free(q->face_cells), free(q->face_xy), free(q->length), free(q->cell_xy), free(q->area);
+}
+
+
+/* A copy of n indices counting from 1 instead of 0 (the domain edge's -1 becomes 0). */
+static int64_t *from_one(const int64_t *v, int64_t n) {
+    int64_t *w = malloc(sizeof(int64_t) * (size_t)(n > 0 ? n : 1));
+    for (int64_t k = 0; k < n; ++k) w[k] = v[k] + 1;
+    return w;
+}
+
+/* The format version of a restart file (its bytes 8 to 11, little-endian). */
+static unsigned file_version(const char *path) {
+    unsigned char bytes[12] = {0};
+    FILE *f = fopen(path, "rb");
+    REQUIRE(f != NULL, "cannot open %s", path);
+    const size_t got = fread(bytes, 1, sizeof bytes, f);
+    fclose(f);
+    REQUIRE(got == sizeof bytes, "%s is shorter than 12 bytes", path);
+    return bytes[8] | (unsigned)bytes[9] << 8 | (unsigned)bytes[10] << 16 | (unsigned)bytes[11] << 24;
+}
+
+/* The scene's mesh with its indices counting from `base`, through the
+ * _indexed constructors (on copies counting from 1 for base 1). */
+static int scene_create_from(const mesh_scene *s, int base, dpsm_grid **out) {
+    const int64_t nidx = s->kind == SCENE_DUAL ? 3 * s->npolygons : s->cell_start[s->npolygons];
+    int64_t *nodes = base ? from_one(s->cell_nodes, nidx) : NULL, *start = base ? from_one(s->cell_start, s->npolygons + 1) : NULL;
+    const int64_t *n = base ? nodes : s->cell_nodes, *st = base ? start : s->cell_start;
+    const int status = s->kind == SCENE_DUAL ? dpsm_create_dual_mesh_indexed(base, s->nnodes, s->node_xy, s->npolygons, n, out)
+                                             : dpsm_create_mesh_indexed(base, s->nnodes, s->node_xy, s->npolygons, st, n, out);
+    free(nodes), free(start);
+    return status;
+}
+
+/* `one` (indices from `base`) is the mesh `zero` (from 0) is: the same
+ * shape and faces (its cells `base` more, base - 1 on the domain edge), the
+ * same stable step, and the same heights, ledger and face fluxes, bit for
+ * bit, after the same steps with the same edge kinds and levels. Destroys
+ * both. */
+static void require_same_mesh(dpsm_grid *zero, dpsm_grid *one, int base, const double *h, const char *what) {
+    int64_t nx0, ny0, nx1, ny1, nf0, nf1;
+    CHECK_OK(zero, dpsm_get_shape(zero, &nx0, &ny0));
+    CHECK_OK(one, dpsm_get_shape(one, &nx1, &ny1));
+    CHECK_OK(zero, dpsm_get_face_count(zero, &nf0));
+    CHECK_OK(one, dpsm_get_face_count(one, &nf1));
+    REQUIRE(nx0 == nx1 && ny0 == ny1 && nf0 == nf1, "%s: %lld x %lld with %lld faces from 0, %lld x %lld with %lld from %d",
+            what, (long long)nx0, (long long)ny0, (long long)nf0, (long long)nx1, (long long)ny1, (long long)nf1, base);
+    int64_t *f0 = calloc((size_t)(2 * nf0), sizeof(int64_t)), *f1 = calloc((size_t)(2 * nf0), sizeof(int64_t));
+    CHECK_OK(zero, dpsm_get_mesh_faces(zero, f0));
+    CHECK_OK(one, dpsm_get_mesh_faces(one, f1));
+    int edges = 0;
+    for (int64_t k = 0; k < 2 * nf0; ++k) {
+        REQUIRE(f1[k] == f0[k] + base, "%s: face_cells[%lld] is %lld from 0 but %lld from %d", what, (long long)k,
+                (long long)f0[k], (long long)f1[k], base);
+        edges += f1[k] == base - 1;
+    }
+    REQUIRE(edges > 0 && f1[0] >= base, "%s: from %d, the domain edge is %d (%d faces on it)", what, base, base - 1,
+            edges);
+    double dt0, dt1;
+    CHECK_OK(zero, dpsm_stable_dt(zero, &dt0));
+    CHECK_OK(one, dpsm_stable_dt(one, &dt1));
+    REQUIRE(dt0 == dt1, "%s: stable step %.17g from 0, %.17g from %d", what, dt0, dt1, base);
+    uint8_t *kinds = malloc((size_t)nf0);
+    double *levels = calloc((size_t)nf0, sizeof(double));
+    for (int64_t f = 0; f < nf0; ++f) kinds[f] = f % 2 ? DPSM_OPEN : DPSM_WALL, levels[f] = 0.5 * (double)(f % 3);
+    dpsm_grid *both[2] = {zero, one};
+    for (int k = 0; k < 2; ++k) {
+        CHECK_OK(both[k], dpsm_set_repose_angle(both[k], 30.0 * kDeg));
+        CHECK_OK(both[k], dpsm_set_edge_kinds(both[k], kinds));
+        CHECK_OK(both[k], dpsm_set_side_levels(both[k], DPSM_MESH_EDGE, levels));
+        CHECK_OK(both[k], dpsm_set_face_flux_recording(both[k], 1));
+        CHECK_OK(both[k], dpsm_set_heights(both[k], h));
+        for (int call = 0; call < 5; ++call) CHECK_OK(both[k], dpsm_step(both[k], 0.1));
+    }
+    double *h0 = calloc((size_t)nx0, sizeof(double)), *h1 = calloc((size_t)nx0, sizeof(double));
+    double *x0 = calloc((size_t)nf0, sizeof(double)), *x1 = calloc((size_t)nf0, sizeof(double));
+    CHECK_OK(zero, dpsm_get_heights(zero, h0));
+    CHECK_OK(one, dpsm_get_heights(one, h1));
+    CHECK_OK(zero, dpsm_get_face_fluxes(zero, x0, NULL));
+    CHECK_OK(one, dpsm_get_face_fluxes(one, x1, NULL));
+    REQUIRE(memcmp(h0, h1, sizeof(double) * (size_t)nx0) == 0, "%s: the heights differ after the same steps", what);
+    REQUIRE(memcmp(x0, x1, sizeof(double) * (size_t)nf0) == 0, "%s: the face fluxes differ", what);
+    REQUIRE(mass_of(zero, DPSM_MASS_OUTFLOW) == mass_of(one, DPSM_MASS_OUTFLOW) && mass_of(zero, DPSM_MASS_OUTFLOW) != 0.0,
+            "%s: outflow %.17g from 0, %.17g from %d", what, mass_of(zero, DPSM_MASS_OUTFLOW),
+            mass_of(one, DPSM_MASS_OUTFLOW), base);
+    free(f0), free(f1), free(kinds), free(levels), free(h0), free(h1), free(x0), free(x1);
+    dpsm_destroy(zero), dpsm_destroy(one);
+}
+
+static void test_indexed_same_as_from_zero(void **state) {
+    (void)state;
+    /* Polygons and the dual: the plain constructor, _indexed(0) and _indexed(1). */
+    const scene_kind kinds[2] = {SCENE_TRIANGLES, SCENE_DUAL};
+    for (int k = 0; k < 2; ++k) {
+        mesh_scene s = scene_make(kinds[k], 12, 2.5, 5u);
+        double *h = column_heights(&s, 1.0, 0.8);
+        for (int base = 0; base < 2; ++base) {
+            dpsm_grid *plain = NULL, *indexed = NULL;
+            CHECK_OK(NULL, scene_create(&s, &plain));
+            CHECK_OK(NULL, scene_create_from(&s, base, &indexed));
+            require_same_mesh(plain, indexed, base, h, scene_name(kinds[k]));
+        }
+        free(h);
+        scene_free(&s);
+    }
+    /* The graph. */
+    const int n = 10;
+    mesh_scene s = scene_make(SCENE_QUADS, n, 2.5, 1u);
+    quad_graph q = quad_graph_make(n, 2.5);
+    int64_t *cells1 = from_one(q.face_cells, 2 * q.nfaces);
+    dpsm_grid *zero = NULL, *one = NULL;
+    CHECK_OK(NULL, dpsm_create_graph(q.ncells, q.cell_xy, q.area, q.nfaces, q.face_cells, q.face_xy, q.length, &zero));
+    CHECK_OK(NULL, dpsm_create_graph_indexed(1, q.ncells, q.cell_xy, q.area, q.nfaces, cells1, q.face_xy, q.length, &one));
+    /* A restart file keeps the graph as given, from 1 (the mesh record's
+     * face_cells as the host's, the file of version 6). */
+    char path[64];
+    snprintf(path, sizeof path, "test_mesh_graph_%d.dpsm", (int)getpid());
+    CHECK_OK(one, dpsm_save(one, path));
+    REQUIRE(file_version(path) == 6u, "a graph from 1 is saved as version %u, not 6", file_version(path));
+    dpsm_grid *loaded = NULL;
+    CHECK_OK(NULL, dpsm_load(path, &loaded));
+    remove(path);
+    int64_t *fa = calloc((size_t)(2 * q.nfaces), sizeof(int64_t)), *fb = calloc((size_t)(2 * q.nfaces), sizeof(int64_t));
+    CHECK_OK(one, dpsm_get_mesh_faces(one, fa));
+    CHECK_OK(loaded, dpsm_get_mesh_faces(loaded, fb));
+    REQUIRE(memcmp(fa, fb, sizeof(int64_t) * (size_t)(2 * q.nfaces)) == 0 && memcmp(fa, cells1, sizeof(int64_t) * 2) == 0,
+            "the loaded graph lists other faces than the saved one from 1");
+    free(fa), free(fb);
+    dpsm_destroy(loaded);
+    double *h = column_heights(&s, 1.0, 0.8);
+    require_same_mesh(zero, one, 1, h, "graph");
+    free(h), free(cells1);
+    quad_graph_free(&q);
+    scene_free(&s);
+}
+
+/* The message of the last failure (on g; NULL: of a constructor) names `what`. */
+static void require_named(const dpsm_grid *g, const char *what) {
+    REQUIRE(strstr(dpsm_last_error(g), what) != NULL, "message '%s' does not name '%s'", dpsm_last_error(g), what);
+}
+
+static void test_indexed_bad_inputs(void **state) {
+    (void)state;
+    dpsm_grid *g = NULL;
+    int64_t *start1 = from_one(kQuadStart, 5), *cells1 = from_one(kQuadCells, 16);
+    const double cell_xy[4] = {0.5, 0.5, 1.5, 0.5}, area[2] = {1, 1};
+    const int64_t face_cells[14] = {0, 1, 0, -1, 0, -1, 0, -1, 1, -1, 1, -1, 1, -1};
+    const double face_xy[14] = {1, 0.5, 0, 0.5, 0.5, 0, 0.5, 1, 2, 0.5, 1.5, 0, 1.5, 1};
+    double length[7] = {1, 1, 1, 1, 1, 1, 1};
+    int64_t *fc1 = from_one(face_cells, 14);
+    const double nodes[10] = {0, 0, 1, 0, 1, 1, 0, 1, 5, 5};
+    const int64_t tris[6] = {0, 1, 2, 0, 2, 3};
+    int64_t *tris1 = from_one(tris, 6);
+
+    /* A start index other than 0 and 1, with arrays good from either. */
+    const int bad_starts[2] = {2, -1};
+    for (int k = 0; k < 2; ++k) {
+        char named[32];
+        snprintf(named, sizeof named, "start_index = %d", bad_starts[k]);
+        EXPECT_CREATE_FAIL(dpsm_create_mesh_indexed(bad_starts[k], 9, kQuadNodes, 4, start1, cells1, &g), g,
+                           DPSM_ERR_INVALID_VALUE, "dpsm_create_mesh_indexed", named);
+        require_named(NULL, "neither 0");
+        require_named(NULL, "nor 1");
+        EXPECT_CREATE_FAIL(dpsm_create_graph_indexed(bad_starts[k], 2, cell_xy, area, 7, fc1, face_xy, length, &g), g,
+                           DPSM_ERR_INVALID_VALUE, "dpsm_create_graph_indexed", named);
+        require_named(NULL, "nor 1");
+        EXPECT_CREATE_FAIL(dpsm_create_dual_mesh_indexed(bad_starts[k], 4, nodes, 2, tris1, &g), g,
+                           DPSM_ERR_INVALID_VALUE, "dpsm_create_dual_mesh_indexed", named);
+        require_named(NULL, "nor 1");
+    }
+    REQUIRE(dpsm_create_mesh_indexed(1, 9, kQuadNodes, 4, start1, cells1, NULL) == DPSM_ERR_NULL_POINTER, "out NULL");
+    /* Arrays from 0 given as from 1, and the other way round. */
+    const char *fn = "dpsm_create_mesh_indexed";
+    EXPECT_CREATE_FAIL(dpsm_create_mesh_indexed(1, 9, kQuadNodes, 4, kQuadStart, kQuadCells, &g), g,
+                       DPSM_ERR_INVALID_VALUE, fn, "cell_start(1) = 0 must be 1");
+    EXPECT_CREATE_FAIL(dpsm_create_mesh_indexed(0, 9, kQuadNodes, 4, start1, cells1, &g), g, DPSM_ERR_INVALID_VALUE, fn,
+                       "cell_start[0] = 1 must be 0");
+
+    /* Polygons from 1: messages count from 1 and quote the host's values. */
+    int64_t cells[16];
+    memcpy(cells, cells1, sizeof cells);
+    cells[6] = 10; /* cell 2's third node: node 10 of 9 */
+    EXPECT_CREATE_FAIL(dpsm_create_mesh_indexed(1, 9, kQuadNodes, 4, start1, cells, &g), g, DPSM_ERR_INVALID_VALUE, fn,
+                       "cell_nodes(7) = 10 is not a node index in [1, 9]");
+    cells[6] = 0;
+    EXPECT_CREATE_FAIL(dpsm_create_mesh_indexed(1, 9, kQuadNodes, 4, start1, cells, &g), g, DPSM_ERR_INVALID_VALUE, fn,
+                       "cell_nodes(7) = 0 is not a node index in [1, 9]");
+    cells[6] = INT64_MIN; /* no overflow on the way to 0-based */
+    EXPECT_CREATE_FAIL(dpsm_create_mesh_indexed(1, 9, kQuadNodes, 4, start1, cells, &g), g, DPSM_ERR_INVALID_VALUE, fn,
+                       "cell_nodes(7) = -9223372036854775808 is not");
+    memcpy(cells, cells1, sizeof cells);
+    cells[9] = 4, cells[10] = 5; /* cell 3 becomes 4, 4, 5, 7: a node repeated in a row */
+    EXPECT_CREATE_FAIL(dpsm_create_mesh_indexed(1, 9, kQuadNodes, 4, start1, cells, &g), g, DPSM_ERR_INVALID_VALUE, fn,
+                       "cell 3 repeats node 4");
+    const int64_t short_start[5] = {1, 5, 9, 13, 15};
+    EXPECT_CREATE_FAIL(dpsm_create_mesh_indexed(1, 9, kQuadNodes, 4, short_start, cells1, &g), g,
+                       DPSM_ERR_INVALID_VALUE, fn, "cell 4 has 2 nodes (cell_start(4) = 13, cell_start(5) = 15)");
+    const int64_t start2[2] = {1, 5}, two[4] = {1, 2, 1, 2};
+    EXPECT_CREATE_FAIL(dpsm_create_mesh_indexed(1, 9, kQuadNodes, 1, start2, two, &g), g, DPSM_ERR_INVALID_VALUE, fn,
+                       "cell 1 has fewer than 3 distinct nodes");
+    const int64_t start3[2] = {1, 4}, line[3] = {1, 2, 3};
+    EXPECT_CREATE_FAIL(dpsm_create_mesh_indexed(1, 9, kQuadNodes, 1, start3, line, &g), g, DPSM_ERR_INVALID_VALUE, fn,
+                       "cell 1 has zero area");
+    const double fan[8] = {0, 0, 1, 0, 0.5, 1, 0.5, -1};
+    const int64_t fan_start[4] = {1, 4, 7, 10}, fan_cells[9] = {1, 2, 3, 1, 2, 4, 2, 1, 3};
+    EXPECT_CREATE_FAIL(dpsm_create_mesh_indexed(1, 4, fan, 3, fan_start, fan_cells, &g), g, DPSM_ERR_INVALID_VALUE, fn,
+                       "the edge between nodes 1 and 2 is shared by 3 cells (1, 2, 3)");
+    double bad_nodes[18];
+    memcpy(bad_nodes, kQuadNodes, sizeof bad_nodes);
+    bad_nodes[7] = NAN; /* y of the host's node 4 */
+    EXPECT_CREATE_FAIL(dpsm_create_mesh_indexed(1, 9, bad_nodes, 4, start1, cells1, &g), g, DPSM_ERR_INVALID_VALUE, fn,
+                       "node_xy(2, 4) (y of node 4)");
+
+    /* The graph from 1: face_cells(2, f) positions, 0 the domain edge. */
+    fn = "dpsm_create_graph_indexed";
+    int64_t fc[14];
+    memcpy(fc, fc1, sizeof fc);
+    fc[9] = 3; /* face 5's b: cell 3 of 2 */
+    EXPECT_CREATE_FAIL(dpsm_create_graph_indexed(1, 2, cell_xy, area, 7, fc, face_xy, length, &g), g,
+                       DPSM_ERR_INVALID_VALUE, fn, "face 5: face_cells(2, 5) = 3 is not a cell index in [1, 2] nor 0 (the domain edge)");
+    fc[9] = -1; /* C's domain edge is no index from 1 */
+    EXPECT_CREATE_FAIL(dpsm_create_graph_indexed(1, 2, cell_xy, area, 7, fc, face_xy, length, &g), g,
+                       DPSM_ERR_INVALID_VALUE, fn, "face_cells(2, 5) = -1 is not a cell index");
+    fc[9] = 0, fc[2] = 0; /* face 2's a on the domain edge */
+    EXPECT_CREATE_FAIL(dpsm_create_graph_indexed(1, 2, cell_xy, area, 7, fc, face_xy, length, &g), g,
+                       DPSM_ERR_INVALID_VALUE, fn, "face 2: face_cells(1, 2) = 0 is not a cell index in [1, 2]");
+    fc[2] = INT64_MAX;
+    EXPECT_CREATE_FAIL(dpsm_create_graph_indexed(1, 2, cell_xy, area, 7, fc, face_xy, length, &g), g,
+                       DPSM_ERR_INVALID_VALUE, fn, "face_cells(1, 2) = 9223372036854775807 is not");
+    memcpy(fc, fc1, sizeof fc);
+    fc[1] = 1;
+    EXPECT_CREATE_FAIL(dpsm_create_graph_indexed(1, 2, cell_xy, area, 7, fc, face_xy, length, &g), g,
+                       DPSM_ERR_INVALID_VALUE, fn, "face 1 joins cell 1 to itself");
+    const double no_area[2] = {1, 0};
+    EXPECT_CREATE_FAIL(dpsm_create_graph_indexed(1, 2, cell_xy, no_area, 7, fc1, face_xy, length, &g), g,
+                       DPSM_ERR_INVALID_VALUE, fn, "cell_area(2) (cell 2) = 0");
+    length[3] = -1;
+    EXPECT_CREATE_FAIL(dpsm_create_graph_indexed(1, 2, cell_xy, area, 7, fc1, face_xy, length, &g), g,
+                       DPSM_ERR_INVALID_VALUE, fn, "face_length(4) (face 4) = -1");
+    length[3] = 1;
+    EXPECT_CREATE_FAIL(dpsm_create_graph_indexed(1, 2, cell_xy, area, 4, fc1, face_xy, length, &g), g,
+                       DPSM_ERR_INVALID_VALUE, fn, "the faces of cell 2 (");
+    require_named(NULL, "domain edges with b = 0");
+
+    /* The dual from 1: nodes and triangles from 1. */
+    fn = "dpsm_create_dual_mesh_indexed";
+    EXPECT_CREATE_FAIL(dpsm_create_dual_mesh_indexed(1, 5, nodes, 2, tris1, &g), g, DPSM_ERR_INVALID_VALUE, fn,
+                       "node 5 belongs to no triangle");
+    const int64_t flat[3] = {1, 2, 2};
+    EXPECT_CREATE_FAIL(dpsm_create_dual_mesh_indexed(1, 4, nodes, 1, flat, &g), g, DPSM_ERR_INVALID_VALUE, fn,
+                       "triangle 1 has fewer than 3 distinct nodes");
+    const int64_t out_of_range[6] = {1, 2, 3, 1, 3, 8};
+    EXPECT_CREATE_FAIL(dpsm_create_dual_mesh_indexed(1, 4, nodes, 2, out_of_range, &g), g, DPSM_ERR_INVALID_VALUE, fn,
+                       "triangle_nodes(3, 2) (triangle 2) = 8 is not a node index in [1, 4]");
+    free(start1), free(cells1), free(fc1), free(tris1);
+}
+
+/* A mesh from 1 names its cells and faces from 1 after its constructor too,
+ * and lists its faces from 1. */
+static void test_indexed_later_messages(void **state) {
+    (void)state;
+    dpsm_grid *g = NULL;
+    int64_t *start1 = from_one(kQuadStart, 5), *cells1 = from_one(kQuadCells, 16);
+    CHECK_OK(NULL, dpsm_create_mesh_indexed(1, 9, kQuadNodes, 4, start1, cells1, &g));
+    int64_t faces[24];
+    CHECK_OK(g, dpsm_get_mesh_faces(g, faces));
+    /* Faces as they first appear, cell by cell (test_create_mesh_quads): cell 1's four first. */
+    int64_t an_edge = -1;
+    for (int f = 0; f < 12; ++f) {
+        REQUIRE(faces[2 * f] >= 1 && faces[2 * f] <= 4 && faces[2 * f + 1] >= 0 && faces[2 * f + 1] <= 4,
+                "face %d joins %lld and %lld: not cells from 1 and 0 for the edge", f, (long long)faces[2 * f],
+                (long long)faces[2 * f + 1]);
+        if (f < 4) REQUIRE(faces[2 * f] == 1, "face %d belongs to cell %lld, not 1", f, (long long)faces[2 * f]);
+        if (faces[2 * f + 1] == 0 && f > 4 && an_edge < 0) an_edge = f;
+    }
+    uint8_t edges[12];
+    memset(edges, DPSM_WALL, sizeof edges);
+    edges[an_edge] = 5;
+    char named[64];
+    snprintf(named, sizeof named, "kinds(%lld) (face %lld, on the domain edge) = 5", (long long)an_edge + 1,
+             (long long)an_edge + 1);
+    EXPECT_FAIL_ON(g, dpsm_set_edge_kinds(g, edges), DPSM_ERR_UNKNOWN_ENUM, named);
+    double levels[12] = {0};
+    levels[an_edge] = INFINITY;
+    snprintf(named, sizeof named, "levels(%lld) (face %lld) is +Inf", (long long)an_edge + 1, (long long)an_edge + 1);
+    EXPECT_FAIL_ON(g, dpsm_set_side_levels(g, DPSM_MESH_EDGE, levels), DPSM_ERR_INVALID_VALUE, named);
+    double h[4] = {1, 2, NAN, 4};
+    EXPECT_FAIL_ON(g, dpsm_set_heights(g, h), DPSM_ERR_INVALID_VALUE, "h(3) (cell 3) is NaN");
+    uint8_t kinds[4] = {0, 0, 7, 0};
+    EXPECT_FAIL_ON(g, dpsm_set_cell_kinds(g, kinds), DPSM_ERR_UNKNOWN_ENUM, "kinds(3) (cell 3) = 7");
+    double theta[4] = {0.5, 0.5, 0.5, 2.0};
+    EXPECT_FAIL_ON(g, dpsm_set_repose_angle_field(g, theta), DPSM_ERR_INVALID_VALUE, "theta_radians(4) (cell 4) = 2");
+    const double bed[4] = {0, 3, 0, 0};
+    CHECK_OK(g, dpsm_set_bedrock(g, bed));
+    h[2] = 3;
+    EXPECT_FAIL_ON(g, dpsm_set_heights(g, h), DPSM_ERR_INVALID_VALUE, "h(2) puts cell 2 at 2, below its bed");
+    dpsm_destroy(g);
+    free(start1), free(cells1);
+}
+
+/* ------------------------------------------------------------------------ */
 /* Numerics                                                                  */
 /* ------------------------------------------------------------------------ */
 
-static dpsm_grid *column_mesh(const mesh_scene *s, int open) {
+/* A column on the scene's mesh (its indices from `base`: 0 through the
+ * plain constructors, 1 through the _indexed ones). */
+static dpsm_grid *column_mesh(const mesh_scene *s, int open, int base) {
     dpsm_grid *g = NULL;
-    CHECK_OK(NULL, scene_create(s, &g));
+    CHECK_OK(NULL, base ? scene_create_from(s, base, &g) : scene_create(s, &g));
     CHECK_OK(g, dpsm_set_repose_angle(g, 30.0 * kDeg));
     if (open) CHECK_OK(g, dpsm_set_boundary(g, DPSM_MESH_EDGE, DPSM_OPEN));
     double *h = column_heights(s, 1.0, 0.5);
@@ -296,7 +643,7 @@ static void test_column_rests_with_mass_and_bounds(void **state) {
     const scene_kind kinds[4] = {SCENE_QUADS, SCENE_TRIANGLES, SCENE_HEXAGONS, SCENE_DUAL};
     for (int k = 0; k < 4; ++k) {
         mesh_scene s = scene_make(kinds[k], 24, 2.5, 7u);
-        dpsm_grid *g = column_mesh(&s, 0);
+        dpsm_grid *g = column_mesh(&s, 0, 0);
         const double before = mass_of(g, DPSM_MASS_TOTAL);
         int rested = 0;
         double *h = calloc((size_t)s.cells, sizeof(double));
@@ -429,36 +776,16 @@ static void test_host_order(void **state) {
     scene_free(&s);
 }
 
-/* The cells of a quad mesh as a graph (built here from the lattice: x faces,
- * y faces, the four sides) step as the polygons do. */
+/* The cells of a quad mesh as a graph step as the polygons do. */
 static void test_graph_steps_as_polygons(void **state) {
     (void)state;
     const int n = 20;
-    const double half = 2.5, dx = 2.0 * half / n;
+    const double half = 2.5;
     mesh_scene s = scene_make(SCENE_QUADS, n, half, 1u);
-    const int64_t nfaces = 2 * (int64_t)(n + 1) * n;
-    int64_t *face_cells = calloc((size_t)(2 * nfaces), sizeof(int64_t));
-    double *face_xy = calloc((size_t)(2 * nfaces), sizeof(double)), *length = calloc((size_t)nfaces, sizeof(double));
-    double *cell_xy = calloc((size_t)(2 * s.cells), sizeof(double));
-    for (int64_t c = 0; c < s.cells; ++c) cell_xy[2 * c] = -half + (c % n + 0.5) * dx, cell_xy[2 * c + 1] = -half + (c / n + 0.5) * dx;
-    int64_t f = 0;
-    for (int j = 0; j < n; ++j)
-        for (int i = 0; i <= n; ++i, ++f) { /* the face on the low x side of cell (i, j) */
-            const int64_t left = i > 0 ? (i - 1) + (int64_t)n * j : -1, right = i < n ? i + (int64_t)n * j : -1;
-            face_cells[2 * f] = left >= 0 ? left : right;
-            face_cells[2 * f + 1] = left >= 0 ? right : -1;
-            face_xy[2 * f] = -half + i * dx, face_xy[2 * f + 1] = -half + (j + 0.5) * dx, length[f] = dx;
-        }
-    for (int j = 0; j <= n; ++j)
-        for (int i = 0; i < n; ++i, ++f) {
-            const int64_t below = j > 0 ? i + (int64_t)n * (j - 1) : -1, above = j < n ? i + (int64_t)n * j : -1;
-            face_cells[2 * f] = below >= 0 ? below : above;
-            face_cells[2 * f + 1] = below >= 0 ? above : -1;
-            face_xy[2 * f] = -half + (i + 0.5) * dx, face_xy[2 * f + 1] = -half + j * dx, length[f] = dx;
-        }
+    quad_graph q = quad_graph_make(n, half);
     dpsm_grid *poly = NULL, *graph = NULL;
     CHECK_OK(NULL, scene_create(&s, &poly));
-    CHECK_OK(NULL, dpsm_create_graph(s.cells, cell_xy, s.area, nfaces, face_cells, face_xy, length, &graph));
+    CHECK_OK(NULL, dpsm_create_graph(q.ncells, q.cell_xy, s.area, q.nfaces, q.face_cells, q.face_xy, q.length, &graph));
     double *h = column_heights(&s, 1.0, 0.5), *hg = calloc((size_t)s.cells, sizeof(double));
     dpsm_grid *both[2] = {poly, graph};
     for (int k = 0; k < 2; ++k) {
@@ -473,7 +800,8 @@ static void test_graph_steps_as_polygons(void **state) {
         REQUIRE(fabs(h[c] - hg[c]) <= 1e-12, "cell %lld: polygons %.17g, graph %.17g", (long long)c, h[c], hg[c]);
     REQUIRE(fabs(mass_of(poly, DPSM_MASS_OUTFLOW) - mass_of(graph, DPSM_MASS_OUTFLOW)) <= 1e-12,
             "outflow: polygons %.17g, graph %.17g", mass_of(poly, DPSM_MASS_OUTFLOW), mass_of(graph, DPSM_MASS_OUTFLOW));
-    free(face_cells), free(face_xy), free(length), free(cell_xy), free(h), free(hg);
+    free(h), free(hg);
+    quad_graph_free(&q);
     dpsm_destroy(poly), dpsm_destroy(graph);
     scene_free(&s);
 }
@@ -586,15 +914,18 @@ static void test_fluxes_match_height_changes(void **state) {
 }
 
 /* A mesh saved in the middle of a run and loaded again continues bit for bit
- * as the one that was not saved, on each constructor's mesh. */
+ * as the one that was not saved, on each constructor's mesh, with indices
+ * from 0 (format version 5) and from 1 (version 6: the loaded mesh counts
+ * from 1 as the saved one did). */
 static void test_restart_on_meshes(void **state) {
     (void)state;
-    const scene_kind kinds[3] = {SCENE_TRIANGLES, SCENE_HEXAGONS, SCENE_DUAL};
+    const scene_kind kinds[5] = {SCENE_TRIANGLES, SCENE_HEXAGONS, SCENE_DUAL, SCENE_HEXAGONS, SCENE_DUAL};
+    const int bases[5] = {0, 0, 0, 1, 1};
     char path[64];
     snprintf(path, sizeof path, "test_mesh_restart_%d.dpsm", (int)getpid());
-    for (int k = 0; k < 3; ++k) {
+    for (int k = 0; k < 5; ++k) {
         mesh_scene s = scene_make(kinds[k], 20, 2.5, 9u);
-        dpsm_grid *a = column_mesh(&s, 0), *b = NULL;
+        dpsm_grid *a = column_mesh(&s, 0, bases[k]), *b = NULL;
         int64_t nfaces = 0;
         CHECK_OK(a, dpsm_get_face_count(a, &nfaces));
         int64_t *faces = calloc((size_t)(2 * nfaces), sizeof(int64_t));
@@ -617,6 +948,8 @@ static void test_restart_on_meshes(void **state) {
         CHECK_OK(a, dpsm_set_face_flux_recording(a, 1));
         CHECK_OK(a, dpsm_step(a, 0.2));
         CHECK_OK(a, dpsm_save(a, path));
+        REQUIRE(file_version(path) == 5u + (unsigned)bases[k], "%s from %d: a file of version %u", scene_name(kinds[k]),
+                bases[k], file_version(path));
         CHECK_OK(NULL, dpsm_load(path, &b));
         int64_t nx = 0, ny = 0, nf = 0;
         CHECK_OK(b, dpsm_get_shape(b, &nx, &ny));
@@ -627,6 +960,13 @@ static void test_restart_on_meshes(void **state) {
         CHECK_OK(b, dpsm_get_mesh_faces(b, faces_b));
         REQUIRE(memcmp(faces, faces_b, sizeof(int64_t) * (size_t)(2 * nfaces)) == 0, "%s: the faces differ after loading",
                 scene_name(kinds[k]));
+        int64_t an_edge = 0;
+        while (faces_b[2 * an_edge + 1] != bases[k] - 1) ++an_edge;
+        /* The loaded mesh names its faces from the saved one's start index. */
+        edges[an_edge] = 7;
+        char named[48];
+        snprintf(named, sizeof named, "(face %lld, on the domain edge) = 7", (long long)(an_edge + bases[k]));
+        EXPECT_FAIL_ON(b, dpsm_set_edge_kinds(b, edges), DPSM_ERR_UNKNOWN_ENUM, named);
         for (int call = 0; call < 3; ++call) {
             CHECK_OK(a, dpsm_step(a, 0.2));
             CHECK_OK(b, dpsm_step(b, 0.2));
@@ -662,6 +1002,9 @@ int main(void) {
         cmocka_unit_test(test_create_graph_and_dual),
         cmocka_unit_test(test_bad_meshes),
         cmocka_unit_test(test_mesh_functions),
+        cmocka_unit_test(test_indexed_same_as_from_zero),
+        cmocka_unit_test(test_indexed_bad_inputs),
+        cmocka_unit_test(test_indexed_later_messages),
         cmocka_unit_test(test_column_rests_with_mass_and_bounds),
         cmocka_unit_test(test_no_new_extremum_on_rough_surfaces),
         cmocka_unit_test(test_exact_states),

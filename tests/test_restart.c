@@ -552,10 +552,10 @@ static void test_values_are_checked_behind_the_checksum(void **state) {
     REQUIRE(get_u32(good + kOffsetVersion) == 1, "the small file is of version %u, not 1",
             get_u32(good + kOffsetVersion));
     memcpy(bytes, good, size);
-    put_u32(bytes + kOffsetVersion, 6);
+    put_u32(bytes + kOffsetVersion, 7);
     reseal(bytes, size);
     write_file(bad, bytes, size);
-    require_refused(bad, "written by a newer dpsm, version 6", "version 6");
+    require_refused(bad, "written by a newer dpsm, version 7", "version 7");
 
     /* The relaxations' flags: DPSM_RELAX_AUTO's needs version 3, and a file
      * cannot ask for both. */
@@ -566,6 +566,11 @@ static void test_values_are_checked_behind_the_checksum(void **state) {
     /* Version 4's parts need version 4: the recording flag (no data of its own). */
     write_with_header(bad, bytes, good, size, 3, 1u << 12);
     require_refused(bad, "need version 4", "the recording flag in version 3");
+    /* Version 6's flag, a mesh whose indices count from 1, needs version 6 and a mesh. */
+    write_with_header(bad, bytes, good, size, 5, 1u << 15);
+    require_refused(bad, "need version 6", "the flag of a mesh from 1 in version 5");
+    write_with_header(bad, bytes, good, size, 6, 1u << 15);
+    require_refused(bad, "holds no mesh", "the flag of a mesh from 1 on a grid");
 
     require_refused_with_f64(bad, bytes, good, size, kOffsetRepose, 2.0, "angle of repose 2 radians",
                              "a repose angle of 2");

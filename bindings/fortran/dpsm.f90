@@ -22,13 +22,16 @@
 !>    shape is checked against the grid (dpsm_get_shape) before C is called; a
 !>    mismatch fails with DPSM_ERR_INVALID_SIZE and a message naming both shapes.
 !>  - Meshes: the constructors take node and cell indices 1-based, as Fortran
-!>    hosts hold them (0 for the domain edge in face_cells), and pass C 0-based
-!>    copies; dpsm_get_mesh_faces returns them 1-based. Pairs and triples are
-!>    columns: node_xy(2, nnodes), face_cells(2, nfaces), triangle_nodes(3,
-!>    ntriangles). On a mesh every per-cell array is h(ncells) (or
-!>    h(ncells, 1)), face arrays (dpsm_get_face_fluxes' fx, dpsm_set_edge_kinds'
-!>    kinds, the levels of DPSM_MESH_EDGE) hold nfaces values. Messages of the
-!>    C library count from 0 (see "meshes" below).
+!>    hosts hold them (0 for the domain edge in face_cells), and hand C the
+!>    host's own arrays with start_index 1 (dpsm_create_mesh_indexed and the
+!>    others, which take any start index, 0 or 1, themselves);
+!>    dpsm_get_mesh_faces returns them as the mesh counts, 1-based. Pairs and
+!>    triples are columns: node_xy(2, nnodes), face_cells(2, nfaces),
+!>    triangle_nodes(3, ntriangles). On a mesh every per-cell array is
+!>    h(ncells) (or h(ncells, 1)), face arrays (dpsm_get_face_fluxes' fx,
+!>    dpsm_set_edge_kinds' kinds, the levels of DPSM_MESH_EDGE) hold nfaces
+!>    values. The C library's messages on such a mesh count from 1, as the
+!>    host does (see "meshes" below).
 !>  - Paths (dpsm_save, dpsm_load) are default character strings; trailing
 !>    blanks are dropped, so a path held in a longer variable may be passed.
 !>  - Every #define constant of dpsm.h is a parameter of the same name.
@@ -136,6 +139,7 @@ module dpsm
   public :: dpsm_save, dpsm_load
   public :: dpsm_last_error, dpsm_status_string, dpsm_version_string, dpsm_version_number
   public :: dpsm_create_mesh, dpsm_create_graph, dpsm_create_dual_mesh
+  public :: dpsm_create_mesh_indexed, dpsm_create_graph_indexed, dpsm_create_dual_mesh_indexed
   public :: dpsm_get_face_count, dpsm_get_mesh_faces, dpsm_set_edge_kinds
   ! Not in C: .true. when g holds a grid (its handle is not NULL).
   public :: dpsm_associated
@@ -161,6 +165,15 @@ module dpsm
   interface dpsm_create_dual_mesh
     module procedure create_dual_mesh_i64, create_dual_mesh_i32
   end interface dpsm_create_dual_mesh
+  interface dpsm_create_mesh_indexed
+    module procedure create_mesh_indexed_i64, create_mesh_indexed_i32
+  end interface dpsm_create_mesh_indexed
+  interface dpsm_create_graph_indexed
+    module procedure create_graph_indexed_i64, create_graph_indexed_i32
+  end interface dpsm_create_graph_indexed
+  interface dpsm_create_dual_mesh_indexed
+    module procedure create_dual_mesh_indexed_i64, create_dual_mesh_indexed_i32
+  end interface dpsm_create_dual_mesh_indexed
   interface dpsm_get_face_count
     module procedure get_face_count_i64, get_face_count_i32
   end interface dpsm_get_face_count
@@ -236,6 +249,7 @@ module dpsm
       type(c_ptr), intent(out) :: out
     end function c_dpsm_create_axisymmetric
 
+    ! C's constructors from 0; the module calls the _indexed ones below.
     integer(c_int) function c_dpsm_create_mesh(nnodes, node_xy, ncells, cell_start, cell_nodes, out) &
         bind(C, name='dpsm_create_mesh')
       import :: c_int, c_int64_t, c_double, c_ptr
@@ -263,6 +277,37 @@ module dpsm
       type(c_ptr), intent(out) :: out
     end function c_dpsm_create_dual_mesh
 
+    integer(c_int) function c_dpsm_create_mesh_indexed(start_index, nnodes, node_xy, ncells, cell_start, cell_nodes, &
+                                                       out) bind(C, name='dpsm_create_mesh_indexed')
+      import :: c_int, c_int64_t, c_double, c_ptr
+      integer(c_int), value :: start_index
+      integer(c_int64_t), value :: nnodes, ncells
+      real(c_double), intent(in) :: node_xy(*)
+      integer(c_int64_t), intent(in) :: cell_start(*), cell_nodes(*) ! from start_index
+      type(c_ptr), intent(out) :: out
+    end function c_dpsm_create_mesh_indexed
+
+    integer(c_int) function c_dpsm_create_graph_indexed(start_index, ncells, cell_xy, cell_area, nfaces, face_cells, &
+                                                        face_xy, face_length, out) &
+        bind(C, name='dpsm_create_graph_indexed')
+      import :: c_int, c_int64_t, c_double, c_ptr
+      integer(c_int), value :: start_index
+      integer(c_int64_t), value :: ncells, nfaces
+      real(c_double), intent(in) :: cell_xy(*), cell_area(*), face_xy(*), face_length(*)
+      integer(c_int64_t), intent(in) :: face_cells(*) ! from start_index, start_index-1 on the domain edge
+      type(c_ptr), intent(out) :: out
+    end function c_dpsm_create_graph_indexed
+
+    integer(c_int) function c_dpsm_create_dual_mesh_indexed(start_index, nnodes, node_xy, ntriangles, triangle_nodes, &
+                                                            out) bind(C, name='dpsm_create_dual_mesh_indexed')
+      import :: c_int, c_int64_t, c_double, c_ptr
+      integer(c_int), value :: start_index
+      integer(c_int64_t), value :: nnodes, ntriangles
+      real(c_double), intent(in) :: node_xy(*)
+      integer(c_int64_t), intent(in) :: triangle_nodes(*) ! from start_index
+      type(c_ptr), intent(out) :: out
+    end function c_dpsm_create_dual_mesh_indexed
+
     integer(c_int) function c_dpsm_get_face_count(g, nfaces) bind(C, name='dpsm_get_face_count')
       import :: c_int, c_int64_t, c_ptr
       type(c_ptr), value :: g
@@ -272,7 +317,7 @@ module dpsm
     integer(c_int) function c_dpsm_get_mesh_faces(g, face_cells) bind(C, name='dpsm_get_mesh_faces')
       import :: c_int, c_int64_t, c_ptr
       type(c_ptr), value :: g
-      integer(c_int64_t), intent(inout) :: face_cells(*) ! 0-based, -1 on the domain edge
+      integer(c_int64_t), intent(inout) :: face_cells(*) ! from the mesh's start index, one less on the domain edge
     end function c_dpsm_get_mesh_faces
 
     integer(c_int) function c_dpsm_set_edge_kinds(g, kinds) bind(C, name='dpsm_set_edge_kinds')
@@ -773,23 +818,32 @@ contains
   ! ==== meshes ===============================================================
   !
   ! The constructors take the host's arrays with 1-based node and cell
-  ! indices, as Fortran hosts hold them, and call C with 0-based copies:
+  ! indices, as Fortran hosts hold them, and hand them to C as they are with
+  ! start_index 1 (C's dpsm_create_mesh_indexed and the others):
   ! cell_start(ncells+1) starts at 1 (cell c has the nodes
   ! cell_nodes(cell_start(c) : cell_start(c+1)-1)), face_cells(2, nfaces) holds
-  ! 0 for the domain edge (C's -1), triangle_nodes(3, ntriangles). Coordinates
-  ! are node_xy(2, nnodes) (x in row 1, y in row 2: C's (x, y) pairs).
+  ! 0 for the domain edge, triangle_nodes(3, ntriangles). Coordinates are
+  ! node_xy(2, nnodes) (x in row 1, y in row 2: C's (x, y) pairs).
+  ! dpsm_create_mesh_indexed(g, start_index, ...) and the other two take the
+  ! start index as their second argument: 0 for arrays counting from 0 (a
+  ! UGRID file's start_index = 0: cell_start(1) = 0, -1 for the domain edge),
+  ! 1 as the routines without it.
   !
   ! The sizes are checked against the arrays here (a mismatch fails with
   ! DPSM_ERR_INVALID_SIZE and a message naming both, which dpsm_last_error()
-  ! returns); everything else is checked by C. C's messages name the 0-based
-  ! copies it was given, not the host's arrays: an index in brackets is the
-  ! Fortran position less 1 (cell_nodes[4] is cell_nodes(5), face_cells[2f+1]
-  ! is face_cells(2, f+1)), cell, node, face and triangle numbers count from 0,
-  ! and the values shown are the converted ones, one less than the host's (a
-  ! node index 10 on a mesh of 9 nodes reads "= 9 is not a node index in
-  ! [0, 8]"; a face_cells value of -3 reads -4, an edge cell 0 reads -1).
-  ! The routines that take or return face arrays (dpsm_get_mesh_faces,
-  ! dpsm_set_edge_kinds) number the faces from 1, as the other arrays.
+  ! returns); everything else is checked by C, whose messages count as the
+  ! host does: cell, node, face and triangle numbers from the start index, the
+  ! values as the host gave them, array positions as Fortran writes them from
+  ! 1 (a node index 10 on a mesh of 9 nodes in cell_nodes(3) reads
+  ! "cell_nodes(3) = 10 is not a node index in [1, 9]"; a face_cells(2, 5) of
+  ! -3 on 2 cells reads "face 5: face_cells(2, 5) = -3 is not a cell index in
+  ! [1, 2] nor 0 (the domain edge)"). They name the C function called,
+  ! dpsm_create_mesh_indexed for dpsm_create_mesh. The mesh keeps its start
+  ! index: later messages count from it too (dpsm_set_heights' "h(3) (cell
+  ! 3)", dpsm_set_edge_kinds' "kinds(12) (face 12, on the domain edge)", in a
+  ! restart file's mesh as well), and dpsm_get_mesh_faces returns its cells
+  ! from it. The routines that take or return face arrays number the faces
+  ! from 1, as the other arrays.
 
   !> Records a failure found on the Fortran side when there is no grid to
   !> keep it, for dpsm_last_error().
@@ -843,31 +897,9 @@ contains
     integer(c_int64_t), intent(in) :: nnodes
     real(c_double), intent(in), contiguous :: node_xy(:, :)
     integer(c_int64_t), intent(in) :: ncells
-    integer(c_int64_t), intent(in) :: cell_start(:), cell_nodes(:)
+    integer(c_int64_t), intent(in), contiguous :: cell_start(:), cell_nodes(:)
     integer, intent(out), optional :: ierr
-    character(len=*), parameter :: fn = 'dpsm_create_mesh'
-    type(c_ptr) :: ptr
-    integer(c_int) :: status
-    integer(c_int64_t), allocatable :: start0(:), nodes0(:)
-    status = DPSM_OK
-    ! Counts below 1 are refused by C, with its message, before it reads an array.
-    if (nnodes >= 1 .and. ncells >= 1) then
-      status = check_columns(fn, 'node_xy', shape(node_xy), 2, nnodes, 'nnodes')
-      if (status == DPSM_OK) status = check_columns(fn, 'cell_start', shape(cell_start), 1, ncells + 1, 'ncells+1')
-      ! C reads cell_start(ncells+1)-1 node indices once cell_start(1) is 1
-      ! and every cell has at least 3 nodes; it refuses the others first.
-      if (status == DPSM_OK .and. cell_start(1) == 1) &
-        status = check_columns(fn, 'cell_nodes', shape(cell_nodes), 1, cell_start(ncells + 1) - 1, &
-                               'cell_start(ncells+1)-1')
-    end if
-    ptr = c_null_ptr
-    if (status == DPSM_OK) then
-      allocate (start0, source=cell_start - 1)
-      allocate (nodes0, source=cell_nodes - 1)
-      status = c_dpsm_create_mesh(nnodes, node_xy, ncells, start0, nodes0, ptr)
-    end if
-    call adopt(g, ptr, status)
-    call finish(status, ierr, fn)
+    call make_mesh(g, 'dpsm_create_mesh', 1, nnodes, node_xy, ncells, cell_start, cell_nodes, ierr)
   end subroutine create_mesh_i64
 
   subroutine create_mesh_i32(g, nnodes, node_xy, ncells, cell_start, cell_nodes, ierr)
@@ -879,6 +911,68 @@ contains
     integer, intent(out), optional :: ierr
     call create_mesh_i64(g, i64(nnodes), node_xy, i64(ncells), i64(cell_start), i64(cell_nodes), ierr)
   end subroutine create_mesh_i32
+
+  !> dpsm_create_mesh_indexed(g, start_index, nnodes, node_xy, ncells, cell_start, cell_nodes[, ierr]):
+  !> as dpsm_create_mesh, the indices counting from start_index (0 or 1):
+  !> cell_start(1) = start_index, node indices from start_index.
+  subroutine create_mesh_indexed_i64(g, start_index, nnodes, node_xy, ncells, cell_start, cell_nodes, ierr)
+    type(dpsm_grid), intent(out) :: g
+    integer, intent(in) :: start_index
+    integer(c_int64_t), intent(in) :: nnodes
+    real(c_double), intent(in), contiguous :: node_xy(:, :)
+    integer(c_int64_t), intent(in) :: ncells
+    integer(c_int64_t), intent(in), contiguous :: cell_start(:), cell_nodes(:)
+    integer, intent(out), optional :: ierr
+    call make_mesh(g, 'dpsm_create_mesh_indexed', start_index, nnodes, node_xy, ncells, cell_start, cell_nodes, ierr)
+  end subroutine create_mesh_indexed_i64
+
+  subroutine create_mesh_indexed_i32(g, start_index, nnodes, node_xy, ncells, cell_start, cell_nodes, ierr)
+    type(dpsm_grid), intent(out) :: g
+    integer, intent(in) :: start_index
+    integer(c_int32_t), intent(in) :: nnodes
+    real(c_double), intent(in), contiguous :: node_xy(:, :)
+    integer(c_int32_t), intent(in) :: ncells
+    integer(c_int32_t), intent(in) :: cell_start(:), cell_nodes(:)
+    integer, intent(out), optional :: ierr
+    call create_mesh_indexed_i64(g, start_index, i64(nnodes), node_xy, i64(ncells), i64(cell_start), &
+                                 i64(cell_nodes), ierr)
+  end subroutine create_mesh_indexed_i32
+
+  !> The polygons' constructor behind dpsm_create_mesh(_indexed): the shapes
+  !> checked, then C's dpsm_create_mesh_indexed on the host's arrays.
+  subroutine make_mesh(g, fn, start_index, nnodes, node_xy, ncells, cell_start, cell_nodes, ierr)
+    type(dpsm_grid), intent(out) :: g
+    character(len=*), intent(in) :: fn
+    integer, intent(in) :: start_index
+    integer(c_int64_t), intent(in) :: nnodes
+    real(c_double), intent(in), contiguous :: node_xy(:, :)
+    integer(c_int64_t), intent(in) :: ncells
+    integer(c_int64_t), intent(in), contiguous :: cell_start(:), cell_nodes(:)
+    integer, intent(out), optional :: ierr
+    type(c_ptr) :: ptr
+    integer(c_int) :: status
+    character(len=:), allocatable :: count_name
+    status = DPSM_OK
+    ! Counts below 1 and a start index other than 0 and 1 are refused by C,
+    ! with its message, before it reads an array.
+    if (nnodes >= 1 .and. ncells >= 1 .and. (start_index == 0 .or. start_index == 1)) then
+      status = check_columns(fn, 'node_xy', shape(node_xy), 2, nnodes, 'nnodes')
+      if (status == DPSM_OK) status = check_columns(fn, 'cell_start', shape(cell_start), 1, ncells + 1, 'ncells+1')
+      ! C reads cell_start(ncells+1)-start_index node indices once
+      ! cell_start(1) is start_index and every cell has at least 3 nodes; it
+      ! refuses the others first.
+      count_name = 'cell_start(ncells+1)'
+      if (start_index == 1) count_name = count_name//'-1'
+      if (status == DPSM_OK .and. cell_start(1) == start_index) &
+        status = check_columns(fn, 'cell_nodes', shape(cell_nodes), 1, cell_start(ncells + 1) - start_index, &
+                               count_name)
+    end if
+    ptr = c_null_ptr
+    if (status == DPSM_OK) &
+      status = c_dpsm_create_mesh_indexed(int(start_index, c_int), nnodes, node_xy, ncells, cell_start, cell_nodes, ptr)
+    call adopt(g, ptr, status)
+    call finish(status, ierr, fn)
+  end subroutine make_mesh
 
   !> dpsm_create_graph(g, ncells, cell_xy, cell_area, nfaces, face_cells, face_xy, face_length[, ierr]):
   !> a mesh from a finite-volume graph: cell_xy(2, ncells) centres,
@@ -893,25 +987,8 @@ contains
     integer(c_int64_t), intent(in), contiguous :: face_cells(:, :)
     real(c_double), intent(in), contiguous :: face_xy(:, :), face_length(:)
     integer, intent(out), optional :: ierr
-    character(len=*), parameter :: fn = 'dpsm_create_graph'
-    type(c_ptr) :: ptr
-    integer(c_int) :: status
-    integer(c_int64_t), allocatable :: cells0(:, :)
-    status = DPSM_OK
-    if (ncells >= 1 .and. nfaces >= 1) then
-      status = check_columns(fn, 'cell_xy', shape(cell_xy), 2, ncells, 'ncells')
-      if (status == DPSM_OK) status = check_columns(fn, 'cell_area', shape(cell_area), 1, ncells, 'ncells')
-      if (status == DPSM_OK) status = check_columns(fn, 'face_cells', shape(face_cells), 2, nfaces, 'nfaces')
-      if (status == DPSM_OK) status = check_columns(fn, 'face_xy', shape(face_xy), 2, nfaces, 'nfaces')
-      if (status == DPSM_OK) status = check_columns(fn, 'face_length', shape(face_length), 1, nfaces, 'nfaces')
-    end if
-    ptr = c_null_ptr
-    if (status == DPSM_OK) then
-      allocate (cells0, source=face_cells - 1) ! the domain edge, 0, becomes C's -1
-      status = c_dpsm_create_graph(ncells, cell_xy, cell_area, nfaces, cells0, face_xy, face_length, ptr)
-    end if
-    call adopt(g, ptr, status)
-    call finish(status, ierr, fn)
+    call make_graph(g, 'dpsm_create_graph', 1, ncells, cell_xy, cell_area, nfaces, face_cells, face_xy, face_length, &
+                    ierr)
   end subroutine create_graph_i64
 
   subroutine create_graph_i32(g, ncells, cell_xy, cell_area, nfaces, face_cells, face_xy, face_length, ierr)
@@ -925,6 +1002,67 @@ contains
     call create_graph_i64(g, i64(ncells), cell_xy, cell_area, i64(nfaces), i64(face_cells), face_xy, face_length, ierr)
   end subroutine create_graph_i32
 
+  !> dpsm_create_graph_indexed(g, start_index, ncells, cell_xy, cell_area, nfaces, face_cells, face_xy,
+  !> face_length[, ierr]): as dpsm_create_graph, the cells in face_cells
+  !> counting from start_index (0 or 1), start_index-1 on the domain edge.
+  subroutine create_graph_indexed_i64(g, start_index, ncells, cell_xy, cell_area, nfaces, face_cells, face_xy, &
+                                      face_length, ierr)
+    type(dpsm_grid), intent(out) :: g
+    integer, intent(in) :: start_index
+    integer(c_int64_t), intent(in) :: ncells
+    real(c_double), intent(in), contiguous :: cell_xy(:, :), cell_area(:)
+    integer(c_int64_t), intent(in) :: nfaces
+    integer(c_int64_t), intent(in), contiguous :: face_cells(:, :)
+    real(c_double), intent(in), contiguous :: face_xy(:, :), face_length(:)
+    integer, intent(out), optional :: ierr
+    call make_graph(g, 'dpsm_create_graph_indexed', start_index, ncells, cell_xy, cell_area, nfaces, face_cells, &
+                    face_xy, face_length, ierr)
+  end subroutine create_graph_indexed_i64
+
+  subroutine create_graph_indexed_i32(g, start_index, ncells, cell_xy, cell_area, nfaces, face_cells, face_xy, &
+                                      face_length, ierr)
+    type(dpsm_grid), intent(out) :: g
+    integer, intent(in) :: start_index
+    integer(c_int32_t), intent(in) :: ncells
+    real(c_double), intent(in), contiguous :: cell_xy(:, :), cell_area(:)
+    integer(c_int32_t), intent(in) :: nfaces
+    integer(c_int32_t), intent(in), contiguous :: face_cells(:, :)
+    real(c_double), intent(in), contiguous :: face_xy(:, :), face_length(:)
+    integer, intent(out), optional :: ierr
+    call create_graph_indexed_i64(g, start_index, i64(ncells), cell_xy, cell_area, i64(nfaces), i64(face_cells), &
+                                  face_xy, face_length, ierr)
+  end subroutine create_graph_indexed_i32
+
+  !> The graph's constructor behind dpsm_create_graph(_indexed): the shapes
+  !> checked, then C's dpsm_create_graph_indexed on the host's arrays.
+  subroutine make_graph(g, fn, start_index, ncells, cell_xy, cell_area, nfaces, face_cells, face_xy, face_length, ierr)
+    type(dpsm_grid), intent(out) :: g
+    character(len=*), intent(in) :: fn
+    integer, intent(in) :: start_index
+    integer(c_int64_t), intent(in) :: ncells
+    real(c_double), intent(in), contiguous :: cell_xy(:, :), cell_area(:)
+    integer(c_int64_t), intent(in) :: nfaces
+    integer(c_int64_t), intent(in), contiguous :: face_cells(:, :)
+    real(c_double), intent(in), contiguous :: face_xy(:, :), face_length(:)
+    integer, intent(out), optional :: ierr
+    type(c_ptr) :: ptr
+    integer(c_int) :: status
+    status = DPSM_OK
+    if (ncells >= 1 .and. nfaces >= 1) then
+      status = check_columns(fn, 'cell_xy', shape(cell_xy), 2, ncells, 'ncells')
+      if (status == DPSM_OK) status = check_columns(fn, 'cell_area', shape(cell_area), 1, ncells, 'ncells')
+      if (status == DPSM_OK) status = check_columns(fn, 'face_cells', shape(face_cells), 2, nfaces, 'nfaces')
+      if (status == DPSM_OK) status = check_columns(fn, 'face_xy', shape(face_xy), 2, nfaces, 'nfaces')
+      if (status == DPSM_OK) status = check_columns(fn, 'face_length', shape(face_length), 1, nfaces, 'nfaces')
+    end if
+    ptr = c_null_ptr
+    if (status == DPSM_OK) &
+      status = c_dpsm_create_graph_indexed(int(start_index, c_int), ncells, cell_xy, cell_area, nfaces, face_cells, &
+                                           face_xy, face_length, ptr)
+    call adopt(g, ptr, status)
+    call finish(status, ierr, fn)
+  end subroutine make_graph
+
   !> dpsm_create_dual_mesh(g, nnodes, node_xy, ntriangles, triangle_nodes[, ierr]):
   !> the median dual of a triangle mesh, one cell per node: node_xy(2, nnodes),
   !> triangle_nodes(3, ntriangles) of 1-based node indices.
@@ -935,23 +1073,7 @@ contains
     integer(c_int64_t), intent(in) :: ntriangles
     integer(c_int64_t), intent(in), contiguous :: triangle_nodes(:, :)
     integer, intent(out), optional :: ierr
-    character(len=*), parameter :: fn = 'dpsm_create_dual_mesh'
-    type(c_ptr) :: ptr
-    integer(c_int) :: status
-    integer(c_int64_t), allocatable :: nodes0(:, :)
-    status = DPSM_OK
-    if (nnodes >= 1 .and. ntriangles >= 1) then
-      status = check_columns(fn, 'node_xy', shape(node_xy), 2, nnodes, 'nnodes')
-      if (status == DPSM_OK) &
-        status = check_columns(fn, 'triangle_nodes', shape(triangle_nodes), 3, ntriangles, 'ntriangles')
-    end if
-    ptr = c_null_ptr
-    if (status == DPSM_OK) then
-      allocate (nodes0, source=triangle_nodes - 1)
-      status = c_dpsm_create_dual_mesh(nnodes, node_xy, ntriangles, nodes0, ptr)
-    end if
-    call adopt(g, ptr, status)
-    call finish(status, ierr, fn)
+    call make_dual_mesh(g, 'dpsm_create_dual_mesh', 1, nnodes, node_xy, ntriangles, triangle_nodes, ierr)
   end subroutine create_dual_mesh_i64
 
   subroutine create_dual_mesh_i32(g, nnodes, node_xy, ntriangles, triangle_nodes, ierr)
@@ -963,6 +1085,57 @@ contains
     integer, intent(out), optional :: ierr
     call create_dual_mesh_i64(g, i64(nnodes), node_xy, i64(ntriangles), i64(triangle_nodes), ierr)
   end subroutine create_dual_mesh_i32
+
+  !> dpsm_create_dual_mesh_indexed(g, start_index, nnodes, node_xy, ntriangles, triangle_nodes[, ierr]):
+  !> as dpsm_create_dual_mesh, the node indices counting from start_index (0 or 1).
+  subroutine create_dual_mesh_indexed_i64(g, start_index, nnodes, node_xy, ntriangles, triangle_nodes, ierr)
+    type(dpsm_grid), intent(out) :: g
+    integer, intent(in) :: start_index
+    integer(c_int64_t), intent(in) :: nnodes
+    real(c_double), intent(in), contiguous :: node_xy(:, :)
+    integer(c_int64_t), intent(in) :: ntriangles
+    integer(c_int64_t), intent(in), contiguous :: triangle_nodes(:, :)
+    integer, intent(out), optional :: ierr
+    call make_dual_mesh(g, 'dpsm_create_dual_mesh_indexed', start_index, nnodes, node_xy, ntriangles, triangle_nodes, &
+                        ierr)
+  end subroutine create_dual_mesh_indexed_i64
+
+  subroutine create_dual_mesh_indexed_i32(g, start_index, nnodes, node_xy, ntriangles, triangle_nodes, ierr)
+    type(dpsm_grid), intent(out) :: g
+    integer, intent(in) :: start_index
+    integer(c_int32_t), intent(in) :: nnodes
+    real(c_double), intent(in), contiguous :: node_xy(:, :)
+    integer(c_int32_t), intent(in) :: ntriangles
+    integer(c_int32_t), intent(in), contiguous :: triangle_nodes(:, :)
+    integer, intent(out), optional :: ierr
+    call create_dual_mesh_indexed_i64(g, start_index, i64(nnodes), node_xy, i64(ntriangles), i64(triangle_nodes), ierr)
+  end subroutine create_dual_mesh_indexed_i32
+
+  !> The dual's constructor behind dpsm_create_dual_mesh(_indexed): the
+  !> shapes checked, then C's dpsm_create_dual_mesh_indexed on the host's arrays.
+  subroutine make_dual_mesh(g, fn, start_index, nnodes, node_xy, ntriangles, triangle_nodes, ierr)
+    type(dpsm_grid), intent(out) :: g
+    character(len=*), intent(in) :: fn
+    integer, intent(in) :: start_index
+    integer(c_int64_t), intent(in) :: nnodes
+    real(c_double), intent(in), contiguous :: node_xy(:, :)
+    integer(c_int64_t), intent(in) :: ntriangles
+    integer(c_int64_t), intent(in), contiguous :: triangle_nodes(:, :)
+    integer, intent(out), optional :: ierr
+    type(c_ptr) :: ptr
+    integer(c_int) :: status
+    status = DPSM_OK
+    if (nnodes >= 1 .and. ntriangles >= 1) then
+      status = check_columns(fn, 'node_xy', shape(node_xy), 2, nnodes, 'nnodes')
+      if (status == DPSM_OK) &
+        status = check_columns(fn, 'triangle_nodes', shape(triangle_nodes), 3, ntriangles, 'ntriangles')
+    end if
+    ptr = c_null_ptr
+    if (status == DPSM_OK) &
+      status = c_dpsm_create_dual_mesh_indexed(int(start_index, c_int), nnodes, node_xy, ntriangles, triangle_nodes, ptr)
+    call adopt(g, ptr, status)
+    call finish(status, ierr, fn)
+  end subroutine make_dual_mesh
 
   !> dpsm_get_face_count(g, nfaces[, ierr]): the faces of a mesh, interior and
   !> on the domain edge (DPSM_ERR_NOT_APPLICABLE on a grid).
@@ -1027,18 +1200,21 @@ contains
   end function check_face_shape
 
   !> dpsm_get_mesh_faces(g, face_cells[, ierr]): face_cells(2, nfaces), the
-  !> two cells (a, b) of every face, 1-based, b = 0 on the domain edge, in
-  !> the host's face order (that of dpsm_get_face_fluxes, dpsm_set_edge_kinds
-  !> and the levels of DPSM_MESH_EDGE). integer(c_int64_t) or default integers.
+  !> two cells (a, b) of every face as the mesh counts them: 1-based with
+  !> b = 0 on the domain edge for a mesh of dpsm_create_mesh and the others
+  !> (from the start index, one less on the edge, for one of the _indexed
+  !> routines), in the host's face order (that of dpsm_get_face_fluxes,
+  !> dpsm_set_edge_kinds and the levels of DPSM_MESH_EDGE).
+  !> integer(c_int64_t) or default integers.
   subroutine get_mesh_faces_i64(g, face_cells, ierr)
     type(dpsm_grid), intent(in) :: g
     integer(c_int64_t), intent(inout), contiguous :: face_cells(:, :)
     integer, intent(out), optional :: ierr
-    integer(c_int64_t), allocatable :: cells0(:)
+    integer(c_int64_t), allocatable :: cells(:)
     integer(c_int) :: status
     call clear_message(g)
-    status = mesh_faces(g, shape(face_cells), cells0)
-    if (status == DPSM_OK) face_cells = reshape(cells0 + 1, shape(face_cells))
+    status = mesh_faces(g, shape(face_cells), cells)
+    if (status == DPSM_OK) face_cells = reshape(cells, shape(face_cells))
     call finish(status, ierr, 'dpsm_get_mesh_faces', g)
   end subroutine get_mesh_faces_i64
 
@@ -1046,34 +1222,35 @@ contains
     type(dpsm_grid), intent(in) :: g
     integer(c_int32_t), intent(inout), contiguous :: face_cells(:, :)
     integer, intent(out), optional :: ierr
-    integer(c_int64_t), allocatable :: cells0(:)
+    integer(c_int64_t), allocatable :: cells(:)
     integer(c_int) :: status
     call clear_message(g)
-    status = mesh_faces(g, shape(face_cells), cells0)
+    status = mesh_faces(g, shape(face_cells), cells)
     if (status == DPSM_OK) then
-      if (maxval(cells0) >= huge(face_cells)) then
+      if (maxval(cells) > huge(face_cells)) then
         status = DPSM_ERR_INVALID_SIZE
         call set_message(g, 'dpsm_get_mesh_faces: the mesh has cells beyond huge(integer(c_int32_t)): '// &
                          'pass an integer(c_int64_t) face_cells')
       else
-        face_cells = reshape(int(cells0 + 1, c_int32_t), shape(face_cells))
+        face_cells = reshape(int(cells, c_int32_t), shape(face_cells))
       end if
     end if
     call finish(status, ierr, 'dpsm_get_mesh_faces', g)
   end subroutine get_mesh_faces_i32
 
-  !> The faces' cells as C gives them (0-based), after the shape check.
-  function mesh_faces(g, array_shape, cells0) result(status)
+  !> The faces' cells as C gives them (from the mesh's start index), after
+  !> the shape check.
+  function mesh_faces(g, array_shape, cells) result(status)
     type(dpsm_grid), intent(in) :: g
     integer, intent(in) :: array_shape(:)
-    integer(c_int64_t), allocatable, intent(out) :: cells0(:)
+    integer(c_int64_t), allocatable, intent(out) :: cells(:)
     integer(c_int) :: status
     integer(c_int64_t) :: nfaces
     status = face_count(g, nfaces)
     if (status /= DPSM_OK) then
       ! C's message (a grid, not a mesh; no grid) comes with the call itself.
-      allocate (cells0(1))
-      status = c_dpsm_get_mesh_faces(g%ptr, cells0)
+      allocate (cells(1))
+      status = c_dpsm_get_mesh_faces(g%ptr, cells)
       return
     end if
     if (array_shape(1) /= 2 .or. int(array_shape(2), c_int64_t) /= nfaces) then
@@ -1082,8 +1259,8 @@ contains
                        ' but the mesh has nfaces = '//itoa(nfaces)//': pass face_cells(2, nfaces)')
       return
     end if
-    allocate (cells0(2*nfaces))
-    status = c_dpsm_get_mesh_faces(g%ptr, cells0)
+    allocate (cells(2*nfaces))
+    status = c_dpsm_get_mesh_faces(g%ptr, cells)
   end function mesh_faces
 
   !> dpsm_set_edge_kinds(g, kinds[, ierr]): kinds(nfaces) of DPSM_OPEN or

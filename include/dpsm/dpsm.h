@@ -273,7 +273,9 @@ DPSM_API int dpsm_create_axisymmetric(int64_t nr, double dr, dpsm_grid **out);
  * cell order; dpsm_get_shape() gives `(ncells, 1)`. The faces are numbered
  * as they first appear, cell by cell, edge by edge in each cell's node
  * order; dpsm_get_mesh_faces() lists their cells. The library renumbers
- * cells inside for memory locality; the host never sees it.
+ * cells inside for memory locality; the host never sees it. Indices count
+ * from 0 here and in the messages; dpsm_create_mesh_indexed() takes them
+ * from 1, as a Fortran host or a UGRID file with `start_index = 1` holds them.
  *
  * A face's slope is the two-point difference between its cells' centroids
  * plus the part across it of their least-squares gradients (see
@@ -305,7 +307,8 @@ DPSM_API int dpsm_create_mesh(int64_t nnodes, const double *node_xy, int64_t nce
  * line between their cells' centres (as these codes' meshes are built); on
  * the domain edge the outside is the cell's mirror image across the face
  * midpoint. Arrays of the other functions hold one value per cell, faces
- * keep the host's order.
+ * keep the host's order. Indices count from 0; dpsm_create_graph_indexed()
+ * takes them from 1.
  *
  * @param ncells       number of cells, at least 1.
  * @param cell_xy      `2*ncells` centres.
@@ -332,6 +335,7 @@ DPSM_API int dpsm_create_graph(int64_t ncells, const double *cell_xy, const doub
  * sources and kinds are per node. The faces are the triangle edges, in order
  * of their node pair (lower node first), then the halves of the boundary
  * edges on the domain edge, in the same order, the lower node's half first.
+ * Indices count from 0; dpsm_create_dual_mesh_indexed() takes them from 1.
  *
  * @param nnodes          number of nodes, at least 1; every node in some triangle.
  * @param node_xy         `2*nnodes` coordinates.
@@ -342,6 +346,93 @@ DPSM_API int dpsm_create_graph(int64_t ncells, const double *cell_xy, const doub
  */
 DPSM_API int dpsm_create_dual_mesh(int64_t nnodes, const double *node_xy, int64_t ntriangles,
                                    const int64_t *triangle_nodes, dpsm_grid **out);
+
+/**
+ * @brief As dpsm_create_mesh(), with the index arrays counting from
+ *        `start_index`: 0 as in C, or 1 as in Fortran (UGRID's
+ *        `start_index` attribute).
+ *
+ * With `start_index` s, `cell_start[0] == s` and the offsets count from s:
+ * the cell at C position `c` of `cell_start` (the host's cell `c + s`) has
+ * the nodes `cell_nodes[cell_start[c] - s .. cell_start[c+1] - 1 - s]` (C
+ * positions), and the node indices in `cell_nodes` count from s. A Fortran
+ * host passes its own arrays: `cell_start(ncells+1)` from 1, cell `c` the
+ * nodes `cell_nodes(cell_start(c) : cell_start(c+1)-1)`.
+ *
+ * The mesh remembers s: every message of this call and of later calls that
+ * names a cell, node or face of the mesh counts from s and quotes the values
+ * as the host gave them (a node index 10 on 9 nodes, from 1: "= 10 is not a
+ * node index in [1, 9]"); with s = 1 array positions read as Fortran writes
+ * them, `cell_nodes(5)`, `node_xy(2, 4)` (C: `cell_nodes[4]`, `node_xy[7]`).
+ * dpsm_get_mesh_faces() returns cells from s, s - 1 on the domain edge, and
+ * dpsm_save() keeps s with the mesh. Everything else is as
+ * dpsm_create_mesh(), which is this function with s = 0 (its messages name
+ * dpsm_create_mesh, these dpsm_create_mesh_indexed).
+ *
+ * @param start_index where the indices count from: 0 or 1.
+ * @param nnodes      number of nodes, at least 1.
+ * @param node_xy     `2*nnodes` coordinates (x, y), finite.
+ * @param ncells      number of cells, at least 1.
+ * @param cell_start  `ncells+1` offsets into `cell_nodes`, counting from
+ *                    `start_index` (`cell_start[0] == start_index`), at least
+ *                    3 nodes per cell.
+ * @param cell_nodes  node indices, from `start_index`.
+ * @param out         receives the new mesh, or NULL on failure.
+ * @return as dpsm_create_mesh(); also ::DPSM_ERR_INVALID_VALUE for a
+ *         `start_index` other than 0 and 1 (the message names the value and
+ *         the two allowed).
+ */
+DPSM_API int dpsm_create_mesh_indexed(int start_index, int64_t nnodes, const double *node_xy, int64_t ncells,
+                                      const int64_t *cell_start, const int64_t *cell_nodes, dpsm_grid **out);
+
+/**
+ * @brief As dpsm_create_graph(), with the index arrays counting from
+ *        `start_index`: 0 as in C, or 1 as in Fortran.
+ *
+ * With `start_index` s, the cells in `face_cells` count from s and the domain
+ * edge is s - 1 (-1 from 0, 0 from 1): a Fortran host passes its own
+ * `face_cells(2, nfaces)`. The mesh remembers s, as
+ * dpsm_create_mesh_indexed() says: messages name cells and faces from s with
+ * the host's values, dpsm_get_mesh_faces() returns cells from s and s - 1 on
+ * the domain edge. dpsm_create_graph() is this function with s = 0.
+ *
+ * @param start_index  where the indices count from: 0 or 1.
+ * @param ncells       number of cells, at least 1.
+ * @param cell_xy      `2*ncells` centres.
+ * @param cell_area    `ncells` positive areas.
+ * @param nfaces       number of faces, at least 1.
+ * @param face_cells   `2*nfaces` cell indices (a, b) from `start_index`;
+ *                     b == `start_index - 1` on the domain edge.
+ * @param face_xy      `2*nfaces` face midpoints.
+ * @param face_length  `nfaces` positive lengths.
+ * @param out          receives the new mesh, or NULL on failure.
+ * @return as dpsm_create_graph(); also ::DPSM_ERR_INVALID_VALUE for a
+ *         `start_index` other than 0 and 1.
+ */
+DPSM_API int dpsm_create_graph_indexed(int start_index, int64_t ncells, const double *cell_xy, const double *cell_area,
+                                       int64_t nfaces, const int64_t *face_cells, const double *face_xy,
+                                       const double *face_length, dpsm_grid **out);
+
+/**
+ * @brief As dpsm_create_dual_mesh(), with the node indices counting from
+ *        `start_index`: 0 as in C, or 1 as in Fortran (TELEMAC's IKLE).
+ *
+ * With `start_index` s, `triangle_nodes` holds node indices from s (a Fortran
+ * host passes its own `triangle_nodes(3, ntriangles)`); node `n` of the host
+ * is the mesh's cell `n`, so cells count from s too. The mesh remembers s, as
+ * dpsm_create_mesh_indexed() says. dpsm_create_dual_mesh() is this function
+ * with s = 0.
+ *
+ * @param start_index     where the indices count from: 0 or 1.
+ * @param nnodes          number of nodes, at least 1; every node in some triangle.
+ * @param node_xy         `2*nnodes` coordinates.
+ * @param ntriangles      number of triangles, at least 1.
+ * @param triangle_nodes  `3*ntriangles` node indices, from `start_index`.
+ * @param out             receives the new mesh, or NULL on failure.
+ * @return as dpsm_create_mesh_indexed().
+ */
+DPSM_API int dpsm_create_dual_mesh_indexed(int start_index, int64_t nnodes, const double *node_xy, int64_t ntriangles,
+                                           const int64_t *triangle_nodes, dpsm_grid **out);
 
 /**
  * @brief Reads the number of faces of a mesh (interior and domain edge).
@@ -356,7 +447,10 @@ DPSM_API int dpsm_get_face_count(const dpsm_grid *g, int64_t *nfaces);
  *        and face order: what the values of dpsm_get_face_fluxes() and
  *        dpsm_set_edge_kinds() stand for.
  * @param g           the mesh.
- * @param face_cells  room for `2*nfaces` indices (a, b); b == -1 on the domain edge.
+ * @param face_cells  room for `2*nfaces` indices (a, b); b == -1 on the domain
+ *                    edge. On a mesh made with a start index
+ *                    (dpsm_create_mesh_indexed() and the others) the cells
+ *                    count from it and the domain edge is one less (0 from 1).
  * @return ::DPSM_OK, ::DPSM_ERR_NULL_POINTER or ::DPSM_ERR_NOT_APPLICABLE (a grid).
  */
 DPSM_API int dpsm_get_mesh_faces(const dpsm_grid *g, int64_t *face_cells);

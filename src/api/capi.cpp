@@ -18,6 +18,7 @@
 #include "model/limits.hpp"
 #include "model/grid.hpp"
 #include "io/restart.hpp"
+#include "mesh/mesh.hpp"
 #include "api/handle.hpp"
 #include "stepping/stepper.hpp"
 
@@ -86,14 +87,17 @@ void require_positive(double value, const char *function, const char *name) {
 const char *describe(double value) { return std::isnan(value) ? "NaN" : value > 0 ? "+Inf" : "-Inf"; }
 
 // Names the first value that is not finite or lies beyond the supported
-// range by its index and `where(k)`, the place it stands for.
+// range by its position (as a host counting from `base` writes it,
+// dpsm::host_position) and `where(k)`, the place it stands for.
 template <class Where>
-void require_in_range(const double *values, std::int64_t n, const char *function, const char *name, Where &&where) {
+void require_in_range(const double *values, std::int64_t n, const char *function, const char *name, Where &&where,
+                      int base = 0) {
     for (std::int64_t k = 0; k < n; ++k) {
         if (std::isfinite(values[k]) && std::fabs(values[k]) <= kMaxMagnitude) continue;
         if (!std::isfinite(values[k]))
-            fail(DPSM_ERR_INVALID_VALUE, function, name, "[", k, "] (", where(k), ") is ", describe(values[k]));
-        fail(DPSM_ERR_INVALID_VALUE, function, name, "[", k, "] (", where(k), ") = ", values[k],
+            fail(DPSM_ERR_INVALID_VALUE, function, dpsm::host_position(name, k, base), " (", where(k), ") is ",
+                 describe(values[k]));
+        fail(DPSM_ERR_INVALID_VALUE, function, dpsm::host_position(name, k, base), " (", where(k), ") = ", values[k],
              " is outside the supported range [-1e50, 1e50]");
     }
 }
@@ -102,21 +106,34 @@ std::string cell_name(std::int64_t i, std::int64_t j) {
     return "cell i = " + std::to_string(i) + ", j = " + std::to_string(j);
 }
 
-// A cell as the host numbers it: (i, j) on a grid, its index on a mesh.
+const dpsm::Mesh *mesh_of(const dpsm_grid *g) { return g->core.geometry().mesh.get(); }
+
+// Where the host's numbers of cells and faces begin: a mesh's start index
+// (0 or 1, as its constructor was given), 0 on a grid.
+int host_base(const dpsm_grid *g) {
+    const dpsm::Mesh *mesh = mesh_of(g);
+    return mesh ? mesh->input.start_index : 0;
+}
+
+// A cell as the host numbers it: (i, j) on a grid, its index on a mesh
+// (host order, from the mesh's start index).
 std::string host_cell_name(const dpsm_grid *g, std::int64_t c) {
     const dpsm::Geometry &geo = g->core.geometry();
-    if (geo.is_mesh()) return "cell " + std::to_string(c);
+    if (geo.is_mesh()) return "cell " + std::to_string(c + host_base(g));
     return cell_name(c % geo.nx, c / geo.nx);
+}
+
+// Array `name`'s position k (a cell's or a face's) as the host writes it.
+std::string host_position(const dpsm_grid *g, const char *name, std::int64_t k) {
+    return dpsm::host_position(name, k, host_base(g));
 }
 
 // Names the first non-finite element by its index and cell.
 void require_finite_array(const dpsm_grid *g, const double *values, const char *function, const char *name) {
     require_pointer(values, function, name);
     require_in_range(values, g->core.geometry().cells(), function, name,
-                     [&](std::int64_t c) { return host_cell_name(g, c); });
+                     [&](std::int64_t c) { return host_cell_name(g, c); }, host_base(g));
 }
-
-const dpsm::Mesh *mesh_of(const dpsm_grid *g) { return g->core.geometry().mesh.get(); }
 
 // On a mesh the library keeps its cells in an order of its own
 // (mesh/mesh.hpp): a host's array goes through `buffer` into it, and comes
@@ -199,8 +216,9 @@ void require_above_bed(const dpsm_grid *g, const dpsm::Grid::Block &b, const dou
         if (next < zb[c]) {
             const dpsm::Mesh *mesh = mesh_of(g);
             const std::int64_t host = mesh ? mesh->host_cell[c] : k;
-            fail(DPSM_ERR_INVALID_VALUE, function, name, "[", host, "] puts ", host_cell_name(g, mesh ? host : c),
-                 " at ", next, ", below its bed zb = ", zb[c], " (see dpsm_set_bedrock)");
+            fail(DPSM_ERR_INVALID_VALUE, function, host_position(g, name, host), " puts ",
+                 host_cell_name(g, mesh ? host : c), " at ", next, ", below its bed zb = ", zb[c],
+                 " (see dpsm_set_bedrock)");
         }
     }
 }
@@ -304,12 +322,16 @@ int create(int dim, bool axisymmetric, std::int64_t nx, std::int64_t ny, double 
     });
 }
 
-// A mesh from a builder of mesh/mesh.hpp.
+// A mesh from a builder of mesh/mesh.hpp, the host's arrays counting from
+// start_index.
 template <class Build>
-int create_mesh(dpsm_grid **out, const char *function, Build &&build) {
+int create_mesh(dpsm_grid **out, int start_index, const char *function, Build &&build) {
     if (out) *out = nullptr;
     return guarded(nullptr, function, [&] {
         require_pointer(out, function, "out");
+        if (start_index != 0 && start_index != 1)
+            fail(DPSM_ERR_INVALID_VALUE, function, "start_index = ", start_index,
+                 " is neither 0 (indices from 0, as in C) nor 1 (from 1, as in Fortran)");
         std::shared_ptr<const dpsm::Mesh> mesh = build();
         dpsm::Geometry geometry{2, false, mesh->cells, 1, mesh->min_distance, mesh->min_distance, mesh};
         *out = new dpsm_grid(geometry);
@@ -334,10 +356,38 @@ int dpsm_create_axisymmetric(int64_t nr, double dr, dpsm_grid **out) {
     return create(1, true, nr, 1, dr, 1.0, out, "dpsm_create_axisymmetric");
 }
 
+int dpsm_create_mesh_indexed(int start_index, int64_t nnodes, const double *node_xy, int64_t ncells,
+                             const int64_t *cell_start, const int64_t *cell_nodes, dpsm_grid **out) {
+    const char *fn = "dpsm_create_mesh_indexed";
+    return create_mesh(out, start_index, fn, [&] {
+        return dpsm::mesh_from_polygons(nnodes, node_xy, ncells, cell_start, cell_nodes, fn, start_index);
+    });
+}
+
+int dpsm_create_graph_indexed(int start_index, int64_t ncells, const double *cell_xy, const double *cell_area,
+                              int64_t nfaces, const int64_t *face_cells, const double *face_xy,
+                              const double *face_length, dpsm_grid **out) {
+    const char *fn = "dpsm_create_graph_indexed";
+    return create_mesh(out, start_index, fn, [&] {
+        return dpsm::mesh_from_graph(ncells, cell_xy, cell_area, nfaces, face_cells, face_xy, face_length, fn,
+                                     start_index);
+    });
+}
+
+int dpsm_create_dual_mesh_indexed(int start_index, int64_t nnodes, const double *node_xy, int64_t ntriangles,
+                                  const int64_t *triangle_nodes, dpsm_grid **out) {
+    const char *fn = "dpsm_create_dual_mesh_indexed";
+    return create_mesh(out, start_index, fn, [&] {
+        return dpsm::mesh_from_dual(nnodes, node_xy, ntriangles, triangle_nodes, fn, start_index);
+    });
+}
+
+// The constructors from 0, as C counts: the same as _indexed(0, ...), their
+// messages naming themselves.
 int dpsm_create_mesh(int64_t nnodes, const double *node_xy, int64_t ncells, const int64_t *cell_start,
                      const int64_t *cell_nodes, dpsm_grid **out) {
     const char *fn = "dpsm_create_mesh";
-    return create_mesh(out, fn, [&] {
+    return create_mesh(out, 0, fn, [&] {
         return dpsm::mesh_from_polygons(nnodes, node_xy, ncells, cell_start, cell_nodes, fn, 0);
     });
 }
@@ -345,7 +395,7 @@ int dpsm_create_mesh(int64_t nnodes, const double *node_xy, int64_t ncells, cons
 int dpsm_create_graph(int64_t ncells, const double *cell_xy, const double *cell_area, int64_t nfaces,
                       const int64_t *face_cells, const double *face_xy, const double *face_length, dpsm_grid **out) {
     const char *fn = "dpsm_create_graph";
-    return create_mesh(out, fn, [&] {
+    return create_mesh(out, 0, fn, [&] {
         return dpsm::mesh_from_graph(ncells, cell_xy, cell_area, nfaces, face_cells, face_xy, face_length, fn, 0);
     });
 }
@@ -353,7 +403,7 @@ int dpsm_create_graph(int64_t ncells, const double *cell_xy, const double *cell_
 int dpsm_create_dual_mesh(int64_t nnodes, const double *node_xy, int64_t ntriangles, const int64_t *triangle_nodes,
                           dpsm_grid **out) {
     const char *fn = "dpsm_create_dual_mesh";
-    return create_mesh(out, fn, [&] {
+    return create_mesh(out, 0, fn, [&] {
         return dpsm::mesh_from_dual(nnodes, node_xy, ntriangles, triangle_nodes, fn, 0);
     });
 }
@@ -375,9 +425,10 @@ int dpsm_get_mesh_faces(const dpsm_grid *g, int64_t *face_cells) {
         require_pointer(face_cells, fn, "face_cells");
         require_mesh(g, fn);
         const dpsm::Mesh &m = *mesh_of(g);
+        const int base = host_base(g);  // the host's cells from it, base - 1 the domain edge
         for (std::int64_t f = 0; f < m.faces; ++f) {
-            const std::int64_t a = m.host_cell[m.face_a[f]];
-            const std::int64_t b = m.face_b[f] < 0 ? -1 : m.host_cell[m.face_b[f]];
+            const std::int64_t a = m.host_cell[m.face_a[f]] + base;
+            const std::int64_t b = (m.face_b[f] < 0 ? -1 : m.host_cell[m.face_b[f]]) + base;
             const std::int64_t k = m.host_face[f];
             face_cells[2 * k] = m.host_sign[f] > 0 ? a : b;
             face_cells[2 * k + 1] = m.host_sign[f] > 0 ? b : a;
@@ -397,8 +448,8 @@ int dpsm_set_edge_kinds(dpsm_grid *g, const uint8_t *kinds) {
         }
         for (std::int64_t k = 0; k < m.faces; ++k)
             if (m.face_b[m.face_of_host[k]] < 0 && kinds[k] != DPSM_OPEN && kinds[k] != DPSM_WALL)
-                fail(DPSM_ERR_UNKNOWN_ENUM, fn, "kinds[", k, "] (face ", k, ", on the domain edge) = ",
-                     static_cast<int>(kinds[k]), " is not DPSM_OPEN or DPSM_WALL");
+                fail(DPSM_ERR_UNKNOWN_ENUM, fn, host_position(g, "kinds", k), " (face ", k + host_base(g),
+                     ", on the domain edge) = ", static_cast<int>(kinds[k]), " is not DPSM_OPEN or DPSM_WALL");
         std::vector<std::uint8_t> open = faces_in_library_order(m, kinds);
         for (std::uint8_t &o : open) o = o == DPSM_OPEN;
         g->core.set_edge_open(open.data());
@@ -469,7 +520,7 @@ int dpsm_set_cell_kinds(dpsm_grid *g, const uint8_t *kinds) {
             const dpsm::Geometry &geo = g->core.geometry();
             for (std::int64_t c = 0; c < geo.cells(); ++c)
                 if (kinds[c] > DPSM_CELL_OPEN)
-                    fail(DPSM_ERR_UNKNOWN_ENUM, fn, "kinds[", c, "] (", host_cell_name(g, c), ") = ",
+                    fail(DPSM_ERR_UNKNOWN_ENUM, fn, host_position(g, "kinds", c), " (", host_cell_name(g, c), ") = ",
                          static_cast<int>(kinds[c]), " is not DPSM_CELL_SAND, DPSM_CELL_WALL or DPSM_CELL_OPEN");
         }
         std::vector<std::uint8_t> buffer;
@@ -694,8 +745,8 @@ int dpsm_set_repose_angle_field(dpsm_grid *g, const double *theta) {
             const dpsm::Geometry &geo = g->core.geometry();
             for (std::int64_t c = 0; c < geo.cells(); ++c)
                 if (!(theta[c] > 0.0 && theta[c] < 0.5 * M_PI))  // also NaN
-                    fail(DPSM_ERR_INVALID_VALUE, fn, "theta_radians[", c, "] (", host_cell_name(g, c), ") = ", theta[c],
-                         " is outside (0, pi/2)");
+                    fail(DPSM_ERR_INVALID_VALUE, fn, host_position(g, "theta_radians", c), " (", host_cell_name(g, c),
+                         ") = ", theta[c], " is outside (0, pi/2)");
         }
         std::vector<double> buffer;
         g->core.set_angle_field(in_library_order(g, theta, buffer));
@@ -733,8 +784,10 @@ int dpsm_set_side_levels(dpsm_grid *g, int side, const double *levels) {
                 g->core.set_side_levels(0, nullptr);
                 return;
             }
-            require_in_range(levels, mesh->faces, fn, "levels",
-                             [&](std::int64_t k) { return "face " + std::to_string(k); });
+            const int base = host_base(g);
+            require_in_range(
+                levels, mesh->faces, fn, "levels", [&](std::int64_t k) { return "face " + std::to_string(k + base); },
+                base);
             g->core.set_side_levels(0, faces_in_library_order(*mesh, levels).data());
             return;
         }

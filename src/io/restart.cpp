@@ -67,14 +67,19 @@ constexpr std::uint32_t kRecordsFluxes = 1u << 12;
 // of a mesh's edge are those of side 0, one per face).
 constexpr std::uint32_t kIsMesh = 1u << 13;
 constexpr std::uint32_t kHasEdgeKinds = 1u << 14;
+// Version 6: the mesh record's indices count from 1 (the mesh was made with
+// start_index 1, and its messages and dpsm_get_mesh_faces count from 1); no
+// data of its own. Without it they count from 0, as in every version 5 file.
+constexpr std::uint32_t kMeshFromOne = 1u << 15;
 constexpr std::uint32_t kKnownFlags = kHasSource | kHasBed | kHasAngleField | kHasMoving | kIsBlock | kRelaxToRest |
                                       kRelaxAuto | kHasSideOutflows | kHasSideLevels | kRecordsFluxes | kIsMesh |
-                                      kHasEdgeKinds;
+                                      kHasEdgeKinds | kMeshFromOne;
 // The flags a file of version 1 cannot hold, those version 2 cannot, and so on.
 constexpr std::uint32_t kVersion2Flags = kIsBlock | kRelaxToRest;
 constexpr std::uint32_t kVersion3Flags = kRelaxAuto;
 constexpr std::uint32_t kVersion4Flags = kHasSideOutflows | kHasSideLevels | kRecordsFluxes;
 constexpr std::uint32_t kVersion5Flags = kIsMesh | kHasEdgeKinds;
+constexpr std::uint32_t kVersion6Flags = kMeshFromOne;
 // The fixed part of the mesh record: kind, a reserved word, and four counts.
 constexpr std::size_t kMeshRecordBytes = 40;
 
@@ -82,6 +87,7 @@ constexpr std::uint32_t side_levels_flag(int side) { return kHasSideLevelsOfXMin
 
 // The oldest version that holds a file with these flags.
 std::uint32_t version_for(std::uint32_t flags) {
+    if (flags & kVersion6Flags) return 6;
     if (flags & kVersion5Flags) return 5;
     if (flags & kVersion4Flags) return 4;
     if (flags & kVersion3Flags) return 3;
@@ -222,6 +228,7 @@ std::uint32_t flags_of(const Grid &g) {
         if (!g.side_levels(side).empty()) flags |= side_levels_flag(side);
     if (g.records_face_fluxes()) flags |= kRecordsFluxes;
     if (g.geometry().is_mesh()) flags |= kIsMesh;
+    if (g.geometry().is_mesh() && g.geometry().mesh->input.start_index == 1) flags |= kMeshFromOne;
     if (!g.edge_open_flags().empty()) flags |= kHasEdgeKinds;
     return flags;
 }
@@ -534,7 +541,7 @@ void check_layout(const Header &h, const std::string &path, const char *fn) {
         bad("nx * ny = ", h.nx, " * ", h.ny, " cells is more than this library can address (", kMaxCells, ")");
     if (h.flags & ~kKnownFlags) bad("unknown array flags ", hex32(h.flags & ~kKnownFlags));
     const std::pair<std::uint32_t, std::uint32_t> needs[] = {
-        {kVersion2Flags, 2}, {kVersion3Flags, 3}, {kVersion4Flags, 4}, {kVersion5Flags, 5}};
+        {kVersion2Flags, 2}, {kVersion3Flags, 3}, {kVersion4Flags, 4}, {kVersion5Flags, 5}, {kVersion6Flags, 6}};
     for (const auto &[flags, version] : needs)
         if ((h.flags & flags) && h.version < version)
             bad("the flags ", hex32(h.flags & flags), " are set in a file of version ", h.version, " (they need version ",
@@ -543,6 +550,8 @@ void check_layout(const Header &h, const std::string &path, const char *fn) {
     if ((h.flags & kRelaxToRest) && h.dim != 2) bad("a grid of dim = ", h.dim, " cannot relax to rest");
     if ((h.flags & kIsBlock) && h.dim != 2) bad("a block of a distributed grid must have dim = 2, not ", h.dim);
     if ((h.flags & kHasEdgeKinds) && !(h.flags & kIsMesh)) bad("edge kinds are set but the file holds no mesh");
+    if ((h.flags & kMeshFromOne) && !(h.flags & kIsMesh))
+        bad("the mesh's indices are said to count from 1 but the file holds no mesh");
     if (h.flags & kIsMesh) {
         if (h.dim != 2 || h.ny != 1 || (h.flags & kIsBlock)) bad("a mesh has dim = 2, ny = 1 and no block record");
         if (h.flags & (kHasSideLevels & ~side_levels_flag(kXMin))) bad("a mesh has levels beyond its edge only");
@@ -800,6 +809,7 @@ void load_restart(const char *path, Geometry &geometry, GridState &state, Restar
     if (header.flags & kIsMesh) {
         read_mesh_counts(body, header);
         read_mesh(body, header, mesh_input);
+        mesh_input.start_index = (header.flags & kMeshFromOne) ? 1 : 0;
     }
     read_body(body, header, n, state);
     if (body.at() != expected - kChecksumBytes)

@@ -17,8 +17,11 @@ namespace dpsm {
 // (DPSM_RELAX_AUTO), version 4 for a grid with side levels, sand that left
 // through a side, or face fluxes recorded, so that older libraries still
 // read every file they could hold.
-// Version 5 holds unstructured meshes (the mesh as its constructor got it).
-constexpr std::uint32_t kRestartVersion = 5;
+// Version 5 holds unstructured meshes (the mesh as its constructor got it),
+// version 6 meshes whose indices count from 1 (a flag: the mesh record's
+// arrays are as a start_index = 1 constructor got them); a mesh from 0 is
+// still written as version 5.
+constexpr std::uint32_t kRestartVersion = 6;
 
 // Where a block file's grid lies in its distributed grid (version 2): its
 // place, which of how many ranks saved it, and the mark that all the files

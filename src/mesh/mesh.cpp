@@ -46,8 +46,21 @@ void require_coordinates(const double *xy, std::int64_t n, const char *function,
     if (!xy) fail(DPSM_ERR_NULL_POINTER, function, name, " is NULL");
     for (std::int64_t k = 0; k < 2 * n; ++k)
         if (!std::isfinite(xy[k]) || std::fabs(xy[k]) > kMaxMagnitude)
-            fail(DPSM_ERR_INVALID_VALUE, function, name, "[", k + base, "] (", k % 2 ? "y" : "x", " of ", what, " ",
-                 k / 2 + base, ") = ", xy[k], " is not finite or lies outside [-1e50, 1e50]");
+            fail(DPSM_ERR_INVALID_VALUE, function, host_position(name, k, base, 2), " (", k % 2 ? "y" : "x", " of ",
+                 what, " ", k / 2 + base, ") = ", xy[k], " is not finite or lies outside [-1e50, 1e50]");
+}
+
+// Whether the host's index v (counting from base) names one of n things.
+bool is_index(std::int64_t v, std::int64_t n, int base) { return v >= base && v <= n - 1 + base; }
+
+// The host's indices counting from 0, for the work after the checks: the
+// host's own array when it counts from 0, else a copy in `buffer`. A value
+// base - 1 (face_cells' domain edge) becomes -1.
+const std::int64_t *from_zero(const std::int64_t *v, std::int64_t n, int base, std::vector<std::int64_t> &buffer) {
+    if (base == 0) return v;
+    buffer.resize(static_cast<std::size_t>(n));
+    for (std::int64_t k = 0; k < n; ++k) buffer[k] = v[k] - base;
+    return buffer.data();
 }
 
 void require_count(std::int64_t n, const char *function, const char *name) {
@@ -290,23 +303,29 @@ std::shared_ptr<const Mesh> mesh_from_polygons(std::int64_t nnodes, const double
     require_coordinates(node_xy, nnodes, function, "node_xy", "node", base);
     if (!cell_start) fail(DPSM_ERR_NULL_POINTER, function, "cell_start is NULL");
     if (!cell_nodes) fail(DPSM_ERR_NULL_POINTER, function, "cell_nodes is NULL");
-    if (cell_start[0] != 0)
-        fail(DPSM_ERR_INVALID_VALUE, function, "cell_start[", base, "] = ", cell_start[0], " must be 0");
+    if (cell_start[0] != base)
+        fail(DPSM_ERR_INVALID_VALUE, function, host_position("cell_start", 0, base), " = ", cell_start[0],
+             " must be ", base);
     for (std::int64_t c = 0; c < ncells; ++c)
         if (cell_start[c + 1] < cell_start[c] + 3 || cell_start[c + 1] - cell_start[c] > (1 << 20))
             fail(DPSM_ERR_INVALID_VALUE, function, "cell ", c + base, " has ", cell_start[c + 1] - cell_start[c],
-                 " nodes (cell_start[", c + base, "] = ", cell_start[c], ", cell_start[", c + 1 + base,
-                 "] = ", cell_start[c + 1], "); a polygon needs at least 3");
-    const std::int64_t total = cell_start[ncells];
+                 " nodes (", host_position("cell_start", c, base), " = ", cell_start[c], ", ",
+                 host_position("cell_start", c + 1, base), " = ", cell_start[c + 1], "); a polygon needs at least 3");
+    const std::int64_t total = cell_start[ncells] - base;
     for (std::int64_t k = 0; k < total; ++k)
-        if (cell_nodes[k] < 0 || cell_nodes[k] >= nnodes)
-            fail(DPSM_ERR_INVALID_VALUE, function, "cell_nodes[", k + base, "] = ", cell_nodes[k] + base,
+        if (!is_index(cell_nodes[k], nnodes, base))
+            fail(DPSM_ERR_INVALID_VALUE, function, host_position("cell_nodes", k, base), " = ", cell_nodes[k],
                  " is not a node index in [", base, ", ", nnodes - 1 + base, "]");
     MeshInput input;
     input.kind = MeshInput::kPolygons;
+    input.start_index = base;
     input.node_xy.assign(node_xy, node_xy + 2 * nnodes);
     input.cell_start.assign(cell_start, cell_start + ncells + 1);
     input.cell_nodes.assign(cell_nodes, cell_nodes + total);
+    // From here on the indices count from 0 (the messages add base again).
+    std::vector<std::int64_t> start_buffer, nodes_buffer;
+    cell_start = from_zero(cell_start, ncells + 1, base, start_buffer);
+    cell_nodes = from_zero(cell_nodes, total, base, nodes_buffer);
     const auto node = [&](std::int64_t n) { return Vec{node_xy[2 * n], node_xy[2 * n + 1]}; };
 
     RawCells cells;
@@ -393,29 +412,31 @@ std::shared_ptr<const Mesh> mesh_from_graph(std::int64_t ncells, const double *c
     cells.area.resize(ncells), cells.centre.resize(ncells);
     for (std::int64_t c = 0; c < ncells; ++c) {
         if (!(cell_area[c] > 0.0) || !(cell_area[c] <= kMaxMagnitude))
-            fail(DPSM_ERR_INVALID_VALUE, function, "cell_area[", c + base, "] (cell ", c + base, ") = ", cell_area[c],
-                 " is not a positive area within 1e50");
+            fail(DPSM_ERR_INVALID_VALUE, function, host_position("cell_area", c, base), " (cell ", c + base, ") = ",
+                 cell_area[c], " is not a positive area within 1e50");
         cells.area[c] = cell_area[c];
         cells.centre[c] = Vec{cell_xy[2 * c], cell_xy[2 * c + 1]};
     }
     std::vector<RawFace> faces(nfaces);
     std::vector<std::vector<double>> angles(ncells);
     for (std::int64_t f = 0; f < nfaces; ++f) {
-        const std::int64_t a = face_cells[2 * f], b = face_cells[2 * f + 1];
-        if (a < 0 || a >= ncells)
-            fail(DPSM_ERR_INVALID_VALUE, function, "face ", f + base, ": face_cells[", 2 * f + base, "] = ", a + base,
-                 " is not a cell index in [", base, ", ", ncells - 1 + base, "]");
-        if (b < -1 || b >= ncells)
-            fail(DPSM_ERR_INVALID_VALUE, function, "face ", f + base, ": face_cells[", 2 * f + 1 + base, "] = ",
-                 b < 0 ? b : b + base, " is not a cell index in [", base, ", ", ncells - 1 + base, "] nor ",
-                 base - 1, " (the domain edge)");
+        const std::int64_t host_a = face_cells[2 * f], host_b = face_cells[2 * f + 1];
+        if (!is_index(host_a, ncells, base))
+            fail(DPSM_ERR_INVALID_VALUE, function, "face ", f + base, ": ", host_position("face_cells", 2 * f, base, 2),
+                 " = ", host_a, " is not a cell index in [", base, ", ", ncells - 1 + base, "]");
+        if (host_b != base - 1 && !is_index(host_b, ncells, base))
+            fail(DPSM_ERR_INVALID_VALUE, function, "face ", f + base, ": ",
+                 host_position("face_cells", 2 * f + 1, base, 2), " = ", host_b, " is not a cell index in [", base,
+                 ", ", ncells - 1 + base, "] nor ", base - 1, " (the domain edge)");
+        // From here on from 0, -1 on the domain edge.
+        const std::int64_t a = host_a - base, b = host_b - base;
         if (a == b)
             fail(DPSM_ERR_INVALID_VALUE, function, "face ", f + base, " joins cell ", a + base, " to itself");
         if (b >= 0 && cells.centre[a].x == cells.centre[b].x && cells.centre[a].y == cells.centre[b].y)
             fail(DPSM_ERR_INVALID_VALUE, function, "face ", f + base, " (cells ", a + base, " and ", b + base,
                  ") joins two cells whose centres coincide at (", cells.centre[a].x, ", ", cells.centre[a].y, ")");
         if (!(face_length[f] > 0.0) || !(face_length[f] <= kMaxMagnitude))
-            fail(DPSM_ERR_INVALID_VALUE, function, "face_length[", f + base, "] (face ", f + base, ") = ",
+            fail(DPSM_ERR_INVALID_VALUE, function, host_position("face_length", f, base), " (face ", f + base, ") = ",
                  face_length[f], " is not a positive length within 1e50");
         RawFace &face = faces[f];
         face.a = a, face.b = b;
@@ -443,6 +464,7 @@ std::shared_ptr<const Mesh> mesh_from_graph(std::int64_t ncells, const double *c
     }
     MeshInput input;
     input.kind = MeshInput::kGraph;
+    input.start_index = base;
     input.ncells = ncells;
     input.cell_xy.assign(cell_xy, cell_xy + 2 * ncells);
     input.cell_area.assign(cell_area, cell_area + ncells);
@@ -459,9 +481,18 @@ std::shared_ptr<const Mesh> mesh_from_dual(std::int64_t nnodes, const double *no
     require_coordinates(node_xy, nnodes, function, "node_xy", "node", base);
     if (!triangle_nodes) fail(DPSM_ERR_NULL_POINTER, function, "triangle_nodes is NULL");
     for (std::int64_t k = 0; k < 3 * ntriangles; ++k)
-        if (triangle_nodes[k] < 0 || triangle_nodes[k] >= nnodes)
-            fail(DPSM_ERR_INVALID_VALUE, function, "triangle_nodes[", k + base, "] (triangle ", k / 3 + base,
-                 ") = ", triangle_nodes[k] + base, " is not a node index in [", base, ", ", nnodes - 1 + base, "]");
+        if (!is_index(triangle_nodes[k], nnodes, base))
+            fail(DPSM_ERR_INVALID_VALUE, function, host_position("triangle_nodes", k, base, 3), " (triangle ",
+                 k / 3 + base, ") = ", triangle_nodes[k], " is not a node index in [", base, ", ", nnodes - 1 + base,
+                 "]");
+    MeshInput input;
+    input.kind = MeshInput::kDual;
+    input.start_index = base;
+    input.node_xy.assign(node_xy, node_xy + 2 * nnodes);
+    input.cell_nodes.assign(triangle_nodes, triangle_nodes + 3 * ntriangles);
+    // From here on the indices count from 0 (the messages add base again).
+    std::vector<std::int64_t> nodes_buffer;
+    triangle_nodes = from_zero(triangle_nodes, 3 * ntriangles, base, nodes_buffer);
     const auto node = [&](std::int64_t n) { return Vec{node_xy[2 * n], node_xy[2 * n + 1]}; };
     RawCells cells;
     cells.area.assign(nnodes, 0.0);
@@ -533,10 +564,6 @@ std::shared_ptr<const Mesh> mesh_from_dual(std::int64_t nnodes, const double *no
         k = end;
     }
     faces.insert(faces.end(), edge_faces.begin(), edge_faces.end());
-    MeshInput input;
-    input.kind = MeshInput::kDual;
-    input.node_xy.assign(node_xy, node_xy + 2 * nnodes);
-    input.cell_nodes.assign(triangle_nodes, triangle_nodes + 3 * ntriangles);
     return assemble(std::move(input), cells, faces, function, base);
 }
 
@@ -544,21 +571,28 @@ std::shared_ptr<const Mesh> mesh_from_input(const MeshInput &input, const char *
     switch (input.kind) {
         case MeshInput::kPolygons: {
             const std::int64_t ncells = static_cast<std::int64_t>(input.cell_start.size()) - 1;
-            if (ncells < 1 || input.cell_start.back() != static_cast<std::int64_t>(input.cell_nodes.size()))
+            if (ncells < 1 ||
+                input.cell_start.back() - input.start_index != static_cast<std::int64_t>(input.cell_nodes.size()))
                 fail(DPSM_ERR_BAD_FILE, function, "the mesh's cells do not match their node list");
             return mesh_from_polygons(static_cast<std::int64_t>(input.node_xy.size() / 2), input.node_xy.data(), ncells,
-                                      input.cell_start.data(), input.cell_nodes.data(), function, 0);
+                                      input.cell_start.data(), input.cell_nodes.data(), function, input.start_index);
         }
         case MeshInput::kGraph:
             return mesh_from_graph(input.ncells, input.cell_xy.data(), input.cell_area.data(),
                                    static_cast<std::int64_t>(input.face_length.size()), input.face_cells.data(),
-                                   input.face_xy.data(), input.face_length.data(), function, 0);
+                                   input.face_xy.data(), input.face_length.data(), function, input.start_index);
         case MeshInput::kDual:
             return mesh_from_dual(static_cast<std::int64_t>(input.node_xy.size() / 2), input.node_xy.data(),
                                   static_cast<std::int64_t>(input.cell_nodes.size() / 3), input.cell_nodes.data(),
-                                  function, 0);
+                                  function, input.start_index);
     }
     fail(DPSM_ERR_BAD_FILE, function, "unknown mesh kind ", static_cast<unsigned>(input.kind));
+}
+
+std::string host_position(const char *name, std::int64_t k, int base, int rows) {
+    if (base == 0) return std::string(name) + "[" + std::to_string(k) + "]";
+    if (rows <= 1) return std::string(name) + "(" + std::to_string(k + base) + ")";
+    return std::string(name) + "(" + std::to_string(k % rows + base) + ", " + std::to_string(k / rows + base) + ")";
 }
 
 }  // namespace dpsm

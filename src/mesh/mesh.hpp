@@ -10,15 +10,21 @@
 
 #include <cstdint>
 #include <memory>
+#include <string>
 #include <vector>
 
 namespace dpsm {
 
 // What the host gave, kept to save in a restart file and to build the same
-// mesh from it again.
+// mesh from it again: the arrays as the host passed them, their indices
+// counting from start_index.
 struct MeshInput {
     enum Kind : std::uint32_t { kPolygons = 1, kGraph = 2, kDual = 3 };
     Kind kind = kPolygons;
+    // 0 (C) or 1 (Fortran, UGRID's start_index = 1): where the host's
+    // numbers of cells, nodes and faces begin, in its arrays and in every
+    // message that names one of them, of the constructor and later ones.
+    int start_index = 0;
     // kPolygons and kDual: nodes and cells over them (kDual: 3 per triangle,
     // cell_start empty).
     std::vector<double> node_xy;
@@ -79,8 +85,12 @@ struct Mesh {
 };
 
 // Each builds a mesh from the host's arrays, checked, or throws
-// Error(DPSM_ERR_*) naming the host's cell, node or face (counted from
-// `base`: 0 in C, 1 from Fortran) and the function in `function`.
+// Error(DPSM_ERR_*) naming the host's cell, node or face and the function in
+// `function`. The arrays' indices count from `base` (0 or 1, checked by the
+// caller): cell_start[0] == base, node and cell indices from base, base - 1
+// for the domain edge in face_cells; the messages count from it too, quote
+// the host's values and name array positions as the host writes them
+// (host_position).
 std::shared_ptr<const Mesh> mesh_from_polygons(std::int64_t nnodes, const double *node_xy, std::int64_t ncells,
                                                const std::int64_t *cell_start, const std::int64_t *cell_nodes,
                                                const char *function, int base);
@@ -92,5 +102,12 @@ std::shared_ptr<const Mesh> mesh_from_dual(std::int64_t nnodes, const double *no
                                            const std::int64_t *triangle_nodes, const char *function, int base);
 // The same mesh again from what a restart file kept.
 std::shared_ptr<const Mesh> mesh_from_input(const MeshInput &input, const char *function);
+
+// Position k of the host's array `name`, as a host that counts from `base`
+// writes it: C's name[k] (base 0), Fortran's name(k+1) (base 1). With `rows`
+// > 1 the array holds tuples of that many values (node_xy, face_cells,
+// triangle_nodes), which Fortran holds as the columns of name(rows, n):
+// name(k % rows + 1, k / rows + 1).
+std::string host_position(const char *name, std::int64_t k, int base, int rows = 1);
 
 }  // namespace dpsm

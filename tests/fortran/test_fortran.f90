@@ -676,14 +676,15 @@ contains
     call dpsm_destroy(g)
   end subroutine test_restart
 
-  !> Meshes: the three constructors with 1-based indices (good and bad),
-  !> their faces 1-based, per-face kinds, levels and fluxes, and the mesh
-  !> routines refused on a grid.
+  !> Meshes: the three constructors with 1-based indices (good and bad, C's
+  !> messages counting from 1 as the host does), their faces 1-based,
+  !> per-face kinds, levels and fluxes, a restart, the _indexed constructors
+  !> from 0 and 1, and the mesh routines refused on a grid.
   subroutine test_meshes()
-    type(dpsm_grid) :: g, grid
+    type(dpsm_grid) :: g, grid, loaded
     real(c_double) :: node_xy(2, 9), h(4), after(4), h2(4, 1), levels(12), fx(12), fx2(12, 1), fy(12)
     real(c_double) :: out, total, total0, brought(4)
-    integer(c_int64_t) :: cell_start(5), cell_nodes(16), bad_nodes(16), nx, ny, nfaces, faces(2, 12)
+    integer(c_int64_t) :: cell_start(5), cell_nodes(16), bad_nodes(16), nx, ny, nfaces, faces(2, 12), back(2, 12)
     integer(c_int32_t) :: nf32, faces32(2, 12)
     integer(c_int8_t) :: kinds(12)
     integer :: ierr, i, j, f
@@ -774,6 +775,14 @@ contains
     kinds(12) = 9
     call dpsm_set_edge_kinds(g, kinds, ierr)
     call expect(ierr == DPSM_ERR_UNKNOWN_ENUM, 'dpsm_set_edge_kinds with a kind 9 on the edge fails')
+    call expect(index(dpsm_last_error(g), 'kinds(12) (face 12, on the domain edge) = 9') > 0, &
+                'a later message names the face as the host numbers it: '//dpsm_last_error(g))
+    h2(:, 1) = h
+    h2(3, 1) = ieee_value(h2(3, 1), ieee_quiet_nan)
+    call dpsm_set_heights(g, h2, ierr)
+    call expect(ierr == DPSM_ERR_INVALID_VALUE, 'dpsm_set_heights with a NaN fails on a mesh')
+    call expect(index(dpsm_last_error(g), 'h(3) (cell 3) is NaN') > 0, &
+                'dpsm_set_heights names the cell as the host numbers it: '//dpsm_last_error(g))
     call dpsm_set_edge_kinds(g, kinds(1:11), ierr)
     call expect(ierr == DPSM_ERR_INVALID_SIZE, 'dpsm_set_edge_kinds(kinds(11)) fails with INVALID_SIZE')
     call dpsm_step(g, 1.0_c_double)
@@ -786,27 +795,75 @@ contains
     call expect(ierr == DPSM_OK, 'dpsm_set_boundary(DPSM_MESH_EDGE, DPSM_OPEN)')
     call dpsm_set_heights_region(g, 0, 0, 1, 1, h(1:1), ierr)
     call expect(ierr == DPSM_ERR_NOT_APPLICABLE, 'a mesh has no blocks')
+    ! A restart keeps the mesh's numbering from 1.
+    call dpsm_save(g, 'test_fortran_mesh.dpsm', ierr)
+    call expect(ierr == DPSM_OK, 'dpsm_save of a mesh: '//dpsm_last_error(g))
+    call dpsm_load(loaded, 'test_fortran_mesh.dpsm', ierr)
+    call expect(ierr == DPSM_OK, 'dpsm_load of a mesh: '//dpsm_last_error())
+    call dpsm_get_mesh_faces(loaded, back)
+    call expect(all(back == faces), 'the loaded mesh lists its faces 1-based: '//ints(back(1, :)))
+    call dpsm_set_edge_kinds(loaded, kinds, ierr)
+    call expect(ierr == DPSM_ERR_UNKNOWN_ENUM, 'dpsm_set_edge_kinds with a kind 9 fails on the loaded mesh')
+    call expect(index(dpsm_last_error(loaded), '(face 12, on') > 0, &
+                'the loaded mesh names its faces 1-based: '//dpsm_last_error(loaded))
+    call dpsm_destroy(loaded)
+    open (newunit=f, file='test_fortran_mesh.dpsm', status='old')
+    close (f, status='delete')
     call dpsm_destroy(g)
+
+    ! The _indexed constructors: from 1 as dpsm_create_mesh, from 0 with C's
+    ! numbering (and faces from 0, -1 on the edge); any other start refused.
+    call dpsm_create_mesh_indexed(g, 1, 9_c_int64_t, node_xy, 4_c_int64_t, cell_start, cell_nodes, ierr)
+    call expect(ierr == DPSM_OK, 'dpsm_create_mesh_indexed(start_index = 1): '//dpsm_last_error())
+    call dpsm_get_mesh_faces(g, back)
+    call expect(all(back == faces), 'dpsm_create_mesh_indexed from 1 has the faces of dpsm_create_mesh')
+    call dpsm_destroy(g)
+    call dpsm_create_mesh_indexed(g, 0, 9, node_xy, 4, int(cell_start - 1, c_int32_t), int(cell_nodes - 1, c_int32_t), &
+                                  ierr)
+    call expect(ierr == DPSM_OK, 'dpsm_create_mesh_indexed(start_index = 0): '//dpsm_last_error())
+    call dpsm_get_mesh_faces(g, back)
+    call expect(all(back == faces - 1), 'from 0 the faces come back from 0, -1 on the edge: '//ints(back(2, :)))
+    call dpsm_destroy(g)
+    call dpsm_create_mesh_indexed(g, 2, 9_c_int64_t, node_xy, 4_c_int64_t, cell_start, cell_nodes, ierr)
+    call expect(ierr == DPSM_ERR_INVALID_VALUE .and. .not. dpsm_associated(g), &
+                'dpsm_create_mesh_indexed(start_index = 2) fails with INVALID_VALUE')
+    call expect(index(dpsm_last_error(), 'start_index = 2') > 0, &
+                'dpsm_create_mesh_indexed(start_index = 2) fails: '//dpsm_last_error())
+    call dpsm_create_mesh_indexed(g, 0, 9_c_int64_t, node_xy, 4_c_int64_t, cell_start - 1, cell_nodes(1:15) - 1, ierr)
+    call expect(ierr == DPSM_ERR_INVALID_SIZE, 'dpsm_create_mesh_indexed with 15 node indices for 16 fails')
+    call expect(index(dpsm_last_error(), 'cell_nodes has 15 values but cell_start(ncells+1) = 16') > 0, &
+                'from 0 the Fortran side names the sizes: '//dpsm_last_error())
 
     ! Default integers.
     call dpsm_create_mesh(g, 9, node_xy, 4, int(cell_start, c_int32_t), int(cell_nodes, c_int32_t), ierr)
     call expect(ierr == DPSM_OK, 'dpsm_create_mesh (default integers)')
     call dpsm_destroy(g)
 
-    ! Bad input: node 10 of 9 (C's message counts from 0), node 0, a cell of 2 nodes.
+    ! Bad input: node 10 of 9, node 0, a cell of 2 nodes, a node repeated: C's
+    ! messages count from 1 and quote the host's values.
     bad_nodes = cell_nodes
     bad_nodes(3) = 10
     call dpsm_create_mesh(g, 9_c_int64_t, node_xy, 4_c_int64_t, cell_start, bad_nodes, ierr)
     message = dpsm_last_error()
     call expect(ierr == DPSM_ERR_INVALID_VALUE .and. .not. dpsm_associated(g), &
                 'dpsm_create_mesh with node 10 of 9 fails with INVALID_VALUE')
-    call expect(index(message, 'cell_nodes[2] = 9 is not a node index in [0, 8]') > 0, &
-                'the message names the 0-based copy: '//message)
+    call expect(index(message, 'dpsm_create_mesh_indexed: cell_nodes(3) = 10 is not a node index in [1, 9]') > 0, &
+                'the message names the host''s array as the host numbers it: '//message)
     bad_nodes(3) = 0
     call dpsm_create_mesh(g, 9_c_int64_t, node_xy, 4_c_int64_t, cell_start, bad_nodes, ierr)
     call expect(ierr == DPSM_ERR_INVALID_VALUE, 'dpsm_create_mesh with node 0 fails with INVALID_VALUE')
+    call expect(index(dpsm_last_error(), 'cell_nodes(3) = 0 is not a node index in [1, 9]') > 0, &
+                'node 0 is no node from 1: '//dpsm_last_error())
     call dpsm_create_mesh(g, 9, node_xy, 4, [1, 5, 9, 13, 15], int(cell_nodes(1:14), c_int32_t), ierr)
     call expect(ierr == DPSM_ERR_INVALID_VALUE, 'dpsm_create_mesh with a cell of 2 nodes fails with INVALID_VALUE')
+    call expect(index(dpsm_last_error(), 'cell 4 has 2 nodes (cell_start(4) = 13, cell_start(5) = 15)') > 0, &
+                'the degenerate cell is named 1-based: '//dpsm_last_error())
+    bad_nodes = cell_nodes
+    bad_nodes(10) = 4 ! cell 3 becomes 4, 4, 8, 7
+    call dpsm_create_mesh(g, 9_c_int64_t, node_xy, 4_c_int64_t, cell_start, bad_nodes, ierr)
+    call expect(ierr == DPSM_ERR_INVALID_VALUE, 'dpsm_create_mesh with a node repeated in a row fails')
+    call expect(index(dpsm_last_error(), 'cell 3 repeats node 4') > 0, &
+                'a repeated node is named 1-based: '//dpsm_last_error())
     call dpsm_create_mesh(g, 9_c_int64_t, node_xy, 4_c_int64_t, cell_start, cell_nodes(1:15), ierr)
     message = dpsm_last_error()
     call expect(ierr == DPSM_ERR_INVALID_SIZE, 'dpsm_create_mesh with 15 node indices for 16 fails with INVALID_SIZE')
@@ -876,12 +933,25 @@ contains
     call dpsm_create_dual_mesh(g, 4, node_xy, 2, int(tris, c_int32_t), ierr)
     call expect(ierr == DPSM_OK, 'dpsm_create_dual_mesh (default integers)')
     call dpsm_destroy(g)
+    call dpsm_create_dual_mesh_indexed(g, 0, 4_c_int64_t, node_xy, 2_c_int64_t, tris - 1, ierr)
+    call expect(ierr == DPSM_OK, 'dpsm_create_dual_mesh_indexed(start_index = 0): '//dpsm_last_error())
+    call dpsm_get_mesh_faces(g, faces)
+    call expect(same_pair(faces(:, 1), 0, 1) .and. all(faces(2, 6:13) == -1), &
+                'a dual mesh from 0 lists its faces from 0, -1 on the edge')
+    call dpsm_destroy(g)
+    call dpsm_create_dual_mesh_indexed(g, 1, 4, node_xy, 2, int(tris, c_int32_t), ierr)
+    call expect(ierr == DPSM_OK, 'dpsm_create_dual_mesh_indexed(start_index = 1, default integers)')
+    call dpsm_destroy(g)
+    call dpsm_create_dual_mesh_indexed(g, -1, 4_c_int64_t, node_xy, 2_c_int64_t, tris, ierr)
+    call expect(ierr == DPSM_ERR_INVALID_VALUE, 'dpsm_create_dual_mesh_indexed(start_index = -1) fails')
+    call expect(index(dpsm_last_error(), 'start_index = -1') > 0, &
+                'dpsm_create_dual_mesh_indexed(start_index = -1) fails: '//dpsm_last_error())
     tris(2, 2) = 5
     call dpsm_create_dual_mesh(g, 4_c_int64_t, node_xy, 2_c_int64_t, tris, ierr)
     call expect(ierr == DPSM_ERR_INVALID_VALUE, &
-                'dpsm_create_dual_mesh with node 5 of 4 fails, C naming the 0-based copy: '//dpsm_last_error())
-    call expect(index(dpsm_last_error(), 'triangle_nodes[4] (triangle 1) = 4') > 0, &
-                'dpsm_create_dual_mesh with node 5 of 4 fails, C naming the 0-based copy: '//dpsm_last_error())
+                'dpsm_create_dual_mesh with node 5 of 4 fails, C naming it as the host does: '//dpsm_last_error())
+    call expect(index(dpsm_last_error(), 'triangle_nodes(2, 2) (triangle 2) = 5 is not a node index in [1, 4]') > 0, &
+                'dpsm_create_dual_mesh with node 5 of 4 fails, C naming it as the host does: '//dpsm_last_error())
     tris(2, 2) = 3
     call dpsm_create_dual_mesh(g, 4_c_int64_t, node_xy, 2_c_int64_t, tris(:, 1:1), ierr)
     call expect(ierr == DPSM_ERR_INVALID_SIZE, &
@@ -927,17 +997,32 @@ contains
     call dpsm_create_graph(g, 2, cell_xy, area, 7, int(face_cells, c_int32_t), face_xy, length, ierr)
     call expect(ierr == DPSM_OK, 'dpsm_create_graph (default integers)')
     call dpsm_destroy(g)
+    call dpsm_create_graph_indexed(g, 0, 2_c_int64_t, cell_xy, area, 7_c_int64_t, face_cells - 1, face_xy, length, ierr)
+    call expect(ierr == DPSM_OK, 'dpsm_create_graph_indexed(start_index = 0): '//dpsm_last_error())
+    call dpsm_get_mesh_faces(g, back)
+    call expect(all(back == face_cells - 1), 'a graph from 0 gives its faces back from 0, -1 on the edge')
+    call dpsm_destroy(g)
+    call dpsm_create_graph_indexed(g, 1, 2, cell_xy, area, 7, int(face_cells, c_int32_t), face_xy, length, ierr)
+    call expect(ierr == DPSM_OK, 'dpsm_create_graph_indexed(start_index = 1, default integers)')
+    call dpsm_destroy(g)
+    call dpsm_create_graph_indexed(g, 2, 2_c_int64_t, cell_xy, area, 7_c_int64_t, face_cells, face_xy, length, ierr)
+    call expect(ierr == DPSM_ERR_INVALID_VALUE, 'dpsm_create_graph_indexed(start_index = 2) fails')
+    call expect(index(dpsm_last_error(), 'start_index = 2') > 0, &
+                'dpsm_create_graph_indexed(start_index = 2) fails: '//dpsm_last_error())
     bad = face_cells
     bad(2, 1) = 3
     call dpsm_create_graph(g, 2_c_int64_t, cell_xy, area, 7_c_int64_t, bad, face_xy, length, ierr)
     call expect(ierr == DPSM_ERR_INVALID_VALUE, &
-                'dpsm_create_graph with cell 3 of 2 fails, C naming the 0-based copy: '//dpsm_last_error())
-    call expect(index(dpsm_last_error(), 'face 0: face_cells[1] = 2') > 0, &
-                'dpsm_create_graph with cell 3 of 2 fails, C naming the 0-based copy: '//dpsm_last_error())
+                'dpsm_create_graph with cell 3 of 2 fails, C naming it as the host does: '//dpsm_last_error())
+    call expect(index(dpsm_last_error(), &
+                      'face 1: face_cells(2, 1) = 3 is not a cell index in [1, 2] nor 0 (the domain edge)') > 0, &
+                'dpsm_create_graph with cell 3 of 2 fails, C naming it as the host does: '//dpsm_last_error())
     bad = face_cells
     bad(1, 2) = 0
     call dpsm_create_graph(g, 2_c_int64_t, cell_xy, area, 7_c_int64_t, bad, face_xy, length, ierr)
     call expect(ierr == DPSM_ERR_INVALID_VALUE, 'dpsm_create_graph with a = 0 (the edge) fails with INVALID_VALUE')
+    call expect(index(dpsm_last_error(), 'face 2: face_cells(1, 2) = 0 is not a cell index in [1, 2]') > 0, &
+                'a = 0 is named as the host wrote it: '//dpsm_last_error())
     call dpsm_create_graph(g, 2_c_int64_t, cell_xy, area, 7_c_int64_t, face_cells, face_xy, length(1:6), ierr)
     call expect(ierr == DPSM_ERR_INVALID_SIZE, &
                 'dpsm_create_graph with face_length(6) for 7 faces fails: '//dpsm_last_error())

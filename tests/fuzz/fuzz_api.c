@@ -38,9 +38,11 @@
  * Opcode kMeshOp (251) builds an unstructured mesh of its own instead (op_mesh:
  * polygons, a finite-volume graph or a median dual over a jittered lattice,
  * sometimes with one defect the constructor must refuse with the exact
- * status), runs a few calls and steps on it with checks of their own (ledger,
- * no new extremum, face fluxes against the harness's own cell areas, restart
- * bit for bit) and destroys it; its comment tells its bytes.
+ * status, sometimes with its indices from 1 through the _indexed
+ * constructors), runs a few calls and steps on it with checks of their own
+ * (ledger, no new extremum, face fluxes against the harness's own cell areas,
+ * restart bit for bit, the same mesh from 0 bit for bit) and destroys it; its
+ * comment tells its bytes.
  * A violated check prints what it saw and calls abort(), which libFuzzer (or
  * the replay driver, fuzz_replay.c) reports with the input.
  *
@@ -51,6 +53,7 @@
  * scenes that rest by themselves), where the library is known to fail
  * (docs/guarantees.md, "Known limits"). */
 #include <float.h>
+#include <limits.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -1489,7 +1492,10 @@ static void op_destroy(reader_t *r) {
  *
  *   kind      % 3: dpsm_create_mesh, dpsm_create_graph, dpsm_create_dual_mesh;
  *             / 3 % 3: a lattice of quads, of triangles, or of both mixed
- *             (the dual always takes triangles)
+ *             (the dual always takes triangles); / 9 % 3, the numbering:
+ *             0 those constructors, from 0; 1 their _indexed forms with
+ *             start_index 1 on the arrays shifted to count from 1 (the
+ *             domain edge 0), 2 their _indexed forms with start_index 0
  *   nx, ny    2 + b % 7 squares a side
  *   dx, dy    kMeshSpacings[b % 5]
  *   jitter    (b % 5) * 0.06 of the spacing, each node (below 1/4: every
@@ -1507,7 +1513,14 @@ static void op_destroy(reader_t *r) {
  * A made mesh must have the shape (ncells, 1) and the faces this harness
  * derives from what it gave (for polygons: in order of first appearance,
  * cell by cell, edge by edge; a graph's faces as given; the dual's by node
- * pair, then the halves of the boundary edges). Its cell areas (shoelace; a
+ * pair, then the halves of the boundary edges), from 1 with 0 on the domain
+ * edge when made from 1. With numbering 1 or 2 a twin made by the plain
+ * constructor from 0 takes every call that succeeds on the mesh and must
+ * match it bit for bit after every operation (heights, ledger, edge outflow,
+ * stable step); with numbering 1 the _indexed constructor must first refuse
+ * a start index other than 0 and 1 (kBadStarts[seed % 4]) with
+ * DPSM_ERR_INVALID_VALUE and *out NULL, and a mesh loaded from a restart file
+ * must list its faces from 1 too. Its cell areas (shoelace; a
  * third of each node's triangles for the dual) must make up DPSM_MASS_TOTAL.
  * After every operation: heights finite, the ledger closes to 1e-9 of the
  * largest mass seen. After every step: held cells unchanged; without a
@@ -1741,10 +1754,24 @@ static void mesh_derive(mesh_t *m, prng_t *p) {
 }
 
 static const char *const kMeshFunctions[] = {"dpsm_create_mesh", "dpsm_create_graph", "dpsm_create_dual_mesh"};
+static const char *const kIndexedFunctions[] = {"dpsm_create_mesh_indexed", "dpsm_create_graph_indexed",
+                                                "dpsm_create_dual_mesh_indexed"};
+static const int kBadStarts[] = {2, -1, INT_MAX, INT_MIN};
+
+/* The n index values of v (NULL: none) counted from 1 instead of 0 (the
+ * domain edge's -1 becomes 0); the extremes stay, out of range either way. */
+static void count_from_one(int64_t *v, size_t n) {
+    if (!v) return;
+    for (size_t k = 0; k < n; ++k)
+        if (v[k] != INT64_MIN && v[k] != INT64_MAX) ++v[k];
+}
 
 /* Calls the constructor on a copy of the mesh's arrays with defect `defect`
- * planted (-1: none). Returns the status; *want receives the one expected. */
-static int mesh_construct(const mesh_t *m, int defect, prng_t *p, dpsm_grid **grid, int *want, const char **what) {
+ * planted (-1: none): the plain one (indexed 0) or its _indexed form with
+ * `start_index`, on the arrays counted from 1 unless start_index is 0.
+ * Returns the status; *want receives the one expected. */
+static int mesh_construct(const mesh_t *m, int defect, prng_t *p, dpsm_grid **grid, int *want, const char **what,
+                          int indexed, int start_index) {
     const int64_t total = m->poly_start[m->npoly];
     /* Room for one more polygon or node (the defects that add one). */
     double *xy = xcalloc((size_t)(2 * m->nnodes + 2), sizeof(double));
@@ -1788,7 +1815,7 @@ static int mesh_construct(const mesh_t *m, int defect, prng_t *p, dpsm_grid **gr
                 break;
             }
             case 4: *what = "a coordinate not finite or out of range"; xy[prng_below(p, (unsigned)(2 * nnodes))] = kBadCoordinates[prng_below(p, 4)]; break;
-            case 5: *what = "cell_start[0] != 0"; start[0] = prng_below(p, 2) ? 1 : -1; break;
+            case 5: *what = "cell_start[0] not the start index"; start[0] = prng_below(p, 2) ? 1 : -1; break;
             case 6: /* the cell again: its interior edges then belong to 3 cells */
                 *what = "an edge of 3 cells";
                 for (int64_t e = 0; e < count; ++e) nodes[total + e] = nodes[k0 + e];
@@ -1898,15 +1925,27 @@ static int mesh_construct(const mesh_t *m, int defect, prng_t *p, dpsm_grid **gr
             default: *what = "a NULL out"; *want = DPSM_ERR_NULL_POINTER; null_out = 1; break;
         }
     }
+    if (indexed && start_index != 0) { /* every index array, the defect's too, from 1 */
+        count_from_one(start, start ? (size_t)(m->npoly + 2) : 0);
+        count_from_one(nodes, nodes ? (size_t)(total + 4) : 0);
+        count_from_one(fc, fc ? (size_t)(2 * m->nfaces) : 0);
+    }
+    if (indexed && start_index != 0 && start_index != 1 && !null_out) {
+        *want = DPSM_ERR_INVALID_VALUE;
+        *what = "a start index other than 0 and 1";
+    }
     *grid = (dpsm_grid *)grid; /* not NULL: a failure must set NULL */
     dpsm_grid **out = null_out ? NULL : grid;
     int st;
     if (m->kind == MESH_POLYGONS)
-        st = dpsm_create_mesh(nnodes, xy, npoly, start, nodes, out);
+        st = indexed ? dpsm_create_mesh_indexed(start_index, nnodes, xy, npoly, start, nodes, out)
+                     : dpsm_create_mesh(nnodes, xy, npoly, start, nodes, out);
     else if (m->kind == MESH_GRAPH)
-        st = dpsm_create_graph(ncells, cell_xy, area, nfaces, fc, fxy, flen, out);
+        st = indexed ? dpsm_create_graph_indexed(start_index, ncells, cell_xy, area, nfaces, fc, fxy, flen, out)
+                     : dpsm_create_graph(ncells, cell_xy, area, nfaces, fc, fxy, flen, out);
     else
-        st = dpsm_create_dual_mesh(nnodes, xy, npoly, nodes, out);
+        st = indexed ? dpsm_create_dual_mesh_indexed(start_index, nnodes, xy, npoly, nodes, out)
+                     : dpsm_create_dual_mesh(nnodes, xy, npoly, nodes, out);
     if (null_out) *grid = NULL;
     free(xy);
     free(start);
@@ -1923,6 +1962,7 @@ static int mesh_construct(const mesh_t *m, int defect, prng_t *p, dpsm_grid **gr
 typedef struct {
     const mesh_t *m;
     dpsm_grid *g;
+    dpsm_grid *twin;    /* the same mesh from 0 when g counts from 1 or came from an _indexed constructor; or NULL */
     uint8_t *kinds;     /* per cell */
     uint8_t *edge_open; /* per face: open edge faces */
     double *levels;     /* per face */
@@ -1999,15 +2039,34 @@ static void mesh_expect(mesh_state_t *ms, int st, int want, const char *fn, cons
     }
 }
 
-#define MESH_CALL(ms, want, fn, call)              \
-    do {                                           \
-        msnap_t before_;                           \
-        mesh_snap((ms), &before_);                 \
-        g_op = (fn);                               \
-        const int st_ = (call);                    \
-        mesh_expect((ms), st_, (want), (fn), &before_); \
-        free(before_.h);                           \
+/* `call` names the mesh ms->g; once it succeeds it is made on the twin too. */
+#define MESH_CALL(ms, want, fn, call)                                                              \
+    do {                                                                                           \
+        msnap_t before_;                                                                           \
+        mesh_snap((ms), &before_);                                                                 \
+        g_op = (fn);                                                                               \
+        const int st_ = (call);                                                                    \
+        mesh_expect((ms), st_, (want), (fn), &before_);                                            \
+        free(before_.h);                                                                           \
+        if (st_ == DPSM_OK && (ms)->twin) {                                                        \
+            dpsm_grid *const mesh_ = (ms)->g;                                                      \
+            (ms)->g = (ms)->twin;                                                                  \
+            const int twin_st_ = (call);                                                           \
+            (ms)->g = mesh_;                                                                       \
+            if (twin_st_ != DPSM_OK) die("%s failed on the twin from 0: %s", (fn), dpsm_last_error((ms)->twin)); \
+        }                                                                                          \
     } while (0)
+
+/* The twin from 0 matches the mesh bit for bit. */
+static void mesh_check_twin(const mesh_state_t *ms, const msnap_t *now) {
+    if (!ms->twin) return;
+    mesh_state_t other = *ms;
+    other.g = ms->twin;
+    msnap_t twin;
+    mesh_snap(&other, &twin);
+    mesh_same(ms, now, &twin, "the mesh and its twin from 0");
+    free(twin.h);
+}
 
 static int mesh_source_active(const mesh_state_t *ms) {
     if (!ms->source) return 0;
@@ -2071,7 +2130,8 @@ static void mesh_step(mesh_state_t *ms, reader_t *r) {
     int want = limited && needed > limit ? DPSM_ERR_WORK_LIMIT : DPSM_OK;
     const int either = limited && fabs(needed - limit) <= 1.0;
     /* Bounded work: a scene at rest by itself stops early, but how early depends on it. */
-    const double cost = (want == DPSM_OK || either ? fmax(needed, 1.0) : 1.0) * (double)m->ncells * (through_restart ? 2 : 1);
+    const double cost = (want == DPSM_OK || either ? fmax(needed, 1.0) : 1.0) * (double)m->ncells *
+                        ((through_restart ? 2 : 1) + (ms->twin ? 1 : 0));
     if (g_work + cost > kWorkBudget) {
         free(before.h);
         return;
@@ -2099,6 +2159,13 @@ static void mesh_step(mesh_state_t *ms, reader_t *r) {
         mesh_snap(&other, &loaded);
         mesh_same(ms, &before, &loaded, "a mesh loaded from a restart file");
         free(loaded.h);
+        /* The file keeps the mesh's numbering: its faces as the mesh lists them. */
+        int64_t *fa = xcalloc((size_t)(2 * nf), sizeof(int64_t)), *fb = xcalloc((size_t)(2 * nf), sizeof(int64_t));
+        if (dpsm_get_mesh_faces(ms->g, fa) != DPSM_OK || dpsm_get_mesh_faces(copy, fb) != DPSM_OK ||
+            memcmp(fa, fb, sizeof(int64_t) * (size_t)(2 * nf)) != 0)
+            die("the loaded mesh lists other faces (or numbers them otherwise) than the saved one");
+        free(fa);
+        free(fb);
     }
     g_op = "dpsm_step";
     const int st = dpsm_step(ms->g, dt);
@@ -2106,6 +2173,8 @@ static void mesh_step(mesh_state_t *ms, reader_t *r) {
           (long long)m->ncells, limited ? "driven" : "not driven");
     if (either && (st == DPSM_OK || st == DPSM_ERR_WORK_LIMIT)) want = st;
     mesh_expect(ms, st, want, "dpsm_step", &before);
+    if (ms->twin && dpsm_step(ms->twin, dt) != st)
+        die("the twin from 0's step returned %s, the mesh's %s", dpsm_last_error(ms->twin), dpsm_status_string(st));
     if (st != DPSM_OK) {
         if (copy && dpsm_step(copy, dt) != st) die("the loaded mesh's step did not fail as the mesh's did");
         dpsm_destroy(copy);
@@ -2358,6 +2427,7 @@ static void mesh_operation(mesh_state_t *ms, reader_t *r) {
     msnap_t now;
     mesh_snap(ms, &now);
     mesh_check_state(ms, &now);
+    mesh_check_twin(ms, &now);
     free(now.h);
 }
 
@@ -2365,6 +2435,7 @@ static void op_mesh(reader_t *r) {
     g_op = "mesh";
     const unsigned kind_byte = u8(r);
     const int kind = (int)(kind_byte % 3), lattice = kind == MESH_DUAL ? 1 : (int)(kind_byte / 3 % 3);
+    const int numbering = (int)(kind_byte / 9 % 3), indexed = numbering != 0, base = numbering == 1;
     const int64_t nx = 2 + (int64_t)(u8(r) % 7), ny = 2 + (int64_t)(u8(r) % 7);
     const double dx = kMeshSpacings[u8(r) % COUNT(kMeshSpacings)], dy = kMeshSpacings[u8(r) % COUNT(kMeshSpacings)];
     const double jitter = 0.06 * (double)(u8(r) % 5);
@@ -2375,13 +2446,26 @@ static void op_mesh(reader_t *r) {
     mesh_build(&m, kind, lattice, nx, ny, dx, dy, jitter, &p);
     mesh_derive(&m, &p);
     const int defect = (defect_byte & 0xc0) == 0xc0 ? (int)(defect_byte & 0x3f) : -1;
-    const char *fn = kMeshFunctions[kind], *what;
+    const char *fn = indexed ? kIndexedFunctions[kind] : kMeshFunctions[kind], *what;
     dpsm_grid *g;
     int want;
     g_op = fn;
-    const int st = mesh_construct(&m, defect, &p, &g, &want, &what);
-    trace("%s (%lld x %lld %s, defect: %s) -> %s", fn, (long long)nx, (long long)ny,
-          lattice == 0 ? "quads" : lattice == 1 ? "triangles" : "mixed", what, dpsm_status_string(st));
+    const prng_t p0 = p; /* the twin and the bad start index take copies: p goes on as without them */
+    if (base) {
+        prng_t q = p0;
+        const int bad = kBadStarts[seed % 4];
+        const int bst = mesh_construct(&m, -1, &q, &g, &want, &what, 1, bad);
+        trace("%s(start_index = %d) -> %s", fn, bad, dpsm_status_string(bst));
+        if (bst != DPSM_ERR_INVALID_VALUE || g != NULL)
+            die("%s(start_index = %d) returned %s (*out %s), expected DPSM_ERR_INVALID_VALUE and NULL", fn, bad,
+                dpsm_status_string(bst), g ? "set" : "NULL");
+        check_failed(NULL, NULL, NULL, bst, fn);
+        if (!strstr(dpsm_last_error(NULL), "start_index"))
+            die("%s refused start_index = %d with \"%s\", which does not name it", fn, bad, dpsm_last_error(NULL));
+    }
+    const int st = mesh_construct(&m, defect, &p, &g, &want, &what, indexed, base);
+    trace("%s (%lld x %lld %s, from %d, defect: %s) -> %s", fn, (long long)nx, (long long)ny,
+          lattice == 0 ? "quads" : lattice == 1 ? "triangles" : "mixed", base, what, dpsm_status_string(st));
     if (st != want)
         die("%s with %s returned %s, expected %s (%s)", fn, what, dpsm_status_string(st), dpsm_status_string(want),
             dpsm_last_error(NULL));
@@ -2402,7 +2486,7 @@ static void op_mesh(reader_t *r) {
     uint8_t *seen = xcalloc((size_t)m.ncells, 1);
     if (dpsm_get_mesh_faces(g, faces) != DPSM_OK) die("dpsm_get_mesh_faces failed: %s", dpsm_last_error(g));
     for (int64_t f = 0; f < nf; ++f) {
-        const int64_t a = faces[2 * f], b = faces[2 * f + 1];
+        const int64_t a = faces[2 * f] - base, b = faces[2 * f + 1] - base; /* from 0 */
         if (a < 0 || a >= m.ncells || b < -1 || b >= m.ncells || a == b)
             die("face %lld joins cells %lld and %lld of %lld", (long long)f, (long long)a, (long long)b, (long long)m.ncells);
         if (a != m.face_cells[2 * f] || b != m.face_cells[2 * f + 1])
@@ -2428,6 +2512,19 @@ static void op_mesh(reader_t *r) {
     ms.m = &m;
     ms.g = g;
     ms.p = &p;
+    if (indexed) {
+        prng_t q = p0;
+        int twin_want;
+        const char *twin_what;
+        g_op = kMeshFunctions[kind];
+        if (mesh_construct(&m, -1, &q, &ms.twin, &twin_want, &twin_what, 0, 0) != DPSM_OK)
+            die("the twin from 0 could not be made: %s", dpsm_last_error(NULL));
+        if (dpsm_set_max_substeps(ms.twin, MESH_MAX_SUBSTEPS) != DPSM_OK) die("dpsm_set_max_substeps failed on the twin");
+        msnap_t now;
+        mesh_snap(&ms, &now);
+        mesh_check_twin(&ms, &now);
+        free(now.h);
+    }
     ms.kinds = xcalloc((size_t)m.ncells, 1);
     ms.edge_open = xcalloc((size_t)m.nfaces, 1);
     ms.levels = xcalloc((size_t)m.nfaces, sizeof(double));
@@ -2436,6 +2533,7 @@ static void op_mesh(reader_t *r) {
     if (dpsm_set_max_substeps(g, MESH_MAX_SUBSTEPS) != DPSM_OK) die("dpsm_set_max_substeps failed on a mesh");
     for (unsigned k = 0; k < nops && more(r); ++k) mesh_operation(&ms, r);
     dpsm_destroy(g);
+    dpsm_destroy(ms.twin);
     free(ms.kinds);
     free(ms.edge_open);
     free(ms.levels);

@@ -256,7 +256,9 @@ seed("coupling_large_2d", create(0, "2d", 71, 65), coupling(0, 2, RECORD_ON), al
      region(SET_REGION, 0, 2, 2, 2, 2, 0, 10.0, 0.0), step(0, 100.0), coupling(0, 3, 0))
 
 # Meshes (op_mesh in fuzz_api.c): byte MESH, then kind (% 3: 0 polygons, 1
-# graph, 2 dual; / 3: 0 quads, 1 triangles, 2 mixed), nx - 2, ny - 2, two
+# graph, 2 dual; / 3 % 3: 0 quads, 1 triangles, 2 mixed; / 9 % 3, the
+# numbering: 0 the constructors from 0, 1 the _indexed ones from 1 with a
+# twin from 0, 2 the _indexed ones from 0 with a twin), nx - 2, ny - 2, two
 # kMeshSpacings indices, jitter (x 0.06), a u16 seed, a defect byte (0xc0 + k
 # plants defect k, which the constructor must refuse; else a valid mesh) and
 # the number of operations on the mesh, each an opcode byte and arguments:
@@ -269,8 +271,9 @@ MH = {0.0: 0, 1.0: 1, 3.0: 2, 10.0: 3, -1.0: 4, 0.5: 5, 30.0: 6, 100.0: 7, -3.0:
 MQ = {0.0: 0, 1e-3: 1, -1e-3: 2, 0.1: 3, -0.1: 4, 1.0: 5, 1e-9: 7}
 
 
-def mesh(kind, lattice, nx, ny, dx=1.0, dy=1.0, jitter=3, seed=1, defect=None, ops=()):
-    return [MESH, MESH_KIND[kind] + 3 * MESH_LATTICE[lattice], nx - 2, ny - 2, MESH_SPACING[dx], MESH_SPACING[dy],
+def mesh(kind, lattice, nx, ny, dx=1.0, dy=1.0, jitter=3, seed=1, defect=None, ops=(), numbering=0):
+    return [MESH, MESH_KIND[kind] + 3 * MESH_LATTICE[lattice] + 9 * numbering, nx - 2, ny - 2, MESH_SPACING[dx],
+            MESH_SPACING[dy],
             jitter, seed & 0xFF, seed >> 8, 0 if defect is None else 0xC0 + defect, len(ops)] + sum(ops, [])
 
 
@@ -358,6 +361,34 @@ seed("mesh_bad_dual", *[mesh("dual", "triangles", 2 + k % 5, 2 + k % 4, seed=k +
      mesh("dual", "triangles", 4, 4, ops=[m_heights(1, 3.0, 0.0), m_edge_kinds(0xE2), m_levels(0xE1, 1.0),
                                           m_levels(0xE3, 1.0), m_heights(3, 0.0, plant=2), m_fluxes(0x02),
                                           m_step(127)]))
+
+# The same meshes through the _indexed constructors: from 1 (numbering 1; the
+# seed picks the bad start index tried first: 2, -1, INT_MAX, INT_MIN) and
+# from 0 (numbering 2), each beside a twin from 0.
+seed("mesh_from_one",
+     mesh("polygons", "quads", 5, 4, jitter=4, seed=8, numbering=1, ops=[
+         m_heights(1, 10.0, 0.0), m_fluxes(1), m_step(95), m_step(127, restart=True), m_boundary(0),
+         m_kinds(2), m_step(127), m_edge_kinds(2), m_levels(2, 1.0, 3.0), m_step(127, True), m_absent(5),
+         m_fluxes(2), m_step(64)]),
+     mesh("graph", "mixed", 4, 5, seed=4243, numbering=1, ops=[
+         m_heights(2, 0.0, 10.0), m_fluxes(1), m_edge_kinds(3), m_levels(3), m_step(127, True), m_source(1, 0.1),
+         m_step(64), m_kinds(1), m_step(127)]),
+     mesh("dual", "triangles", 5, 4, seed=6, numbering=1, ops=[
+         m_heights(1, 10.0, 0.0), m_fluxes(1), m_boundary(0), m_step(127, True), m_kinds(3), m_step(127)]),
+     mesh("polygons", "triangles", 3, 3, seed=11, numbering=1, ops=[m_heights(1, 3.0, 0.0), m_step(127)]))
+seed("mesh_indexed_from_zero",
+     mesh("polygons", "mixed", 4, 4, seed=301, numbering=2, ops=[
+         m_heights(2, 0.0, 30.0), m_fluxes(1), m_step(127, True), m_edge_kinds(1), m_step(127)]),
+     mesh("graph", "quads", 3, 3, seed=21, numbering=2, ops=[m_heights(1, 3.0, 0.0), m_step(127, True)]),
+     mesh("dual", "triangles", 3, 3, seed=41, numbering=2, ops=[m_heights(1, 3.0, 0.0), m_step(127)]))
+seed("mesh_bad_from_one",
+     *[mesh("polygons", ("quads", "triangles", "mixed")[k % 3], 3 + k % 4, 2 + k % 3, seed=k + 1, defect=k,
+            numbering=1) for k in range(11)],
+     *[mesh("graph", ("quads", "triangles", "mixed")[k % 3], 2 + k % 4, 3 + k % 3, seed=k + 20, defect=k,
+            numbering=1) for k in range(11)],
+     *[mesh("dual", "triangles", 2 + k % 5, 2 + k % 4, seed=k + 40, defect=k, numbering=1) for k in range(9)],
+     mesh("polygons", "quads", 3, 3, numbering=1, ops=[m_heights(0, 1.0, plant=0), m_kinds(0xE1),
+                                                      m_edge_kinds(0xE2), m_levels(0xE1, 1.0)]))
 
 rng = random.Random(20240611)
 for k in range(8):

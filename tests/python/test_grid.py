@@ -875,6 +875,101 @@ class TestMesh(LedgerMixin, unittest.TestCase):
         self.assertFails(dpsm.ERR_INVALID_SIZE, dpsm.Grid.create_graph, cell_xy, [1.0], face_cells, face_xy,
                          [1.0] * 7)
 
+    def test_start_index(self):
+        """Indices from 1 (start_index=1, or the _indexed functions with the start index first): the same
+        mesh as from 0, bit for bit, its faces from 1 (0 on the domain edge), messages counting from 1;
+        a start index other than 0 and 1 refused."""
+        def one(values):
+            return [v + 1 for v in values]
+
+        def pairs(faces, shift):
+            return [[a + shift, b + shift] for a, b in faces]
+
+        start1, nodes1 = one(self.cell_start), one(self.cell_nodes)
+        h = [2.0, 0.0, 0.5, 0.0]
+        grids = [dpsm.Grid.create_mesh(self.node_xy, self.cell_start, self.cell_nodes),
+                 dpsm.Grid.create_mesh(self.node_xy, start1, nodes1, start_index=1),
+                 dpsm.Grid.create_mesh_indexed(1, self.node_xy, start1, nodes1),
+                 dpsm.Grid.mesh_indexed(0, self.node_xy, self.cell_start, self.cell_nodes)]
+        if np is not None:
+            grids.append(dpsm.Grid.create_mesh(np.array(self.node_xy), np.array(start1, dtype=np.int32),
+                                               np.array(nodes1, dtype=np.uint16), start_index=1))
+        for k, g in enumerate(grids):
+            from_one = k in (1, 2, 4)
+            self.assertEqual(as_list(g.get_mesh_faces()), pairs(self.faces, 1) if from_one else self.faces)
+            g.set_heights(h)
+            g.step(0.05)
+        heights = [flat(g.get_heights()) for g in grids]
+        for other in heights[1:]:
+            self.assertEqual(other, heights[0])
+        self.assertNotEqual(heights[0], h)
+        kinds = [dpsm.WALL] * 12
+        kinds[3] = 7  # the 4th face, on the domain edge
+        e = self.assertFails(dpsm.ERR_UNKNOWN_ENUM, grids[1].set_edge_kinds, kinds)
+        self.assertIn("kinds(4) (face 4, on the domain edge) = 7", e.message)
+        e = self.assertFails(dpsm.ERR_UNKNOWN_ENUM, grids[0].set_edge_kinds, kinds)
+        self.assertIn("kinds[3] (face 3, on the domain edge) = 7", e.message)
+        for g in grids:
+            g.close()
+
+        f = dpsm.Grid.create_mesh
+        bad = list(nodes1)
+        bad[2] = 10
+        e = self.assertFails(dpsm.ERR_INVALID_VALUE, f, self.node_xy, start1, bad, start_index=1)
+        self.assertEqual(e.function, "dpsm_create_mesh_indexed")
+        self.assertIn("cell_nodes(3) = 10 is not a node index in [1, 9]", e.message)
+        e = self.assertFails(dpsm.ERR_INVALID_VALUE, f, self.node_xy, self.cell_start, self.cell_nodes, start_index=1)
+        self.assertIn("cell_start(1) = 0 must be 1", e.message)
+        e = self.assertFails(dpsm.ERR_INVALID_SIZE, f, self.node_xy, start1, nodes1[:15], start_index=1)
+        self.assertIn("cell_nodes has 15 values but cell_start[-1] - 1 is 16", e.message)
+        with self.assertRaises(TypeError):
+            f(self.node_xy, start1, nodes1, start_index=1.0)
+
+        # The graph of test_graph and the dual of test_dual_mesh, from 1.
+        cell_xy, area = [(0.5, 0.5), (1.5, 0.5)], [1.0, 1.0]
+        face_cells = [(0, 1), (0, -1), (0, -1), (0, -1), (1, -1), (1, -1), (1, -1)]
+        face_xy = [(1.0, 0.5), (0.0, 0.5), (0.5, 0.0), (0.5, 1.0), (2.0, 0.5), (1.5, 0.0), (1.5, 1.0)]
+        cells1 = pairs(face_cells, 1)
+        graphs = [dpsm.Grid.create_graph(cell_xy, area, face_cells, face_xy, [1.0] * 7),
+                  dpsm.Grid.create_graph(cell_xy, area, cells1, face_xy, [1.0] * 7, start_index=1),
+                  dpsm.Grid.create_graph_indexed(1, cell_xy, area, cells1, face_xy, [1.0] * 7)]
+        self.assertEqual([as_list(g.get_mesh_faces()) for g in graphs],
+                         [pairs(face_cells, 0), cells1, cells1])
+        for g in graphs:
+            g.set_heights([2.0, 0.0])
+            g.step(0.1)
+        self.assertEqual(flat(graphs[1].get_heights()), flat(graphs[0].get_heights()))
+        self.assertEqual(flat(graphs[2].get_heights()), flat(graphs[0].get_heights()))
+        for g in graphs:
+            g.close()
+        bad = list(cells1)
+        bad[0] = (1, 3)
+        e = self.assertFails(dpsm.ERR_INVALID_VALUE, dpsm.Grid.graph_indexed, 1, cell_xy, area, bad, face_xy, [1.0] * 7)
+        self.assertIn("face 1: face_cells(2, 1) = 3 is not a cell index in [1, 2] nor 0 (the domain edge)", e.message)
+        square = [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)]
+        with dpsm.Grid.create_dual_mesh(square, [(1, 2, 3), (1, 3, 4)], start_index=1) as g:
+            with dpsm.Grid.create_dual_mesh_indexed(0, square, [(0, 1, 2), (0, 2, 3)]) as g0:
+                self.assertEqual(as_list(g.get_mesh_faces()), pairs(as_list(g0.get_mesh_faces()), 1))
+        with dpsm.Grid.dual_mesh_indexed(1, [v for xy in square for v in xy], [1, 2, 3, 1, 3, 4]) as g:
+            self.assertEqual(g.face_count(), 13)
+        e = self.assertFails(dpsm.ERR_INVALID_VALUE, dpsm.Grid.create_dual_mesh, square, [(1, 2, 3), (1, 3, 5)],
+                             start_index=1)
+        self.assertIn("triangle_nodes(3, 2) (triangle 2) = 5 is not a node index in [1, 4]", e.message)
+
+        # A start index other than 0 and 1.
+        for s in (2, -1):
+            calls = [(dpsm.Grid.create_mesh, (self.node_xy, start1, nodes1), {"start_index": s}),
+                     (dpsm.Grid.create_mesh_indexed, (s, self.node_xy, start1, nodes1), {}),
+                     (dpsm.Grid.create_graph_indexed, (s, cell_xy, area, cells1, face_xy, [1.0] * 7), {}),
+                     (dpsm.Grid.create_dual_mesh_indexed, (s, square, [(1, 2, 3), (1, 3, 4)]), {})]
+            for call, args, kwargs in calls:
+                e = self.assertFails(dpsm.ERR_INVALID_VALUE, call, *args, **kwargs)
+                self.assertTrue(e.function.endswith("_indexed"), e.function)
+                self.assertIn("start_index = %d is neither 0" % s, e.message)
+        e = self.assertFails(dpsm.ERR_INVALID_VALUE, dpsm.Grid.create_mesh, self.node_xy, start1, nodes1,
+                             start_index=2**40)
+        self.assertIn("does not fit in a C int", e.message)
+
     def test_column_collapse_on_triangles(self):
         # A column of sand on a 12 x 12 triangle mesh of a square, between walls.
         n, d = 12, 0.1

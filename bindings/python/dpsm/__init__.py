@@ -17,8 +17,10 @@ A ctypes binding of the C library (no compiled extension)::
 - Meshes: ``Grid.create_mesh(node_xy, cell_start, cell_nodes)`` (``Grid.mesh``),
   ``Grid.create_graph(...)`` (``Grid.graph``), ``Grid.create_dual_mesh(node_xy,
   triangle_nodes)`` (``Grid.dual_mesh``) and ``Grid.from_meshio(mesh)``, indices
-  from 0 as in C; their arrays hold one value per cell (``g.shape == (ncells,)``)
-  and ``g.get_mesh_faces()`` lists the faces, edge side ``MESH_EDGE``.
+  from 0 as in C, or from 1 with ``start_index=1`` (``Grid.create_mesh_indexed``
+  and the others take it first, as the C functions); their arrays hold one value
+  per cell (``g.shape == (ncells,)``) and ``g.get_mesh_faces()`` lists the faces
+  (from the start index), edge side ``MESH_EDGE``.
 - ``Grid`` methods are the C functions without the ``dpsm_`` prefix and
   without the grid argument; ``close()`` (or leaving the ``with`` block)
   releases the grid, as ``dpsm_destroy``.

@@ -295,39 +295,81 @@ class Grid:
         return cls._create(f, "axisymmetric", _c_int64(nr, "nr", f), float(dr))
 
     # ---- meshes ----------------------------------------------------------------
-    # Indices are 0-based, as in C: a face's second cell is -1 on the domain
-    # edge. Pairs and triples are rows: node_xy (nnodes, 2), face_cells
-    # (nfaces, 2), triangle_nodes (ntriangles, 3), or flat sequences.
+    # Indices are 0-based, as in C, unless ``start_index=1`` says they count
+    # from 1 (a Fortran host's arrays, a UGRID file's ``start_index = 1``):
+    # a face's second cell is ``start_index - 1`` on the domain edge. Such a
+    # mesh keeps its start index: the library's messages count its cells,
+    # nodes and faces from it (and name array positions as Fortran does,
+    # ``cell_nodes(7)``), ``get_mesh_faces`` returns cells from it. Pairs and
+    # triples are rows: node_xy (nnodes, 2), face_cells (nfaces, 2),
+    # triangle_nodes (ntriangles, 3), or flat sequences.
+
+    @staticmethod
+    def _mesh_function(function, start_index):
+        """The C constructor and the start index to pass it: the plain one
+        from 0, the ``_indexed`` one otherwise (which refuses a start index
+        other than 0 and 1 with its message)."""
+        if start_index == 0 and not function.endswith("_indexed"):
+            return function, ()
+        name = function if function.endswith("_indexed") else function + "_indexed"
+        return name, (_c_int(start_index, "start_index", name, C.DPSM_ERR_INVALID_VALUE),)
 
     @classmethod
-    def create_mesh(cls, node_xy, cell_start, cell_nodes):
+    def create_mesh(cls, node_xy, cell_start, cell_nodes, start_index=0):
         """``dpsm_create_mesh``: a mesh of polygonal cells over shared nodes.
         ``node_xy``: ``(nnodes, 2)`` or ``2*nnodes`` coordinates; cell ``c`` has
-        the nodes ``cell_nodes[cell_start[c]:cell_start[c+1]]`` (``cell_start``
-        holds ``ncells+1`` offsets from 0, ``cell_nodes`` ``cell_start[-1]``
-        node indices from 0). Also ``Grid.mesh``."""
-        f = "dpsm_create_mesh"
+        the nodes ``cell_nodes[cell_start[c] - s:cell_start[c+1] - s]`` with
+        ``s = start_index`` (``cell_start`` holds ``ncells+1`` offsets from
+        ``s``, ``cell_nodes`` ``cell_start[-1] - s`` node indices from ``s``).
+        With a ``start_index`` other than 0 it calls
+        ``dpsm_create_mesh_indexed``. Also ``Grid.mesh``."""
+        return cls._polygons("dpsm_create_mesh", start_index, node_xy, cell_start, cell_nodes)
+
+    @classmethod
+    def create_mesh_indexed(cls, start_index, node_xy, cell_start, cell_nodes):
+        """``dpsm_create_mesh_indexed``: ``create_mesh`` with the indices
+        counting from ``start_index`` (0 or 1)."""
+        return cls._polygons("dpsm_create_mesh_indexed", start_index, node_xy, cell_start, cell_nodes)
+
+    @classmethod
+    def _polygons(cls, function, start_index, node_xy, cell_start, cell_nodes):
+        f, first = cls._mesh_function(function, start_index)
         _, xy, nnodes, keep_xy = _table_in(node_xy, 2, "node_xy", f, False)
         start, start_p, nstart, keep_start = _table_in(cell_start, 1, "cell_start", f, True)
         _, nodes_p, total, keep_nodes = _table_in(cell_nodes, 1, "cell_nodes", f, True)
         ncells = max(nstart - 1, 0)
-        # The library reads cell_start[-1] node indices once cell_start[0] is
-        # 0 and every cell has 3 nodes or more (it refuses the others first).
-        if nnodes >= 1 and ncells >= 1 and int(start[0]) == 0:
-            _sizes_agree(f, [("cell_nodes", total, "values", int(start[-1]), "cell_start[-1]")])
-        grid = cls._create(f, "mesh", nnodes, xy, ncells, start_p, nodes_p)
+        # The library reads cell_start[-1] - start_index node indices once
+        # cell_start[0] is the start index and every cell has 3 nodes or more
+        # (it refuses the others first).
+        if nnodes >= 1 and ncells >= 1 and start_index in (0, 1) and int(start[0]) == start_index:
+            _sizes_agree(f, [("cell_nodes", total, "values", int(start[-1]) - start_index,
+                              "cell_start[-1]" + (" - 1" if start_index else ""))])
+        grid = cls._create(f, "mesh", *first, nnodes, xy, ncells, start_p, nodes_p)
         del keep_xy, keep_start, keep_nodes
         return grid
 
     @classmethod
-    def create_graph(cls, cell_xy, cell_area, face_cells, face_xy, face_length):
+    def create_graph(cls, cell_xy, cell_area, face_cells, face_xy, face_length, start_index=0):
         """``dpsm_create_graph``: a mesh from a finite-volume graph, as a host
         holds it: ``cell_xy`` ``(ncells, 2)`` centres, ``cell_area`` ``ncells``
         areas, ``face_cells`` ``(nfaces, 2)`` the cells ``(a, b)`` of each face
-        from 0 (``b == -1`` on the domain edge), ``face_xy`` ``(nfaces, 2)``
-        midpoints, ``face_length`` ``nfaces`` lengths. Faces keep this order.
-        Also ``Grid.graph``."""
-        f = "dpsm_create_graph"
+        from ``start_index`` (``b == start_index - 1`` on the domain edge: -1
+        from 0), ``face_xy`` ``(nfaces, 2)`` midpoints, ``face_length``
+        ``nfaces`` lengths. Faces keep this order. With a ``start_index``
+        other than 0 it calls ``dpsm_create_graph_indexed``. Also
+        ``Grid.graph``."""
+        return cls._graph("dpsm_create_graph", start_index, cell_xy, cell_area, face_cells, face_xy, face_length)
+
+    @classmethod
+    def create_graph_indexed(cls, start_index, cell_xy, cell_area, face_cells, face_xy, face_length):
+        """``dpsm_create_graph_indexed``: ``create_graph`` with the cells of
+        ``face_cells`` counting from ``start_index`` (0 or 1)."""
+        return cls._graph("dpsm_create_graph_indexed", start_index, cell_xy, cell_area, face_cells, face_xy,
+                          face_length)
+
+    @classmethod
+    def _graph(cls, function, start_index, cell_xy, cell_area, face_cells, face_xy, face_length):
+        f, first = cls._mesh_function(function, start_index)
         _, cxy, ncells, keep_cxy = _table_in(cell_xy, 2, "cell_xy", f, False)
         _, area, nareas, keep_area = _table_in(cell_area, 1, "cell_area", f, False)
         _, cells, nfaces, keep_cells = _table_in(face_cells, 2, "face_cells", f, True)
@@ -337,26 +379,40 @@ class Grid:
             _sizes_agree(f, [("cell_area", nareas, "values", ncells, "ncells (the rows of cell_xy)"),
                              ("face_xy", nfxy, "rows", nfaces, "nfaces (the rows of face_cells)"),
                              ("face_length", nlength, "values", nfaces, "nfaces (the rows of face_cells)")])
-        grid = cls._create(f, "mesh", ncells, cxy, area, nfaces, cells, fxy, length)
+        grid = cls._create(f, "mesh", *first, ncells, cxy, area, nfaces, cells, fxy, length)
         del keep_cxy, keep_area, keep_cells, keep_fxy, keep_length
         return grid
 
     @classmethod
-    def create_dual_mesh(cls, node_xy, triangle_nodes):
+    def create_dual_mesh(cls, node_xy, triangle_nodes, start_index=0):
         """``dpsm_create_dual_mesh``: the median dual of a triangle mesh, one
         cell per node (heights, sources and kinds per node): ``node_xy``
-        ``(nnodes, 2)``, ``triangle_nodes`` ``(ntriangles, 3)`` node indices from
-        0. Also ``Grid.dual_mesh``."""
-        f = "dpsm_create_dual_mesh"
+        ``(nnodes, 2)``, ``triangle_nodes`` ``(ntriangles, 3)`` node indices
+        from ``start_index``. With a ``start_index`` other than 0 it calls
+        ``dpsm_create_dual_mesh_indexed``. Also ``Grid.dual_mesh``."""
+        return cls._dual("dpsm_create_dual_mesh", start_index, node_xy, triangle_nodes)
+
+    @classmethod
+    def create_dual_mesh_indexed(cls, start_index, node_xy, triangle_nodes):
+        """``dpsm_create_dual_mesh_indexed``: ``create_dual_mesh`` with the
+        node indices counting from ``start_index`` (0 or 1)."""
+        return cls._dual("dpsm_create_dual_mesh_indexed", start_index, node_xy, triangle_nodes)
+
+    @classmethod
+    def _dual(cls, function, start_index, node_xy, triangle_nodes):
+        f, first = cls._mesh_function(function, start_index)
         _, xy, nnodes, keep_xy = _table_in(node_xy, 2, "node_xy", f, False)
         _, tris, ntriangles, keep_tris = _table_in(triangle_nodes, 3, "triangle_nodes", f, True)
-        grid = cls._create(f, "mesh", nnodes, xy, ntriangles, tris)
+        grid = cls._create(f, "mesh", *first, nnodes, xy, ntriangles, tris)
         del keep_xy, keep_tris
         return grid
 
     mesh = create_mesh
     graph = create_graph
     dual_mesh = create_dual_mesh
+    mesh_indexed = create_mesh_indexed
+    graph_indexed = create_graph_indexed
+    dual_mesh_indexed = create_dual_mesh_indexed
 
     @classmethod
     def from_meshio(cls, mesh):
@@ -654,7 +710,8 @@ class Grid:
 
     def get_mesh_faces(self):
         """``dpsm_get_mesh_faces``: the two cells ``(a, b)`` of every face, from 0, ``b == -1`` on the
-        domain edge, in the host's face order (that of ``get_face_fluxes``, ``set_edge_kinds`` and the
+        domain edge (from the mesh's start index, ``b == start_index - 1``, for a mesh made with one), in
+        the host's face order (that of ``get_face_fluxes``, ``set_edge_kinds`` and the
         levels of ``MESH_EDGE``): a numpy int64 array of shape ``(nfaces, 2)``, or a list of ``[a, b]``
         pairs without numpy. Also ``mesh_faces()``."""
         f = "dpsm_get_mesh_faces"
