@@ -20,12 +20,7 @@ static const double kTwoPi = 6.283185307179586476925;
 
 stress_worst_t stress_worst;
 
-#define OK(s, call)                                                                                            \
-    do {                                                                                                       \
-        const int st_ = (call);                                                                                \
-        REQUIRE(st_ == DPSM_OK, "[%s] %s returned %s: %s", (s)->name, #call, dpsm_status_string(st_),        \
-                dpsm_last_error((s)->g));                                                                      \
-    } while (0)
+#define OK(s, call) SCENE_OK(s, call)
 
 void stress_worst_reset(stress_worst_t *w) {
     memset(w, 0, sizeof *w);
@@ -572,4 +567,38 @@ void scene_run_to_rest(scene_t *s, double dt, int max_calls, stress_worst_t *w) 
     for (int k = 0; k < max_calls; ++k)
         if (scene_step(s, dt, w)) return;
     REQUIRE(0, "[%s] not at rest after %d steps of %g", s->name, max_calls, dt);
+}
+
+/* Everything dpsm shows of a grid, to compare bit for bit. */
+typedef struct {
+    double *h;
+    double mass[4], info[4], stable_dt;
+} snap_t;
+
+static void snap(dpsm_grid *g, int64_t ncells, snap_t *out) {
+    out->h = malloc(sizeof(double) * (size_t)ncells);
+    REQUIRE(out->h != NULL, "out of memory");
+    REQUIRE(dpsm_get_heights(g, out->h) == DPSM_OK, "get_heights");
+    for (int q = 0; q < 4; ++q) REQUIRE(dpsm_get_mass(g, q, &out->mass[q]) == DPSM_OK, "get_mass");
+    for (int i = 0; i < 4; ++i) REQUIRE(dpsm_get_step_info(g, i, &out->info[i]) == DPSM_OK, "get_step_info");
+    REQUIRE(dpsm_stable_dt(g, &out->stable_dt) == DPSM_OK, "stable_dt");
+}
+
+void expect_work_limit_on(dpsm_grid *g, int64_t ncells, const char *name, double dt) {
+    snap_t a, b;
+    snap(g, ncells, &a);
+    const int st = dpsm_step(g, dt);
+    const char *msg = dpsm_last_error(g);
+    REQUIRE(st == DPSM_ERR_WORK_LIMIT, "[%s] dpsm_step(%g) returned %s, expected DPSM_ERR_WORK_LIMIT (%s)", name, dt,
+            dpsm_status_string(st), msg);
+    REQUIRE(strstr(msg, "dpsm_step") && strstr(msg, "dt") && strstr(msg, "dpsm_set_max_substeps"),
+            "[%s] the work-limit message does not say what to do: \"%s\"", name, msg);
+    snap(g, ncells, &b);
+    const char *what = "after DPSM_ERR_WORK_LIMIT";
+    REQUIRE(memcmp(a.h, b.h, sizeof(double) * (size_t)ncells) == 0, "[%s] %s: heights changed", name, what);
+    REQUIRE(memcmp(a.mass, b.mass, sizeof a.mass) == 0, "[%s] %s: the ledger changed", name, what);
+    REQUIRE(memcmp(a.info, b.info, sizeof a.info) == 0, "[%s] %s: the step information changed", name, what);
+    REQUIRE(memcmp(&a.stable_dt, &b.stable_dt, sizeof(double)) == 0, "[%s] %s: stable_dt changed", name, what);
+    free(a.h);
+    free(b.h);
 }

@@ -56,6 +56,16 @@ typedef struct {
     int record;        /* face fluxes recorded and checked (every second scene) */
 } scene_t;
 
+/* Fails the test, naming the scene s (any struct with a name and a grid g)
+ * and the library's message, when a call does not succeed (REQUIRE:
+ * test_support.h). */
+#define SCENE_OK(s, call)                                                                                      \
+    do {                                                                                                       \
+        const int st_ = (call);                                                                                \
+        REQUIRE(st_ == DPSM_OK, "[%s] %s returned %s: %s", (s)->name, #call, dpsm_status_string(st_),        \
+                dpsm_last_error((s)->g));                                                                      \
+    } while (0)
+
 /* The worst figures seen so far (over every scene of the process). */
 typedef struct {
     double ledger;            /* relative ledger residual */
@@ -122,6 +132,12 @@ int scene_driven(const scene_t *s);
 /* Checks every invariant of the current state (no step: max principle not
  * applied). */
 void scene_check(scene_t *s, stress_worst_t *w);
+
+/* dpsm_step(g, dt) must fail with DPSM_ERR_WORK_LIMIT, with a message that
+ * says what to do, and change nothing dpsm shows of the grid of `ncells`
+ * cells (heights, the ledger, the step information, the stable sub-step), bit
+ * for bit; `name` names the scene in the failure. Any grid or mesh. */
+void expect_work_limit_on(dpsm_grid *g, int64_t ncells, const char *name, double dt);
 
 /* The relative ledger residual of g: relative to the largest of the four
  * figures, the gross mass sum |h| * area over sand cells now, and the largest

@@ -108,43 +108,8 @@ static double stable(const scene_t *s) {
     return dt;
 }
 
-/* Everything dpsm shows of a grid, to compare bit for bit. */
-typedef struct {
-    double *h;
-    double mass[4], info[4], stable_dt;
-} snap_t;
-
-static void snap(const scene_t *s, snap_t *out) {
-    out->h = malloc(sizeof(double) * (size_t)s->n);
-    REQUIRE(out->h != NULL, "out of memory");
-    REQUIRE(dpsm_get_heights(s->g, out->h) == DPSM_OK, "get_heights");
-    for (int q = 0; q < 4; ++q) REQUIRE(dpsm_get_mass(s->g, q, &out->mass[q]) == DPSM_OK, "get_mass");
-    for (int i = 0; i < 4; ++i) REQUIRE(dpsm_get_step_info(s->g, i, &out->info[i]) == DPSM_OK, "get_step_info");
-    REQUIRE(dpsm_stable_dt(s->g, &out->stable_dt) == DPSM_OK, "stable_dt");
-}
-
-static void same_snap(const scene_t *s, const snap_t *a, const snap_t *b, const char *what) {
-    REQUIRE(memcmp(a->h, b->h, sizeof(double) * (size_t)s->n) == 0, "[%s] %s: heights changed", s->name, what);
-    REQUIRE(memcmp(a->mass, b->mass, sizeof a->mass) == 0, "[%s] %s: the ledger changed", s->name, what);
-    REQUIRE(memcmp(a->info, b->info, sizeof a->info) == 0, "[%s] %s: the step information changed", s->name, what);
-    REQUIRE(memcmp(&a->stable_dt, &b->stable_dt, sizeof(double)) == 0, "[%s] %s: stable_dt changed", s->name, what);
-}
-
 /* dpsm_step(dt) must fail with DPSM_ERR_WORK_LIMIT, say why, and change nothing. */
-static void expect_work_limit(scene_t *s, double dt) {
-    snap_t before, after;
-    snap(s, &before);
-    const int st = dpsm_step(s->g, dt);
-    const char *msg = dpsm_last_error(s->g);
-    REQUIRE(st == DPSM_ERR_WORK_LIMIT, "[%s] dpsm_step(%g) returned %s, expected DPSM_ERR_WORK_LIMIT (%s)", s->name, dt,
-            dpsm_status_string(st), msg);
-    REQUIRE(strstr(msg, "dpsm_step") && strstr(msg, "dt") && strstr(msg, "dpsm_set_max_substeps"),
-            "[%s] the work-limit message does not say what to do: \"%s\"", s->name, msg);
-    snap(s, &after);
-    same_snap(s, &before, &after, "after DPSM_ERR_WORK_LIMIT");
-    free(before.h);
-    free(after.h);
-}
+static void expect_work_limit(scene_t *s, double dt) { expect_work_limit_on(s->g, s->n, s->name, dt); }
 
 static void finish_test(const char *title, const stress_worst_t *w) {
     stress_worst_print(title, w);
