@@ -958,14 +958,39 @@ static void test_threads(void **state) {
         }
     free(ref);
     free(h);
-    /* 1D and axisymmetric grids accept it too. */
+    /* dpsm_get_threads: what was asked for on a 2D grid; the default at least 1 (a serial grid takes OpenMP's). */
     dpsm_grid *g = NULL;
+    int n = -7;
+    CHECK_OK(NULL, dpsm_create_2d(8, 8, 1.0, 1.0, &g));
+    CHECK_OK(g, dpsm_get_threads(g, &n));
+    REQUIRE(n >= 1, "a 2D grid's default is %d threads", n);
+#if defined(DPSM_TEST_WITH_OPENMP)
+    const int three = 3, most = 1024; /* each thread holds buffers of its own: at most 1024 */
+#else
+    const int three = 1, most = 1; /* a build without OpenMP runs on one thread */
+#endif
+    CHECK_OK(g, dpsm_set_threads(g, 3));
+    CHECK_OK(g, dpsm_get_threads(g, &n));
+    REQUIRE(n == three, "asked for 3 threads, dpsm_get_threads says %d", n);
+    CHECK_OK(g, dpsm_set_threads(g, INT_MAX));
+    CHECK_OK(g, dpsm_get_threads(g, &n));
+    REQUIRE(n == most, "asked for INT_MAX threads, dpsm_get_threads says %d", n);
+    CHECK_OK(g, dpsm_set_threads(g, 0));
+    int again = -7;
+    CHECK_OK(g, dpsm_get_threads(g, &again));
+    REQUIRE(again >= 1, "back to the default: %d threads", again);
+    dpsm_destroy(g);
+    /* 1D and axisymmetric grids accept it too, and step on one thread. */
     CHECK_OK(NULL, dpsm_create_1d(5, 1.0, &g));
     CHECK_OK(g, dpsm_set_threads(g, 4));
     CHECK_OK(g, dpsm_set_threads(g, INT_MAX));
+    CHECK_OK(g, dpsm_get_threads(g, &n));
+    REQUIRE(n == 1, "a 1D grid steps on %d threads", n);
     dpsm_destroy(g);
     CHECK_OK(NULL, dpsm_create_axisymmetric(5, 1.0, &g));
     CHECK_OK(g, dpsm_set_threads(g, 0));
+    CHECK_OK(g, dpsm_get_threads(g, &n));
+    REQUIRE(n == 1, "an axisymmetric grid steps on %d threads", n);
     dpsm_destroy(g);
 }
 
@@ -2094,6 +2119,9 @@ static void test_null_grid_every_function(void **state) {
     EXPECT_NULL_GRID(dpsm_set_max_substeps(NULL, 0), "dpsm_set_max_substeps");
     EXPECT_NULL_GRID(dpsm_set_threads(NULL, 1), "dpsm_set_threads");
     EXPECT_NULL_GRID(dpsm_set_threads(NULL, -1), "dpsm_set_threads");
+    int threads = 0;
+    EXPECT_NULL_GRID(dpsm_get_threads(NULL, &threads), "dpsm_get_threads");
+    EXPECT_NULL_GRID(dpsm_get_threads(NULL, NULL), "dpsm_get_threads");
     EXPECT_NULL_GRID(dpsm_set_side_levels(NULL, DPSM_XMAX, h), "dpsm_set_side_levels");
     EXPECT_NULL_GRID(dpsm_set_side_levels(NULL, 99, NULL), "dpsm_set_side_levels");
     EXPECT_NULL_GRID(dpsm_get_side_outflow(NULL, DPSM_XMAX, &v), "dpsm_get_side_outflow");
@@ -2402,6 +2430,7 @@ static void test_bad_threads(void **state) {
     const int bad[] = {-1, -2, INT_MIN};
     for (size_t k = 0; k < sizeof bad / sizeof *bad; ++k)
         EXPECT_FAIL(fx, dpsm_set_threads(fx->g, bad[k]), DPSM_ERR_INVALID_VALUE, "dpsm_set_threads", "n");
+    EXPECT_FAIL(fx, dpsm_get_threads(fx->g, NULL), DPSM_ERR_NULL_POINTER, "dpsm_get_threads", "n");
 }
 
 static void test_bad_max_substeps(void **state) {

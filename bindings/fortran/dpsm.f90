@@ -133,7 +133,7 @@ module dpsm
   public :: dpsm_set_cell_kinds, dpsm_set_heights, dpsm_get_heights
   public :: dpsm_set_heights_region, dpsm_add_heights_region, dpsm_get_heights_region
   public :: dpsm_set_source, dpsm_stable_dt, dpsm_step, dpsm_get_mass, dpsm_get_step_info
-  public :: dpsm_get_shape, dpsm_set_rest_tolerance, dpsm_set_max_substeps, dpsm_set_threads
+  public :: dpsm_get_shape, dpsm_set_rest_tolerance, dpsm_set_max_substeps, dpsm_set_threads, dpsm_get_threads
   public :: dpsm_set_bedrock, dpsm_set_repose_angle_field, dpsm_set_flux_exponent, dpsm_set_static_angle
   public :: dpsm_set_side_levels, dpsm_get_side_outflow, dpsm_set_face_flux_recording, dpsm_get_face_fluxes
   public :: dpsm_save, dpsm_load
@@ -455,6 +455,12 @@ module dpsm
       type(c_ptr), value :: g
       integer(c_int), value :: n
     end function c_dpsm_set_threads
+
+    integer(c_int) function c_dpsm_get_threads(g, n) bind(C, name='dpsm_get_threads')
+      import :: c_int, c_ptr
+      type(c_ptr), value :: g
+      integer(c_int), intent(out) :: n
+    end function c_dpsm_get_threads
 
     integer(c_int) function c_dpsm_set_bedrock(g, zb) bind(C, name='dpsm_set_bedrock')
       import :: c_int, c_double, c_ptr
@@ -1373,6 +1379,16 @@ contains
     call clear_message(g)
     call finish(c_dpsm_set_threads(g%ptr, n), ierr, 'dpsm_set_threads', g)
   end subroutine dpsm_set_threads
+
+  !> dpsm_get_threads(g, n[, ierr]): the threads dpsm_step will use (1 on a
+  !> block of a distributed grid unless OMP_NUM_THREADS is set).
+  subroutine dpsm_get_threads(g, n, ierr)
+    type(dpsm_grid), intent(in) :: g
+    integer(c_int), intent(out) :: n
+    integer, intent(out), optional :: ierr
+    call clear_message(g)
+    call finish(c_dpsm_get_threads(g%ptr, n), ierr, 'dpsm_get_threads', g)
+  end subroutine dpsm_get_threads
 
   ! ==== cell kinds ===========================================================
 

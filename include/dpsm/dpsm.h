@@ -898,12 +898,32 @@ DPSM_API int dpsm_set_max_substeps(dpsm_grid *g, int64_t n);
  * order. Without OpenMP support in the build the library runs on one thread
  * and accepts any valid `n`.
  *
+ * The default (`n` = 0) is OpenMP's default, usually one thread per core,
+ * except on a block of a distributed grid (dpsm_mpi.h), which takes one
+ * thread unless the environment sets `OMP_NUM_THREADS`: an MPI host runs a
+ * rank per core, and each rank taking every core of the node would
+ * oversubscribe it. dpsm_get_threads() says what a step will use.
+ *
  * @param g  the grid.
- * @param n  at least 0; 0 (the default) means OpenMP's default, usually one
- *           thread per core.
+ * @param n  at least 0; 0 (the default) means the default above; counts
+ *           beyond 1024 run as 1024 (each thread holds buffers of its own).
  * @return ::DPSM_OK, ::DPSM_ERR_NULL_POINTER or ::DPSM_ERR_INVALID_VALUE.
  */
 DPSM_API int dpsm_set_threads(dpsm_grid *g, int n);
+
+/**
+ * @brief How many threads dpsm_step() will use on this grid.
+ *
+ * The count dpsm_set_threads() asked for, or the default it describes (1 on
+ * a block of a distributed grid without `OMP_NUM_THREADS`, else OpenMP's
+ * default); 1 on 1D and axisymmetric grids, whose steps are serial, and
+ * without OpenMP support in the build.
+ *
+ * @param g  the grid.
+ * @param n  receives the count, at least 1.
+ * @return ::DPSM_OK or ::DPSM_ERR_NULL_POINTER.
+ */
+DPSM_API int dpsm_get_threads(const dpsm_grid *g, int *n);
 
 /** @name Physics for real scenes
  *  A bed that cannot erode, angles that vary, other flow laws and

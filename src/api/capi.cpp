@@ -727,6 +727,15 @@ int dpsm_set_threads(dpsm_grid *g, int n) {
     });
 }
 
+int dpsm_get_threads(const dpsm_grid *g, int *n) {
+    const char *fn = "dpsm_get_threads";
+    return guarded(g, fn, [&] {
+        require_grid(g, fn);
+        require_pointer(n, fn, "n");
+        *n = g->core.geometry().dim == 1 ? 1 : g->core.step_threads();  // 1D and axisymmetric: the serial line sweep
+    });
+}
+
 int dpsm_set_bedrock(dpsm_grid *g, const double *zb) {
     const char *fn = "dpsm_set_bedrock";
     return guarded(g, fn, [&] {

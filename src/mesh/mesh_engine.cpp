@@ -259,7 +259,7 @@ private:
             prepare_bed(grid, m, s, dt, did);
             law.available = s.available.data();
         }
-        const int threads = thread_count(grid.threads());
+        const int threads = grid.step_threads();
         double max_excess = 0.0;
         bool moved = false;
 

@@ -14,6 +14,7 @@
 #include "model/face_fluxes.hpp"
 #include "model/ledger.hpp"
 #include "model/side_levels.hpp"
+#include "model/threads.hpp"
 
 namespace dpsm {
 
@@ -131,6 +132,8 @@ public:
     std::int64_t max_substeps() const { return max_substeps_; }
     void set_max_substeps(std::int64_t n) { max_substeps_ = n; }
     int threads() const { return threads_; }  // 0: OpenMP's default
+    // The threads a step runs on (model/threads.hpp).
+    int step_threads() const { return thread_count(threads_, decomposition_ != nullptr); }
     void set_threads(int n) { threads_ = n; }
     Scheme scheme() const { return scheme_; }
     void set_scheme(Scheme scheme) {

@@ -426,7 +426,7 @@ SideMass side_mass_of(const SubstepSummary &evaluation, double dt) {
 bool relax_to_rest(Grid &grid, std::int64_t budget, double &cells_visited) {
     cells_visited = 0.0;
     require_supported(grid);
-    prepare_tiled_sweep(grid, grid.threads());  // allocates before anything changes
+    prepare_tiled_sweep(grid, grid.step_threads());  // allocates before anything changes
     StepInfo info;
     info.at_rest = true;
     info.time_integrated = 0.0;

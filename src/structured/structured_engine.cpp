@@ -33,7 +33,7 @@ namespace {
 class TiledEngine final : public Engine {
 public:
     double stable_dt(const Grid &grid) const override { return structured_stable_dt(grid); }
-    void prepare(Grid &grid) const override { prepare_tiled_sweep(grid, grid.threads()); }
+    void prepare(Grid &grid) const override { prepare_tiled_sweep(grid, grid.step_threads()); }
     bool may_move(const Grid &grid) const override { return grid.active_set().may_move(); }
 
     bool drive_sources(Grid &grid, double dt, double sub_dt, bool lazy) const override {

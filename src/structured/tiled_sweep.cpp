@@ -417,7 +417,7 @@ void prepare_tiled_sweep(Grid &grid, int threads) {
         ws.residuals.assign(cells, 0.0f);
         ws.all_stale = true;
     }
-    const std::size_t want = static_cast<std::size_t>(thread_count(threads));
+    const std::size_t want = static_cast<std::size_t>(threads);
     while (ws.buffers.size() < want) {
         ws.buffers.emplace_back();
         ws.buffers.back().resize(kBufferSide, kBufferSide);
@@ -491,7 +491,7 @@ std::int64_t tiled_sweep(Grid &grid, int levels, double dt, std::vector<SubstepS
     // DPSM_COPY_TILES=1 copies every tile into a buffer and back (no tile is
     // read or written in place), for tests that show it changes no result.
     const bool in_place = !environment_flag("DPSM_COPY_TILES");
-    const int threads = thread_count(grid.threads());
+    const int threads = grid.step_threads();
     std::int64_t visited_cells = 0;
     for (const CellBox &cells : ws.boxes) visited_cells += (cells.i1 - cells.i0) * (cells.j1 - cells.j0);
     // Threads pay off only with enough work between their barriers; below this
@@ -732,7 +732,7 @@ namespace {
 template <class Visit>
 void for_tiles_in_parallel(Grid &grid, std::int64_t count, std::int64_t cells, Visit &&visit) {
     TiledWorkspace &ws = grid.tiled_workspace();
-    const int threads = thread_count(grid.threads());
+    const int threads = grid.step_threads();
 #if defined(_OPENMP)
     const bool parallel = threads > 1 && count > 1 && cells >= kCellsForThreads;
 #pragma omp parallel for schedule(dynamic, 1) num_threads(threads) if (parallel)

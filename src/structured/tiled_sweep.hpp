@@ -64,8 +64,8 @@ struct TiledWorkspace {
     std::vector<std::int64_t> origin;   // per visited tile: its buffer's first cell (i, j)
 };
 
-// Makes sure the workspace can run a sweep with `threads` threads (0: the
-// OpenMP default). Allocates; call before changing anything.
+// Makes sure the workspace can run a sweep with `threads` threads
+// (Grid::step_threads). Allocates; call before changing anything.
 void prepare_tiled_sweep(Grid &grid, int threads);
 
 // The host changed the cells of box (heights or residuals): the scratch no

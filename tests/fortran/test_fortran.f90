@@ -111,6 +111,7 @@ contains
     real(c_double) :: dt, value, total, external, slope_excess
     integer(c_int64_t) :: nx64, ny64
     integer(c_int32_t) :: nx32, ny32
+    integer(c_int) :: threads
     integer :: ierr, i, j
     character(len=:), allocatable :: message
 
@@ -163,6 +164,8 @@ contains
     call expect(ierr == DPSM_ERR_INVALID_VALUE, 'dpsm_set_threads(-1) fails')
     call dpsm_set_threads(g, 2_c_int, ierr)
     call expect(ierr == DPSM_OK, 'dpsm_set_threads(2)')
+    call dpsm_get_threads(g, threads, ierr)
+    call expect(ierr == DPSM_OK .and. threads == 2, 'dpsm_get_threads after dpsm_set_threads(2)')
 
     call dpsm_stable_dt(g, dt, ierr)
     call expect(ierr == DPSM_OK .and. close_to(dt, 1/(2*nu*cos(theta)*(1/dx**2 + 1/dy**2)), 1e-12_c_double), &

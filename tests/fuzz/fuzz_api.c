@@ -667,6 +667,12 @@ static void op_parameter(reader_t *r, unsigned which) {
             static const int values[] = {0, 1, 2, 3, 1, 2, -1, INT32_MIN};
             const int v = values[u8(r) % COUNT(values)];
             ON_BOTH(s, v >= 0 ? DPSM_OK : DPSM_ERR_INVALID_VALUE, g_op, dpsm_set_threads(g_, v));
+            /* What a step will use: 1 on a line's serial sweep, else what was asked, else OpenMP's default. */
+            int n = 0;
+            g_op = "dpsm_get_threads";
+            ON_BOTH(s, DPSM_OK, g_op, dpsm_get_threads(g_, &n));
+            if (s->geom != GEOM_2D ? n != 1 : v > 0 ? n != v : n < 1) die("dpsm_get_threads says %d after %d", n, v);
+            if (dpsm_get_threads(s->g, NULL) != DPSM_ERR_NULL_POINTER) die("dpsm_get_threads accepted a NULL n");
             break;
         }
     }
@@ -1435,7 +1441,7 @@ static void op_null_grid(reader_t *r) {
     int64_t a, c;
     int st;
     const char *fn;
-    switch (b >= kLaterOps ? 25 + (b - kLaterOps) % 4 : b % 25) {
+    switch (b >= kLaterOps ? 25 + (b - kLaterOps) % 5 : b % 25) {
         case 0: st = dpsm_set_repose_angle(NULL, 0.5), fn = "dpsm_set_repose_angle"; break;
         case 1: st = dpsm_set_mobility(NULL, 1.0), fn = "dpsm_set_mobility"; break;
         case 2: st = dpsm_set_scheme(NULL, 0), fn = "dpsm_set_scheme"; break;
@@ -1464,6 +1470,11 @@ static void op_null_grid(reader_t *r) {
         case 26: st = dpsm_get_side_outflow(NULL, DPSM_XMIN, &d), fn = "dpsm_get_side_outflow"; break;
         case 27: st = dpsm_set_face_flux_recording(NULL, 1), fn = "dpsm_set_face_flux_recording"; break;
         case 28: st = dpsm_get_face_fluxes(NULL, h, NULL), fn = "dpsm_get_face_fluxes"; break;
+        case 29: {
+            int n = 0;
+            st = dpsm_get_threads(NULL, &n), fn = "dpsm_get_threads";
+            break;
+        }
         default: {
             dpsm_destroy(NULL);
             const int code = (int)(int8_t)u8(r);

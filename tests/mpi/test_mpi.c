@@ -730,6 +730,38 @@ static void physics_agreement(void) {
     dpsm_destroy(g);
 }
 
+/* A block takes one thread unless OMP_NUM_THREADS or dpsm_set_threads says
+ * otherwise (an MPI host runs a rank per core); a serial grid keeps OpenMP's
+ * default. */
+static void thread_defaults(void) {
+    const int64_t nx = 40, ny = 30;
+    block_t b = block_of(GRID_2D, rank_, size_, nx, ny);
+    dpsm_grid *g = NULL, *serial = NULL;
+    OK(NULL, dpsm_create_2d_mpi(MPI_COMM_WORLD, nx, ny, b.i0, b.j0, b.ni, b.nj, 1.0, 1.0, &g));
+    OK(NULL, dpsm_create_2d(nx, ny, 1.0, 1.0, &serial));
+    if (!g || !serial) return;
+    const char *env = getenv("OMP_NUM_THREADS");
+    char saved[64] = "";
+    if (env) snprintf(saved, sizeof saved, "%s", env);
+    int n = 0;
+    unsetenv("OMP_NUM_THREADS");
+    OK(g, dpsm_get_threads(g, &n));
+    require(n == 1, "a block without OMP_NUM_THREADS takes %d threads, not 1", n);
+    OK(serial, dpsm_get_threads(serial, &n));
+    require(n >= 1, "a serial grid takes %d threads", n);
+    setenv("OMP_NUM_THREADS", "3", 1);
+    OK(g, dpsm_get_threads(g, &n));
+    require(n >= 1, "a block with OMP_NUM_THREADS takes %d threads (OpenMP's count)", n);
+    unsetenv("OMP_NUM_THREADS");
+    OK(g, dpsm_set_threads(g, 2));
+    OK(g, dpsm_get_threads(g, &n));
+    require(n == 2, "a block asked for 2 threads takes %d", n);
+    OK(g, dpsm_step(g, 1.0));
+    if (env) setenv("OMP_NUM_THREADS", saved, 1);
+    dpsm_destroy(g);
+    dpsm_destroy(serial);
+}
+
 /* ---- restart files ------------------------------------------------------- */
 
 /* This rank's file of save `name` (the rank count in the name: the runs on 1,
@@ -990,6 +1022,7 @@ int main(int argc, char **argv) {
     disagreeing_ranks();
     refusing_rank();
     physics_agreement();
+    thread_defaults();
     restart_files();
 
     long total = 0, all_checks = 0;

@@ -37,6 +37,7 @@ C_TYPES = {
     "dpsm_grid **": ctypes.POINTER(_lib.GridPtr),
     "double *": ctypes.POINTER(ctypes.c_double),
     "const double *": ctypes.POINTER(ctypes.c_double),
+    "int *": ctypes.POINTER(ctypes.c_int),
     "int64_t *": ctypes.POINTER(ctypes.c_int64),
     "const int64_t *": ctypes.POINTER(ctypes.c_int64),
     "const uint8_t *": ctypes.POINTER(ctypes.c_uint8),

@@ -132,7 +132,9 @@ class Test2D(LedgerMixin, unittest.TestCase):
         g.set_max_substeps(dpsm.DEFAULT_MAX_SUBSTEPS)
         self.assertFails(dpsm.ERR_INVALID_VALUE, g.set_threads, -1)
         g.set_threads(2)
+        self.assertEqual(g.get_threads(), 2)
         g.set_threads(0)
+        self.assertGreaterEqual(g.get_threads(), 1)
         expected = 1 / (2 * 2.0 * math.cos(0.6) * (1 / self.dx**2 + 1 / self.dy**2))
         self.assertAlmostEqual(g.stable_dt(), expected, delta=1e-12 * expected)
 

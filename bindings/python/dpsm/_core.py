@@ -609,9 +609,16 @@ class Grid:
         self._call(f, _c_int64(n, "n", f, C.DPSM_ERR_INVALID_VALUE))
 
     def set_threads(self, n):
-        """``dpsm_set_threads``: at least 0; 0 means OpenMP's default."""
+        """``dpsm_set_threads``: at least 0; 0 means the default (OpenMP's; one thread on a block of a
+        distributed grid unless ``OMP_NUM_THREADS`` is set)."""
         f = "dpsm_set_threads"
         self._call(f, _c_int(n, "n", f, C.DPSM_ERR_INVALID_VALUE))
+
+    def get_threads(self):
+        """``dpsm_get_threads``: how many threads a step will use."""
+        value = ctypes.c_int()
+        self._call("dpsm_get_threads", ctypes.byref(value))
+        return value.value
 
     def set_flux_exponent(self, p):
         """``dpsm_set_flux_exponent``: within [1, ``MAX_FLUX_EXPONENT``]; 1 is the paper's law."""
