@@ -812,9 +812,7 @@ static void test_graph_steps_as_polygons(void **state) {
  * steps run on the active set's lists; on the plane a face's slope is decided
  * by its tangential part too, so a cell must wake the cells whose gradients
  * read it (with only the changed cells woken, the heights differ). */
-static void run_active_scene(const mesh_scene *s, double *h_out, double *ledger_out) {
-    dpsm_grid *g = NULL;
-    CHECK_OK(NULL, scene_create(s, &g));
+static void run_active_scene_on(dpsm_grid *g, const mesh_scene *s, double *h_out, double *ledger_out) {
     const double tan_theta = tan(30.0 * kDeg);
     CHECK_OK(g, dpsm_set_repose_angle(g, 30.0 * kDeg));
     double *h = calloc((size_t)s->cells, sizeof(double)), *q = calloc((size_t)s->cells, sizeof(double));
@@ -842,6 +840,12 @@ static void run_active_scene(const mesh_scene *s, double *h_out, double *ledger_
     dpsm_destroy(g);
 }
 
+static void run_active_scene(const mesh_scene *s, double *h_out, double *ledger_out) {
+    dpsm_grid *g = NULL;
+    CHECK_OK(NULL, scene_create(s, &g));
+    run_active_scene_on(g, s, h_out, ledger_out);
+}
+
 static void test_active_set_same_bits(void **state) {
     (void)state;
     const scene_kind kinds[3] = {SCENE_TRIANGLES, SCENE_DUAL, SCENE_HEXAGONS};
@@ -863,6 +867,65 @@ static void test_active_set_same_bits(void **state) {
         free(a), free(b);
         scene_free(&s);
     }
+}
+
+/* What a cell's sums read is ordered by the host's cell numbers (and on the
+ * domain edge by the faces' midpoints), never by the library's internal
+ * order or the order the host lists faces in: a distributed mesh, whose ranks
+ * each order their part their own way, must add the same terms in the same
+ * order as one serial mesh. So the cells in the host's order instead of along
+ * the Hilbert curve (DPSM_MESH_HOST_ORDER=1), on every mesh kind, and a graph
+ * whose faces are listed backwards, each the other way round, step to the
+ * same heights bit for bit; the ledger's sums over faces may round
+ * differently. */
+static void compare_runs(const char *what, const double *a, const double *b, int64_t n, const double *la,
+                         const double *lb) {
+    for (int64_t c = 0; c < n; ++c)
+        REQUIRE(memcmp(&a[c], &b[c], sizeof(double)) == 0, "%s: cell %lld: %.17g against %.17g", what, (long long)c,
+                b[c], a[c]);
+    for (int q = 0; q < 3; ++q)
+        REQUIRE(fabs(la[q] - lb[q]) <= 1e-13 * fmax(1.0, fabs(la[q])), "%s: ledger figure %d: %.17g against %.17g",
+                what, q, lb[q], la[q]);
+}
+
+static void test_sums_ordered_by_host_numbers(void **state) {
+    (void)state;
+    const scene_kind kinds[3] = {SCENE_TRIANGLES, SCENE_DUAL, SCENE_HEXAGONS};
+    for (int k = 0; k < 3; ++k) {
+        mesh_scene s = scene_make(kinds[k], 40, 2.5, 9u);
+        double *a = calloc((size_t)s.cells, sizeof(double)), *b = calloc((size_t)s.cells, sizeof(double));
+        double la[3], lb[3];
+        run_active_scene(&s, a, la);
+        setenv("DPSM_MESH_HOST_ORDER", "1", 1);
+        run_active_scene(&s, b, lb);
+        unsetenv("DPSM_MESH_HOST_ORDER");
+        char what[96];
+        snprintf(what, sizeof what, "%s, cells in the host's order", scene_name(kinds[k]));
+        compare_runs(what, a, b, s.cells, la, lb);
+        free(a), free(b);
+        scene_free(&s);
+    }
+    const int n = 40;
+    mesh_scene s = scene_make(SCENE_QUADS, n, 2.5, 1u);
+    quad_graph q = quad_graph_make(n, 2.5);
+    int64_t *faces = calloc((size_t)(2 * q.nfaces), sizeof(int64_t));
+    double *mid = calloc((size_t)(2 * q.nfaces), sizeof(double)), *length = calloc((size_t)q.nfaces, sizeof(double));
+    for (int64_t f = 0; f < q.nfaces; ++f) {
+        const int64_t from = q.nfaces - 1 - f, a = q.face_cells[2 * from], b = q.face_cells[2 * from + 1];
+        faces[2 * f] = b >= 0 ? b : a, faces[2 * f + 1] = b >= 0 ? a : -1;
+        mid[2 * f] = q.face_xy[2 * from], mid[2 * f + 1] = q.face_xy[2 * from + 1], length[f] = q.length[from];
+    }
+    double *a = calloc((size_t)s.cells, sizeof(double)), *b = calloc((size_t)s.cells, sizeof(double));
+    double la[3], lb[3];
+    dpsm_grid *g = NULL;
+    CHECK_OK(NULL, dpsm_create_graph(q.ncells, q.cell_xy, q.area, q.nfaces, q.face_cells, q.face_xy, q.length, &g));
+    run_active_scene_on(g, &s, a, la);
+    CHECK_OK(NULL, dpsm_create_graph(q.ncells, q.cell_xy, q.area, q.nfaces, faces, mid, length, &g));
+    run_active_scene_on(g, &s, b, lb);
+    compare_runs("a graph's faces listed backwards and turned", a, b, s.cells, la, lb);
+    free(a), free(b), free(faces), free(mid), free(length);
+    quad_graph_free(&q);
+    scene_free(&s);
 }
 
 static void test_fluxes_match_height_changes(void **state) {
@@ -1011,6 +1074,7 @@ int main(void) {
         cmocka_unit_test(test_host_order),
         cmocka_unit_test(test_graph_steps_as_polygons),
         cmocka_unit_test(test_active_set_same_bits),
+        cmocka_unit_test(test_sums_ordered_by_host_numbers),
         cmocka_unit_test(test_fluxes_match_height_changes),
         cmocka_unit_test(test_restart_on_meshes),
     };

@@ -108,6 +108,34 @@ std::vector<std::int64_t> hilbert_order(const std::vector<Vec> &centre) {
     return order;
 }
 
+// Each cell's faces in the order its sums take them (net flux, summed
+// conductance): the cells across them by the host's numbers, then the domain
+// edge's faces by their midpoints. Neither the library's order of cells nor
+// the order or direction in which the host lists faces changes a sum, as a
+// distributed mesh needs: its ranks order their parts each their own way.
+void order_each_cells_faces(Mesh &m, const std::vector<RawFace> &faces) {
+    struct Entry {
+        std::int64_t face, other;
+        double into;
+    };
+    std::vector<Entry> entries;
+    for (std::int64_t c = 0; c < m.cells; ++c) {
+        const std::int64_t k0 = m.cell_face_start[c], k1 = m.cell_face_start[c + 1];
+        entries.clear();
+        for (std::int64_t k = k0; k < k1; ++k) entries.push_back({m.cell_faces[k], m.other[k], m.into[k]});
+        std::sort(entries.begin(), entries.end(), [&](const Entry &l, const Entry &r) {
+            if ((l.other < 0) != (r.other < 0)) return r.other < 0;
+            if (l.other >= 0) return m.host_cell[l.other] < m.host_cell[r.other];
+            const Vec &ml = faces[m.host_face[l.face]].mid, &mr = faces[m.host_face[r.face]].mid;
+            return ml.x < mr.x || (ml.x == mr.x && ml.y < mr.y);
+        });
+        for (std::int64_t k = k0; k < k1; ++k) {
+            const Entry &e = entries[static_cast<std::size_t>(k - k0)];
+            m.cell_faces[k] = e.face, m.other[k] = e.other, m.into[k] = e.into;
+        }
+    }
+}
+
 // The least-squares gradient weights of every cell, weighted by inverse
 // distance squared, over one ring of neighbours across faces or, where cells
 // have fewer than 4 of them on average, two; a cell whose neighbours do not
@@ -134,7 +162,8 @@ void gradient_weights(Mesh &m) {
                     if (n >= 0 && seen[n] != c) seen[n] = c, ring.push_back(n);
                 }
         }
-        std::sort(ring.begin(), ring.end());
+        std::sort(ring.begin(), ring.end(),
+                  [&](std::int64_t l, std::int64_t r) { return m.host_cell[l] < m.host_cell[r]; });
         m.grad_cells.insert(m.grad_cells.end(), ring.begin(), ring.end());
         m.grad_start[c + 1] = static_cast<std::int64_t>(m.grad_cells.size());
     }
@@ -171,7 +200,14 @@ std::shared_ptr<const Mesh> assemble(MeshInput &&input, const RawCells &cells, c
     m.input = std::move(input);
     m.cells = static_cast<std::int64_t>(cells.area.size());
     m.faces = static_cast<std::int64_t>(faces.size());
-    m.host_cell = hilbert_order(cells.centre);
+    // DPSM_MESH_HOST_ORDER=1 keeps the host's order (for tests: no result may depend on it).
+    const char *host_order = std::getenv("DPSM_MESH_HOST_ORDER");
+    if (host_order && *host_order && *host_order != '0') {
+        m.host_cell.resize(cells.area.size());
+        for (std::size_t c = 0; c < cells.area.size(); ++c) m.host_cell[c] = static_cast<std::int64_t>(c);
+    } else {
+        m.host_cell = hilbert_order(cells.centre);
+    }
     m.cell_of_host.assign(m.cells, 0);
     for (std::int64_t c = 0; c < m.cells; ++c) m.cell_of_host[m.host_cell[c]] = c;
     m.area.resize(m.cells), m.x.resize(m.cells), m.y.resize(m.cells);
@@ -239,7 +275,7 @@ std::shared_ptr<const Mesh> assemble(MeshInput &&input, const RawCells &cells, c
         smallest = f == 0 ? d : std::min(smallest, d);
     }
     m.min_distance = smallest;
-    // Each cell's faces, in increasing face order.
+    // Each cell's faces (order_each_cells_faces sorts them).
     m.cell_face_start.assign(m.cells + 1, 0);
     for (std::size_t f = 0; f < nf; ++f) {
         ++m.cell_face_start[m.face_a[f] + 1];
@@ -261,6 +297,7 @@ std::shared_ptr<const Mesh> assemble(MeshInput &&input, const RawCells &cells, c
             m.other[fill[b]++] = a;
         }
     }
+    order_each_cells_faces(m, faces);
     gradient_weights(m);
     for (std::int64_t c = 0; c < m.cells; ++c) {
         double sum = 0.0;

@@ -41,9 +41,11 @@ struct Mesh {
 
     // Per cell, in the library's order.
     std::vector<double> area, x, y;
-    // Cell c's faces are cell_faces[cell_face_start[c] .. cell_face_start[c + 1]),
-    // in increasing face order; a face's other cell is `other` at the same
-    // place (-1 on the domain edge).
+    // Cell c's faces are cell_faces[cell_face_start[c] .. cell_face_start[c + 1]):
+    // those between cells by the host's number of the cell across, then those
+    // on the domain edge by their midpoints, so that no sum over them depends
+    // on the library's order or the host's listing of faces; a face's other
+    // cell is `other` at the same place (-1 on the domain edge).
     std::vector<std::int64_t> cell_face_start, cell_faces, other;
     // At the same place: +1 where the face's flux (from its a to its b)
     // enters the cell, -1 where it leaves.
@@ -53,7 +55,8 @@ struct Mesh {
     // (h_n - h_c): over the cells across its faces, and on meshes whose
     // cells have fewer than 4 neighbours (triangles) also over theirs, so
     // that the fit is not set by 3 points alone; none where they do not span
-    // the plane. The cells a change of height reaches through gradients are
+    // the plane; in the order of the host's cell numbers, as the faces. The
+    // cells a change of height reaches through gradients are
     // the same list (the stencil is symmetric), which the active set wakes.
     std::vector<std::int64_t> grad_start, grad_cells;
     std::vector<double> grad_wx, grad_wy;
