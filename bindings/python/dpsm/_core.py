@@ -1,6 +1,8 @@
 """The Grid class, dpsm.Error and the module-level functions."""
 
 import ctypes
+import itertools
+import numbers
 import operator
 import os
 
@@ -121,8 +123,76 @@ def _check(status, function, handle=None, created=False):
         raise Error(status, message, function)
 
 
-def _c_int(value, name, function, status, range_=_INT_RANGE, ctype="int"):
-    """``value`` as a Python int that fits the C type (ctypes would wrap it)."""
+# What the checks below take without looking further: Python ints and floats
+# (not bool: type(True) is bool) and numpy's default scalars.
+_BOOL_TYPES = (bool,) if np is None else (bool, np.bool_)
+_FAST_INTS = frozenset([int] if np is None else [int, np.int64])
+_FAST_REALS = frozenset([int, float] if np is None else [int, float, np.int64, np.float64])
+
+
+def _what(value):
+    """``value`` for a message: its type and a short repr, e.g. ``a str ('1')``."""
+    if value is None:
+        return "None"
+    kind = type(value).__name__
+    text = repr(value)
+    if len(text) > 40:
+        text = text[:37] + "..."
+    return "%s %s (%s)" % ("an" if kind[:1] in "aeiou" else "a", kind, text)
+
+
+def _not_real(value):
+    """None if ``value`` is a real number C can take as a double, else what it is, for a message.
+    Refused: str and bytes (float() would parse them), bool (True is not a length or a time),
+    complex numbers (numpy's would lose their imaginary part with a warning), arrays, and objects
+    that are not numbers at all."""
+    if isinstance(value, (str, bytes, bytearray, memoryview)) or isinstance(value, _BOOL_TYPES):
+        return _what(value)
+    if isinstance(value, numbers.Complex) and not isinstance(value, numbers.Real):
+        return _what(value)
+    dtype = getattr(value, "dtype", None)
+    if dtype is not None and hasattr(value, "ndim"):  # numpy scalars and arrays
+        if value.ndim != 0:
+            return "an array of shape %s" % (value.shape,)
+        return None if dtype.kind in "iuf" else "a %s (%r)" % (dtype, value)
+    if not (hasattr(type(value), "__float__") or hasattr(type(value), "__index__")):
+        return _what(value)
+    return None
+
+
+def _c_double(value, name, function):
+    """``value``, a real number (see _not_real), as a Python float for a C double; TypeError otherwise."""
+    if type(value) is float:
+        return value
+    why = _not_real(value)
+    if why is not None:
+        raise TypeError("%s: %s must be a real number, not %s" % (function, name, why))
+    try:
+        return float(value)
+    except OverflowError:
+        raise Error(C.DPSM_ERR_INVALID_VALUE, "%s = %s does not fit in a C double" % (name, value), function) from None
+
+
+def _not_integer(value):
+    """None if ``value`` is an integer (an int, a numpy integer: anything with __index__ but a bool),
+    else what it is, for a message. A float is refused even when integral (1.0), as ctypes does."""
+    if isinstance(value, _BOOL_TYPES):
+        return _what(value)
+    try:
+        operator.index(value)
+    except TypeError:
+        return _what(value)
+    return None
+
+
+def _c_int(value, name, function, status, range_=_INT_RANGE, ctype="int", allow_bool=False):
+    """``value`` as a Python int that fits the C type (ctypes would wrap it). Not a float (even
+    1.0), a str or, unless ``allow_bool``, a bool: TypeError naming ``name``."""
+    if allow_bool and isinstance(value, _BOOL_TYPES):
+        value = int(bool(value))
+    why = _not_integer(value)
+    if why is not None:
+        raise TypeError("%s: %s must be an integer, not %s" % (function, name, why))
     value = operator.index(value)
     if not range_[0] <= value <= range_[1]:
         raise Error(status, "%s = %d does not fit in a C %s" % (name, value, ctype), function)
@@ -133,9 +203,79 @@ def _c_int64(value, name, function, status=C.DPSM_ERR_INVALID_SIZE):
     return _c_int(value, name, function, status, _INT64_RANGE, "int64_t")
 
 
+def _position(name, k, columns):
+    """The element ``k`` of a flat list of values for a message: ``h[k]``, or ``h[j][i]`` when the
+    values came as rows of ``columns``."""
+    if columns:
+        return "%s[%d][%d]" % (name, k // columns, k % columns)
+    return "%s[%d]" % (name, k)
+
+
+def _reals(items, name, function, columns=None):
+    """The list ``items`` checked to hold real numbers only (see _not_real), as ints and floats C
+    can take as doubles; TypeError naming the first other one."""
+    if set(map(type, items)) <= _FAST_REALS:
+        return items
+    values = []
+    for k, v in enumerate(items):
+        why = None if type(v) in _FAST_REALS else _not_real(v)
+        if why is not None:
+            raise TypeError("%s: %s must hold real numbers; %s is %s"
+                            % (function, name, _position(name, k, columns), why))
+        values.append(v if type(v) in _FAST_REALS else float(v))
+    return values
+
+
+def _integers(items, name, function, columns=None, want="integers"):
+    """The list ``items`` checked to hold integers only (see _not_integer), as Python ints;
+    TypeError naming the first other one (``want`` says what is expected)."""
+    if set(map(type, items)) <= _FAST_INTS:
+        return items
+    values = []
+    for k, v in enumerate(items):
+        why = _not_integer(v)
+        if why is not None:
+            raise TypeError("%s: %s must hold %s; %s is %s%s"
+                            % (function, name, want, _position(name, k, columns), why, _bool_hint(v, want)))
+        values.append(operator.index(v))
+    return values
+
+
+def _bool_hint(value, want):
+    """For kinds given as booleans: they name no kind."""
+    if isinstance(value, _BOOL_TYPES) and want != "integers":
+        return " (a boolean names no kind: map a mask to kinds, e.g. numpy.where(mask, dpsm.CELL_WALL, " \
+               "dpsm.CELL_SAND))"
+    return ""
+
+
+def _real_array(values, name, function):
+    """``values`` (numpy is here) as a numpy array of integers or floats: any other dtype (complex,
+    bool, strings, ...) is refused with TypeError; an object array is checked value by value."""
+    array = np.asarray(values)
+    kind = array.dtype.kind
+    if kind == "O":  # Python objects: Decimal, Fraction, or garbage
+        columns = array.shape[1] if array.ndim == 2 else None
+        checked = _reals(array.reshape(-1).tolist(), name, function, columns)
+        return np.array(checked, dtype=np.float64).reshape(array.shape)
+    if kind not in "iuf":
+        raise TypeError("%s: %s must hold real numbers, not an array of %s" % (function, name, _dtype_name(array)))
+    return array
+
+
+def _dtype_name(array):
+    return "bool" if array.dtype.kind == "b" else str(array.dtype)
+
+
+def _is_list(values):
+    """A Python list or tuple: checked value by value (numpy would turn a True among floats into 1.0);
+    numpy takes other array-likes whole, by their dtype."""
+    return isinstance(values, (list, tuple))
+
+
 def _flatten(values, shape, name, function):
-    """A flat list of the values of a nested or flat sequence holding
-    ``shape = (rows, columns)`` values (rows may be None for 1D)."""
+    """(a flat list of the values, ``columns`` if they came as rows else None) of a nested or
+    flat sequence holding ``shape = (rows, columns)`` values (rows may be None for 1D)."""
     rows, columns = shape
     count = columns * (rows or 1)
     items = list(values)
@@ -146,14 +286,20 @@ def _flatten(values, shape, name, function):
             if len(row) != columns:
                 raise _shape_error(function, name, "a row of %d values" % len(row), shape)
             flat.extend(row)
-        return flat
-    if len(items) == count and not any(_is_sequence(item) for item in items):
-        return items
+        return flat, columns
+    if len(items) == count and not _any_sequence(items):
+        return items, None
     return _raise_shape(function, name, "%d items" % len(items), shape)
 
 
 def _is_sequence(item):
-    return hasattr(item, "__len__") and hasattr(item, "__iter__") and not isinstance(item, (str, bytes))
+    return (hasattr(item, "__len__") and hasattr(item, "__iter__") and not isinstance(item, (str, bytes))
+            and getattr(item, "ndim", 1) != 0)  # a 0-d numpy array is a value
+
+
+def _any_sequence(items):
+    """Whether a list holds a sequence (a row where a value should be); quick when it holds numbers."""
+    return not set(map(type, items)) <= _FAST_REALS and any(_is_sequence(item) for item in items)
 
 
 def _shape_error(function, name, got, shape):
@@ -178,23 +324,27 @@ def _table_in(values, width, name, function, integer):
     """A flat copy of ``n`` rows of ``width`` values, given as an (n, width)
     array or nested sequence or a flat sequence of n*width values (width 1: a
     flat sequence): (the flat values, a pointer to C's copy of them, n, the
-    object that keeps that copy alive). Integers
-    are int64 (a float is refused with TypeError, as ctypes would), other
-    values float64."""
+    object that keeps that copy alive). Integers are int64 (a float, even
+    1.0, or a bool is refused with TypeError), other values float64 (a
+    complex number, a bool or a str is refused with TypeError)."""
     ctype = ctypes.c_int64 if integer else ctypes.c_double
-    if np is not None:
+    if np is not None and not _is_list(values):
         array = np.asarray(values)
         if integer:
             if array.size == 0:
                 array = array.astype(np.int64)
             elif array.dtype.kind == "O":  # Python ints beyond int64, or mixed objects
+                columns = array.shape[1] if array.ndim == 2 else None
+                checked = _integers(array.reshape(-1).tolist(), name, function, columns)
                 values = [_c_int(v, name, function, C.DPSM_ERR_INVALID_VALUE, _INT64_RANGE, "int64_t")
-                          for v in array.reshape(-1)]
+                          for v in checked]
                 array = np.array(values, dtype=np.int64).reshape(array.shape)
             elif array.dtype.kind not in "iu":
-                raise TypeError("%s: %s must hold integers, not %s" % (function, name, array.dtype))
+                raise TypeError("%s: %s must hold integers, not an array of %s" % (function, name, _dtype_name(array)))
             elif array.dtype.kind == "u" and array.max() > _INT64_RANGE[1]:
                 raise Error(C.DPSM_ERR_INVALID_VALUE, "%s holds values that do not fit in a C int64_t" % name, function)
+        else:
+            array = _real_array(array, name, function)
         if width == 1:
             ok = array.ndim == 1
         else:
@@ -204,18 +354,27 @@ def _table_in(values, width, name, function, integer):
         flat = np.ascontiguousarray(array, dtype=np.int64 if integer else np.float64).reshape(-1)
         return flat, flat.ctypes.data_as(ctypes.POINTER(ctype)), flat.size // width, flat
     items = list(values)
-    if width > 1 and items and all(_is_sequence(item) for item in items):
-        rows = [list(row) for row in items]
-        for row in rows:
-            if len(row) != width or any(_is_sequence(v) for v in row):
-                raise _rows_error(function, name, "a row of %d values" % len(row), width)
-        items = [v for row in rows for v in row]
-    elif any(_is_sequence(item) for item in items) or len(items) % width:
+    columns = None
+    if width > 1 and items and (set(map(type, items)) <= {list, tuple} or all(_is_sequence(item) for item in items)):
+        if set(map(len, items)) != {width}:
+            row = next(row for row in items if len(row) != width)
+            raise _rows_error(function, name, "a row of %d values" % len(row), width)
+        items = list(itertools.chain.from_iterable(items))
+        columns = width
+        if _any_sequence(items):
+            raise _rows_error(function, name, "a row holding a sequence", width)
+    elif _any_sequence(items) or len(items) % width:
         raise _rows_error(function, name, "%d items" % len(items), width)
     if integer:
-        flat = [_c_int(v, name, function, C.DPSM_ERR_INVALID_VALUE, _INT64_RANGE, "int64_t") for v in items]
+        flat = _integers(items, name, function, columns)
+        if flat and not (_INT64_RANGE[0] <= min(flat) and max(flat) <= _INT64_RANGE[1]):
+            for v in flat:
+                _c_int(v, name, function, C.DPSM_ERR_INVALID_VALUE, _INT64_RANGE, "int64_t")
     else:
-        flat = [float(v) for v in items]
+        flat = _reals(items, name, function, columns)
+    if np is not None:  # faster than ctypes for long lists
+        array = np.array(flat, dtype=np.int64 if integer else np.float64).reshape(-1)
+        return flat, array.ctypes.data_as(ctypes.POINTER(ctype)), len(flat) // width, array
     buffer = (ctype * max(len(flat), 1))(*flat)
     return flat, ctypes.cast(buffer, ctypes.POINTER(ctype)), len(flat) // width, buffer
 
@@ -256,6 +415,13 @@ class Grid:
     accepted) and ``(nx,)`` on 1D and axisymmetric grids; on a mesh
     (``kind == "mesh"``) ``(ncells,)``, one value per cell in the host's cell
     order (``nx`` is the number of cells, ``ny`` is 1).
+
+    Nothing is converted silently: numbers are ints, floats or numpy
+    scalars (not str, bytes, bool or complex), arrays of reals hold only
+    such numbers (a numpy array of an integer or float dtype, or lists
+    checked value by value), sizes, indices, enumerations and kinds are
+    integers (not floats, even 1.0, nor bools). Anything else raises
+    ``TypeError`` naming the function and the argument, before C is called.
     """
 
     def __init__(self, _handle=None, _kind=None):
@@ -280,19 +446,20 @@ class Grid:
     def create_1d(cls, nx, dx):
         """``dpsm_create_1d``: ``nx`` cells of width ``dx``."""
         f = "dpsm_create_1d"
-        return cls._create(f, "1d", _c_int64(nx, "nx", f), float(dx))
+        return cls._create(f, "1d", _c_int64(nx, "nx", f), _c_double(dx, "dx", f))
 
     @classmethod
     def create_2d(cls, nx, ny, dx, dy):
         """``dpsm_create_2d``: ``nx`` by ``ny`` cells of size ``dx`` by ``dy``."""
         f = "dpsm_create_2d"
-        return cls._create(f, "2d", _c_int64(nx, "nx", f), _c_int64(ny, "ny", f), float(dx), float(dy))
+        return cls._create(f, "2d", _c_int64(nx, "nx", f), _c_int64(ny, "ny", f), _c_double(dx, "dx", f),
+                           _c_double(dy, "dy", f))
 
     @classmethod
     def create_axisymmetric(cls, nr, dr):
         """``dpsm_create_axisymmetric``: ``nr`` rings of width ``dr``."""
         f = "dpsm_create_axisymmetric"
-        return cls._create(f, "axisymmetric", _c_int64(nr, "nr", f), float(dr))
+        return cls._create(f, "axisymmetric", _c_int64(nr, "nr", f), _c_double(dr, "dr", f))
 
     # ---- meshes ----------------------------------------------------------------
     # Indices are 0-based, as in C, unless ``start_index=1`` says they count
@@ -309,10 +476,11 @@ class Grid:
         """The C constructor and the start index to pass it: the plain one
         from 0, the ``_indexed`` one otherwise (which refuses a start index
         other than 0 and 1 with its message)."""
+        name = function if function.endswith("_indexed") else function + "_indexed"
+        start_index = _c_int(start_index, "start_index", name, C.DPSM_ERR_INVALID_VALUE)
         if start_index == 0 and not function.endswith("_indexed"):
             return function, ()
-        name = function if function.endswith("_indexed") else function + "_indexed"
-        return name, (_c_int(start_index, "start_index", name, C.DPSM_ERR_INVALID_VALUE),)
+        return name, (start_index,)
 
     @classmethod
     def create_mesh(cls, node_xy, cell_start, cell_nodes, start_index=0):
@@ -436,12 +604,21 @@ class Grid:
             blocks.append((kind, _MESHIO_CELLS.get(kind), data))
         if not blocks:
             raise Error(C.DPSM_ERR_INVALID_SIZE, "the mesh has no 2D cells (triangle, quad or polygon)", f)
-        if np is not None:
-            points = np.asarray(mesh.points, dtype=np.float64)
+        if np is not None and not _is_list(mesh.points):
+            points = np.asarray(_real_array(mesh.points, "points", f), dtype=np.float64)
             if points.ndim != 2 or points.shape[1] not in (2, 3):
                 raise Error(C.DPSM_ERR_INVALID_SIZE, "points has shape %s; expected (n, 2) or (n, 3)"
                             % (points.shape,), f)
             node_xy = points[:, :2]
+        else:
+            node_xy = []
+            for k, point in enumerate(mesh.points):
+                point = list(point)
+                if len(point) not in (2, 3):
+                    raise Error(C.DPSM_ERR_INVALID_SIZE, "a point has %d coordinates; expected 2 or 3" % len(point),
+                                f)
+                node_xy.extend(_reals(point[:2], "points[%d]" % k, f))
+        if np is not None:
             counts, nodes = [], []
             for kind, corners, data in blocks:
                 try:
@@ -461,12 +638,6 @@ class Grid:
             cell_start = np.concatenate([[0], np.cumsum(counts)])
             cell_nodes = np.concatenate(nodes) if nodes else np.zeros(0, dtype=np.int64)
             return cls.create_mesh(node_xy, cell_start, cell_nodes)
-        node_xy = []
-        for point in mesh.points:
-            point = list(point)
-            if len(point) not in (2, 3):
-                raise Error(C.DPSM_ERR_INVALID_SIZE, "a point has %d coordinates; expected 2 or 3" % len(point), f)
-            node_xy.extend(point[:2])
         cell_start, cell_nodes = [0], []
         for kind, corners, data in blocks:
             for row in data:
@@ -550,11 +721,13 @@ class Grid:
 
     def set_repose_angle(self, theta_radians):
         """``dpsm_set_repose_angle``: the angle of repose, strictly between 0 and pi/2."""
-        self._call("dpsm_set_repose_angle", float(theta_radians))
+        f = "dpsm_set_repose_angle"
+        self._call(f, _c_double(theta_radians, "theta_radians", f))
 
     def set_mobility(self, nu):
         """``dpsm_set_mobility``: the mobility ``nu``, finite and positive."""
-        self._call("dpsm_set_mobility", float(nu))
+        f = "dpsm_set_mobility"
+        self._call(f, _c_double(nu, "nu", f))
 
     def set_scheme(self, scheme):
         """``dpsm_set_scheme``: ``SCHEME_ISOTROPIC`` (the default) or ``SCHEME_PAIRWISE``."""
@@ -601,7 +774,8 @@ class Grid:
 
     def set_rest_tolerance(self, tol):
         """``dpsm_set_rest_tolerance``: finite and positive."""
-        self._call("dpsm_set_rest_tolerance", float(tol))
+        f = "dpsm_set_rest_tolerance"
+        self._call(f, _c_double(tol, "tol", f))
 
     def set_max_substeps(self, n):
         """``dpsm_set_max_substeps``: at least 1."""
@@ -622,11 +796,13 @@ class Grid:
 
     def set_flux_exponent(self, p):
         """``dpsm_set_flux_exponent``: within [1, ``MAX_FLUX_EXPONENT``]; 1 is the paper's law."""
-        self._call("dpsm_set_flux_exponent", float(p))
+        f = "dpsm_set_flux_exponent"
+        self._call(f, _c_double(p, "p", f))
 
     def set_static_angle(self, radians):
         """``dpsm_set_static_angle``: sand at rest starts to move only beyond it."""
-        self._call("dpsm_set_static_angle", float(radians))
+        f = "dpsm_set_static_angle"
+        self._call(f, _c_double(radians, "radians", f))
 
     # ---- arrays --------------------------------------------------------------
 
@@ -639,13 +815,17 @@ class Grid:
         count = 1
         for n in shape:
             count *= n
-        if np is not None:
-            array = np.ascontiguousarray(values, dtype=np.float64)
+        if np is not None and not _is_list(values):
+            array = np.ascontiguousarray(_real_array(values, name, function), dtype=np.float64)
             if array.shape != tuple(shape) and array.shape != (count,):
                 raise _shape_error(function, name, "shape %s" % (array.shape,), _rows_columns(shape))
             return array.ctypes.data_as(_P_DOUBLE), array
-        flat = _flatten(values, _rows_columns(shape), name, function)
-        buffer = (ctypes.c_double * count)(*[float(v) for v in flat])
+        flat, columns = _flatten(values, _rows_columns(shape), name, function)
+        flat = _reals(flat, name, function, columns)
+        if np is not None:  # faster than ctypes for long lists
+            array = np.array(flat, dtype=np.float64)
+            return array.ctypes.data_as(_P_DOUBLE), array
+        buffer = (ctypes.c_double * count)(*flat)
         return buffer, buffer
 
     def _doubles_out(self, shape, out, name, function):
@@ -677,32 +857,51 @@ class Grid:
 
     def set_cell_kinds(self, kinds=None):
         """``dpsm_set_cell_kinds``: one of ``CELL_SAND``, ``CELL_WALL``,
-        ``CELL_OPEN`` per cell; ``None`` makes every cell sand."""
+        ``CELL_OPEN`` per cell; ``None`` makes every cell sand. Kinds are
+        integers (Python ints, numpy integer arrays): floats (even 1.0),
+        booleans (a mask names no kind: ``numpy.where(mask, dpsm.CELL_WALL,
+        dpsm.CELL_SAND)``) and strings are refused with ``TypeError``, other
+        values with ``dpsm.Error`` (``ERR_UNKNOWN_ENUM``)."""
         f = "dpsm_set_cell_kinds"
         if kinds is None:
             self._call(f, None)
             return
-        pointer, keep = self._kinds_in(kinds, self.shape, f)
+        pointer, keep = self._kinds_in(kinds, self.shape, f, "CELL_SAND, CELL_WALL or CELL_OPEN")
         self._call(f, pointer)
         del keep
 
     @staticmethod
-    def _kinds_in(kinds, shape, f):
-        """(pointer, keep-alive) for C from kinds of ``shape`` as uint8."""
+    def _kinds_in(kinds, shape, f, names):
+        """(pointer, keep-alive) for C from kinds of ``shape`` as uint8: integers only (``names``
+        says which, for messages), within 0..255 (C checks which are kinds)."""
         count = 1
         for n in shape:
             count *= n
-        if np is not None:
+        want = "integers (%s)" % names
+        if np is not None and not _is_list(kinds):
             array = np.asarray(kinds)
+            if array.dtype.kind == "O":  # Python objects: ints beyond int64, or garbage
+                columns = array.shape[1] if array.ndim == 2 else None
+                checked = _integers(array.reshape(-1).tolist(), "kinds", f, columns, want)
+                if checked and (min(checked) < 0 or max(checked) > 255):
+                    raise Error(C.DPSM_ERR_UNKNOWN_ENUM, "kinds holds values outside 0..255", f)
+                array = np.array(checked, dtype=np.uint8).reshape(array.shape)
+            elif array.dtype.kind not in "iu":
+                hint = _bool_hint(True, want) if array.dtype.kind == "b" else ""
+                raise TypeError("%s: kinds must hold %s, not an array of %s%s" % (f, want, _dtype_name(array), hint))
             if array.shape != tuple(shape) and array.shape != (count,):
                 raise _shape_error(f, "kinds", "shape %s" % (array.shape,), _rows_columns(shape))
             if array.size and (array.min() < 0 or array.max() > 255):
                 raise Error(C.DPSM_ERR_UNKNOWN_ENUM, "kinds holds values outside 0..255", f)
             array = np.ascontiguousarray(array, dtype=np.uint8)
             return array.ctypes.data_as(_P_UINT8), array
-        flat = [operator.index(k) for k in _flatten(kinds, _rows_columns(shape), "kinds", f)]
-        if any(k < 0 or k > 255 for k in flat):
+        flat, columns = _flatten(kinds, _rows_columns(shape), "kinds", f)
+        flat = _integers(flat, "kinds", f, columns, want)
+        if flat and (min(flat) < 0 or max(flat) > 255):
             raise Error(C.DPSM_ERR_UNKNOWN_ENUM, "kinds holds values outside 0..255", f)
+        if np is not None:
+            array = np.array(flat, dtype=np.uint8)
+            return array.ctypes.data_as(_P_UINT8), array
         buffer = (ctypes.c_uint8 * max(count, 1))(*flat)
         return buffer, buffer
 
@@ -737,15 +936,16 @@ class Grid:
     mesh_faces = get_mesh_faces
 
     def set_edge_kinds(self, kinds=None):
-        """``dpsm_set_edge_kinds``: ``OPEN`` or ``WALL`` per face of a mesh (``nfaces`` values, those of
-        interior faces ignored); ``None`` makes every edge face a wall. An open face holds the outside at
+        """``dpsm_set_edge_kinds``: ``OPEN`` or ``WALL`` per face of a mesh (``nfaces`` integers, those of
+        interior faces ignored; floats and booleans are refused with ``TypeError``); ``None`` makes every
+        edge face a wall. An open face holds the outside at
         its level (``set_side_levels(MESH_EDGE, levels)``) and books what leaves as outflow of
         ``MESH_EDGE``; ``set_boundary(MESH_EDGE, kind)`` sets every edge face at once."""
         f = "dpsm_set_edge_kinds"
         if kinds is None or self.kind != "mesh":  # a grid: refused by the library, with its message
             self._call(f, None)
             return
-        pointer, keep = self._kinds_in(kinds, (self.get_face_count(),), f)
+        pointer, keep = self._kinds_in(kinds, (self.get_face_count(),), f, "OPEN or WALL")
         self._call(f, pointer)
         del keep
 
@@ -843,7 +1043,8 @@ class Grid:
 
     def step(self, dt):
         """``dpsm_step``: advances the surface by exactly ``dt``."""
-        self._call("dpsm_step", float(dt))
+        f = "dpsm_step"
+        self._call(f, _c_double(dt, "dt", f))
 
     def get_mass(self, quantity):
         """``dpsm_get_mass``: ``MASS_TOTAL``, ``MASS_SOURCED``, ``MASS_EXTERNAL``, ``MASS_OUTFLOW`` or ``MASS_UNMET``."""
@@ -872,7 +1073,7 @@ class Grid:
         """``dpsm_set_face_flux_recording``: 1 (or True) to keep the volume each face carries in every
         step, 0 (or False) to stop."""
         f = "dpsm_set_face_flux_recording"
-        self._call(f, _c_int(on, "on", f, C.DPSM_ERR_INVALID_VALUE))
+        self._call(f, _c_int(on, "on", f, C.DPSM_ERR_INVALID_VALUE, allow_bool=True))
 
     def get_face_fluxes(self, out_x=None, out_y=None):
         """``dpsm_get_face_fluxes``: ``(fx, fy)``, the volume each face carried in the last step,
