@@ -930,6 +930,39 @@ static void run_threads_scene(dpsm_grid *g, int64_t nx, int64_t ny, double *h) {
     free(q);
 }
 
+/* A step whose source would carry a height beyond the supported range
+ * (+-1e50) within dt is refused before it changes anything, naming the cell;
+ * one that stays inside runs. On a line, a disk and a 2D grid, deposition
+ * and erosion. */
+static void test_step_beyond_supported_range(void **state) {
+    (void)state;
+    for (int kind = 0; kind < 3; ++kind)
+        for (int sign = -1; sign <= 1; sign += 2) {
+            dpsm_grid *g = NULL;
+            if (kind == 0) CHECK_OK(NULL, dpsm_create_1d(6, 1.0, &g));
+            if (kind == 1) CHECK_OK(NULL, dpsm_create_axisymmetric(6, 1.0, &g));
+            if (kind == 2) CHECK_OK(NULL, dpsm_create_2d(3, 2, 1.0, 1.0, &g));
+            double h[6] = {1, 1, 1, 1, 1, 1}, q[6] = {0, 0, 0, 0, 0, 0}, after[6];
+            q[4] = sign * 1e49; /* cell 4: i = 1, j = 1 on the 2D grid */
+            CHECK_OK(g, dpsm_set_heights(g, h));
+            CHECK_OK(g, dpsm_set_source(g, q));
+            const double total = mass_of(g, DPSM_MASS_TOTAL), sourced = mass_of(g, DPSM_MASS_SOURCED);
+            const int status = dpsm_step(g, 1e3); /* would reach 1e52 */
+            const char *msg = dpsm_last_error(g);
+            REQUIRE(status == DPSM_ERR_INVALID_VALUE, "kind %d: a step to %g*1e52 returned %s", kind, (double)sign,
+                    dpsm_status_string(status));
+            REQUIRE(strstr(msg, "dpsm_step") && strstr(msg, "supported range") &&
+                        strstr(msg, kind == 2 ? "cell i = 1, j = 1" : "cell i = 4, j = 0"),
+                    "kind %d: message \"%s\"", kind, msg);
+            CHECK_OK(g, dpsm_get_heights(g, after));
+            REQUIRE(memcmp(h, after, sizeof h) == 0, "kind %d: the refused step changed the heights", kind);
+            REQUIRE(mass_of(g, DPSM_MASS_TOTAL) == total && mass_of(g, DPSM_MASS_SOURCED) == sourced,
+                    "kind %d: the refused step changed the ledger", kind);
+            CHECK_OK(g, dpsm_step(g, 1.0)); /* to 1e49: inside */
+            dpsm_destroy(g);
+        }
+}
+
 static void test_threads(void **state) {
     (void)state;
     enum { NX = 64, NY = 48, N = NX * NY };
@@ -1409,8 +1442,10 @@ static void test_work_limit(void **state) {
     CHECK_OK(g, dpsm_get_step_info(g, DPSM_INFO_SUBSTEPS, &v));
     REQUIRE(v == 3.0, "%g sub-steps, expected 3", v);
     EXPECT_FAIL_EX(NULL, g, dpsm_step(g, 3.5 * sdt), DPSM_ERR_WORK_LIMIT, "dpsm_step", "dt", NULL);
-    EXPECT_FAIL_EX(NULL, g, dpsm_step(g, 1e300), DPSM_ERR_WORK_LIMIT, "dpsm_step", "dt", NULL);
-    EXPECT_FAIL_EX(NULL, g, dpsm_step(g, DBL_MAX), DPSM_ERR_WORK_LIMIT, "dpsm_step", "dt", NULL);
+    EXPECT_FAIL_EX(NULL, g, dpsm_step(g, 1e40), DPSM_ERR_WORK_LIMIT, "dpsm_step", "dt", NULL);
+    /* Over 1e300 the source would carry the sand beyond the supported range: refused before the limit. */
+    EXPECT_FAIL_EX(NULL, g, dpsm_step(g, 1e300), DPSM_ERR_INVALID_VALUE, "dpsm_step", "dt", "supported range");
+    EXPECT_FAIL_EX(NULL, g, dpsm_step(g, DBL_MAX), DPSM_ERR_INVALID_VALUE, "dpsm_step", "dt", "supported range");
     CHECK_OK(g, dpsm_set_max_substeps(g, 4));
     CHECK_OK(g, dpsm_step(g, 3.5 * sdt));
     /* Open cells at different levels can feed sand forever: limited too. */
@@ -2384,7 +2419,9 @@ static void test_bad_step(void **state) {
     double sdt = 0.0;
     CHECK_OK(fx->g, dpsm_stable_dt(fx->g, &sdt));
     EXPECT_FAIL(fx, dpsm_step(fx->g, (PROBE_MAX_SUBSTEPS + 0.5) * sdt), DPSM_ERR_WORK_LIMIT, "dpsm_step", "dt");
-    EXPECT_FAIL(fx, dpsm_step(fx->g, 1e300), DPSM_ERR_WORK_LIMIT, "dpsm_step", "dt");
+    EXPECT_FAIL(fx, dpsm_step(fx->g, 1e40), DPSM_ERR_WORK_LIMIT, "dpsm_step", "dt");
+    /* Its source over 1e300 would carry the sand beyond the supported range: refused before the limit. */
+    EXPECT_FAIL_D(fx, dpsm_step(fx->g, 1e300), DPSM_ERR_INVALID_VALUE, "dpsm_step", "dt", "supported range");
 }
 
 static void test_bad_get_mass(void **state) {
@@ -2591,6 +2628,7 @@ int main(int argc, char **argv) {
         cmocka_unit_test(test_set_repose_angle_edges),
         cmocka_unit_test(test_scheme),
         cmocka_unit_test(test_threads),
+        cmocka_unit_test(test_step_beyond_supported_range),
         cmocka_unit_test(test_heights_round_trip),
         cmocka_unit_test(test_get_heights_writes_nx_ny_values),
         cmocka_unit_test(test_version),

@@ -758,6 +758,12 @@ DPSM_API int dpsm_stable_dt(const dpsm_grid *g, double *dt);
  * and changes nothing. Any other scene comes to rest by itself (its energy
  * falls while sand moves) and is not limited.
  *
+ * A source that would carry a sand cell's height beyond the supported range
+ * within `dt` (`h + q dt` outside [-1e50, 1e50]; erosion down to a bed
+ * excepted) fails the call at once with ::DPSM_ERR_INVALID_VALUE, naming the
+ * cell, and changes nothing (steps of ::DPSM_RELAX_TO_REST, which integrate
+ * no time, are not checked).
+ *
  * @param g   the grid.
  * @param dt  finite and positive.
  * @return ::DPSM_OK, ::DPSM_ERR_NULL_POINTER, ::DPSM_ERR_INVALID_VALUE,

@@ -1035,6 +1035,14 @@ static void op_step(reader_t *r) {
             return;
         }
         if (want == DPSM_OK || either) g_work += cost;
+        /* A source that would carry a sand cell beyond the supported range within dt: refused first. */
+        for (int64_t c = 0; s->source && c < s->n; ++c)
+            if (s->kinds[c] == DPSM_CELL_SAND && s->source[c] != 0.0 && !(s->bed && s->source[c] < 0.0) &&
+                !(fabs(before.h[c] + s->source[c] * dt) <= 1e50)) {
+                want = DPSM_ERR_INVALID_VALUE;
+                either = 0;
+                break;
+            }
     }
 
     double hi = -INFINITY, lo = INFINITY;

@@ -684,6 +684,18 @@ static void refusing_rank(void) {
             "DPSM_RELAX_TO_REST on rank 1 only: status %s, message \"%s\"", dpsm_status_string(status),
             dpsm_last_error(g));
     if (rank_ == 1) OK(g, dpsm_set_relaxation(g, DPSM_RELAX_TIME_ACCURATE));
+    /* A source on rank 1 that would carry a height beyond the supported range: refused on every rank. */
+    double *q = calloc(cells, sizeof(double));
+    if (rank_ == 1) q[0] = 1e49;
+    OK(g, dpsm_set_source(g, q));
+    status = dpsm_step(g, 1e3);
+    want = rank_ == 1 ? "supported range" : "another rank";
+    require(status == DPSM_ERR_INVALID_VALUE && strstr(dpsm_last_error(g), want) != NULL,
+            "a source beyond the range on rank 1 only: status %s, message \"%s\"", dpsm_status_string(status),
+            dpsm_last_error(g));
+    if (rank_ == 0) printf("  a rank's source beyond the range refused, on every rank: %s\n", dpsm_last_error(g));
+    OK(g, dpsm_set_source(g, NULL));
+    free(q);
     OK(g, dpsm_get_heights(g, after));
     require(memcmp(h, after, cells * sizeof(double)) == 0, "a refused step changed the heights");
     OK(g, dpsm_stable_dt(g, &sdt_after));

@@ -584,21 +584,26 @@ static void snap(dpsm_grid *g, int64_t ncells, snap_t *out) {
     REQUIRE(dpsm_stable_dt(g, &out->stable_dt) == DPSM_OK, "stable_dt");
 }
 
-void expect_work_limit_on(dpsm_grid *g, int64_t ncells, const char *name, double dt) {
+void expect_step_refused_on(dpsm_grid *g, int64_t ncells, const char *name, double dt, int status,
+                            const char *needle) {
     snap_t a, b;
     snap(g, ncells, &a);
     const int st = dpsm_step(g, dt);
     const char *msg = dpsm_last_error(g);
-    REQUIRE(st == DPSM_ERR_WORK_LIMIT, "[%s] dpsm_step(%g) returned %s, expected DPSM_ERR_WORK_LIMIT (%s)", name, dt,
-            dpsm_status_string(st), msg);
-    REQUIRE(strstr(msg, "dpsm_step") && strstr(msg, "dt") && strstr(msg, "dpsm_set_max_substeps"),
-            "[%s] the work-limit message does not say what to do: \"%s\"", name, msg);
+    REQUIRE(st == status, "[%s] dpsm_step(%g) returned %s, expected %s (%s)", name, dt, dpsm_status_string(st),
+            dpsm_status_string(status), msg);
+    REQUIRE(strstr(msg, "dpsm_step") && strstr(msg, "dt") && strstr(msg, needle),
+            "[%s] the message does not say what to do (%s): \"%s\"", name, needle, msg);
     snap(g, ncells, &b);
-    const char *what = "after DPSM_ERR_WORK_LIMIT";
-    REQUIRE(memcmp(a.h, b.h, sizeof(double) * (size_t)ncells) == 0, "[%s] %s: heights changed", name, what);
-    REQUIRE(memcmp(a.mass, b.mass, sizeof a.mass) == 0, "[%s] %s: the ledger changed", name, what);
-    REQUIRE(memcmp(a.info, b.info, sizeof a.info) == 0, "[%s] %s: the step information changed", name, what);
-    REQUIRE(memcmp(&a.stable_dt, &b.stable_dt, sizeof(double)) == 0, "[%s] %s: stable_dt changed", name, what);
+    const char *what = dpsm_status_string(status);
+    REQUIRE(memcmp(a.h, b.h, sizeof(double) * (size_t)ncells) == 0, "[%s] after %s: heights changed", name, what);
+    REQUIRE(memcmp(a.mass, b.mass, sizeof a.mass) == 0, "[%s] after %s: the ledger changed", name, what);
+    REQUIRE(memcmp(a.info, b.info, sizeof a.info) == 0, "[%s] after %s: the step information changed", name, what);
+    REQUIRE(memcmp(&a.stable_dt, &b.stable_dt, sizeof(double)) == 0, "[%s] after %s: stable_dt changed", name, what);
     free(a.h);
     free(b.h);
+}
+
+void expect_work_limit_on(dpsm_grid *g, int64_t ncells, const char *name, double dt) {
+    expect_step_refused_on(g, ncells, name, dt, DPSM_ERR_WORK_LIMIT, "dpsm_set_max_substeps");
 }

@@ -138,6 +138,9 @@ void scene_check(scene_t *s, stress_worst_t *w);
  * cells (heights, the ledger, the step information, the stable sub-step), bit
  * for bit; `name` names the scene in the failure. Any grid or mesh. */
 void expect_work_limit_on(dpsm_grid *g, int64_t ncells, const char *name, double dt);
+/* The same for any refusal: `status`, a message naming dpsm_step, dt and `needle`, nothing changed. */
+void expect_step_refused_on(dpsm_grid *g, int64_t ncells, const char *name, double dt, int status,
+                            const char *needle);
 
 /* The relative ledger residual of g: relative to the largest of the four
  * figures, the gross mass sum |h| * area over sand cells now, and the largest
