@@ -20,7 +20,9 @@ def _import_numpy():
     return numpy
 
 
+## numpy, or None when it cannot be imported or DPSM_NO_NUMPY rules it out.
 np = _import_numpy()
+## True when arrays are numpy arrays, False when they are plain lists.
 HAVE_NUMPY = np is not None
 
 _INT_RANGE = (-(2**31), 2**31 - 1)
@@ -79,9 +81,14 @@ class Error(Exception):
     """
 
     def __init__(self, status, message, function=None):
+        """The error of a call to ``function`` that returned ``status`` with ``message``."""
+        ## The status, one of the ``DPSM_ERR_*`` codes.
         self.status = status
+        ## The library's message.
         self.message = message
+        ## The C function that failed, or None.
         self.function = function
+        ## The name of the status (dpsm_status_string).
         self.status_name = status_string(status)
         where = function + ": " if function else ""
         super().__init__("%s%s: %s" % (where, self.status_name, message))
@@ -425,13 +432,16 @@ class Grid:
     """
 
     def __init__(self, _handle=None, _kind=None):
+        """Not for hosts: a Grid is made by one of the ``create_*`` class methods."""
         if not isinstance(_handle, GridPtr) or not _handle:
             raise TypeError("make a Grid with Grid.create_1d, Grid.create_2d, Grid.create_axisymmetric, "
                             "Grid.create_mesh, Grid.create_graph, Grid.create_dual_mesh or Grid.from_meshio")
         self._handle = _handle
+        ## What the grid is: "1d", "2d", "axisymmetric" or "mesh".
         self.kind = _kind
         nx, ny = ctypes.c_int64(), ctypes.c_int64()
         _check(lib.dpsm_get_shape(_handle, ctypes.byref(nx), ctypes.byref(ny)), "dpsm_get_shape", _handle)
+        ## The shape (dpsm_get_shape): nx and ny, the cells along x and y (ny is 1 on 1D, axisymmetric and mesh grids).
         self.nx, self.ny = nx.value, ny.value
 
     # ---- creating and releasing --------------------------------------------
@@ -575,11 +585,17 @@ class Grid:
         del keep_xy, keep_tris
         return grid
 
+    ## Short name of create_mesh.
     mesh = create_mesh
+    ## Short name of create_graph.
     graph = create_graph
+    ## Short name of create_dual_mesh.
     dual_mesh = create_dual_mesh
+    ## Short name of create_mesh_indexed.
     mesh_indexed = create_mesh_indexed
+    ## Short name of create_graph_indexed.
     graph_indexed = create_graph_indexed
+    ## Short name of create_dual_mesh_indexed.
     dual_mesh_indexed = create_dual_mesh_indexed
 
     @classmethod
@@ -680,20 +696,25 @@ class Grid:
         if handle:
             lib.dpsm_destroy(handle)
 
+    ## The C name of close.
     destroy = close
 
     @property
     def closed(self):
+        """True once the grid is closed."""
         return not self._handle
 
     def __enter__(self):
+        """``with`` gives the grid itself."""
         return self
 
     def __exit__(self, *exc):
+        """Leaving ``with`` closes the grid."""
         self.close()
         return False
 
     def __del__(self):
+        """A grid that is garbage collected is closed."""
         if getattr(self, "_handle", None):
             try:
                 self.close()
@@ -701,6 +722,7 @@ class Grid:
                 pass
 
     def __repr__(self):
+        """The kind, the shape and whether the grid is closed."""
         if self.closed:
             state = "closed"
         elif self.kind == "mesh":
@@ -932,7 +954,9 @@ class Grid:
         self._call(f, buffer)
         return [[buffer[2 * k], buffer[2 * k + 1]] for k in range(nfaces)]
 
+    ## Short name of get_face_count.
     face_count = get_face_count
+    ## Short name of get_mesh_faces.
     mesh_faces = get_mesh_faces
 
     def set_edge_kinds(self, kinds=None):

@@ -16,7 +16,7 @@ import ctypes.util
 import os
 import sys
 
-# The major version (the soname) of the C API these declarations describe.
+## The major version (the soname) of the C API these declarations describe.
 ABI_MAJOR = 0
 
 
@@ -24,6 +24,7 @@ class GridStruct(ctypes.Structure):
     """The opaque ``struct dpsm_grid``; only pointers to it are used."""
 
 
+## A pointer to a grid, C's ``dpsm_grid *``.
 GridPtr = ctypes.POINTER(GridStruct)
 
 _int = ctypes.c_int
@@ -31,7 +32,7 @@ _i64 = ctypes.c_int64
 _dbl = ctypes.c_double
 _P = ctypes.POINTER
 
-# Every function of dpsm.h: name -> (restype, argtypes), in the header's order.
+## Every function of dpsm.h: name -> (restype, argtypes), in the header's order.
 SIGNATURES = {
     "dpsm_create_1d": (_int, [_i64, _dbl, _P(GridPtr)]),
     "dpsm_create_2d": (_int, [_i64, _i64, _dbl, _dbl, _P(GridPtr)]),
@@ -147,5 +148,8 @@ def _declare(lib):
         )
 
 
+## The loaded C library (a ctypes.CDLL).
 lib, LIBRARY = _load()
+## @var LIBRARY
+#  The path the C library was loaded from.
 _declare(lib)
