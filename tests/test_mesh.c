@@ -846,27 +846,40 @@ static void run_active_scene(const mesh_scene *s, double *h_out, double *ledger_
     run_active_scene_on(g, s, h_out, ledger_out);
 }
 
-static void test_active_set_same_bits(void **state) {
-    (void)state;
+/* The active scene on each mesh kind with and without an environment switch
+ * (the two runs in a and b, their ledgers in la and lb); calls check(...) per
+ * kind. */
+typedef void (*switch_check)(const char *what, const double *a, const double *b, int64_t n, const double *la,
+                             const double *lb);
+static void run_with_and_without(const char *variable, int n, unsigned seed, const char *what, switch_check check) {
     const scene_kind kinds[3] = {SCENE_TRIANGLES, SCENE_DUAL, SCENE_HEXAGONS};
     for (int k = 0; k < 3; ++k) {
-        mesh_scene s = scene_make(kinds[k], 60, 2.5, 5u);
+        mesh_scene s = scene_make(kinds[k], n, 2.5, seed);
         double *a = calloc((size_t)s.cells, sizeof(double)), *b = calloc((size_t)s.cells, sizeof(double));
         double la[3], lb[3];
         run_active_scene(&s, a, la);
-        setenv("DPSM_VISIT_ALL_CELLS", "1", 1);
+        setenv(variable, "1", 1);
         run_active_scene(&s, b, lb);
-        unsetenv("DPSM_VISIT_ALL_CELLS");
-        int64_t moved = 0;
-        for (int64_t c = 0; c < s.cells; ++c) {
-            REQUIRE(memcmp(&a[c], &b[c], sizeof(double)) == 0, "%s cell %lld: %.17g with the active set, %.17g without",
-                    scene_name(kinds[k]), (long long)c, a[c], b[c]);
-        }
-        (void)moved;
-        REQUIRE(memcmp(la, lb, sizeof la) == 0, "%s: the ledger differs with the active set", scene_name(kinds[k]));
+        unsetenv(variable);
+        char name[96];
+        snprintf(name, sizeof name, "%s, %s", scene_name(kinds[k]), what);
+        check(name, a, b, s.cells, la, lb);
         free(a), free(b);
         scene_free(&s);
     }
+}
+
+static void same_bits_and_ledger(const char *what, const double *a, const double *b, int64_t n, const double *la,
+                                 const double *lb) {
+    for (int64_t c = 0; c < n; ++c)
+        REQUIRE(memcmp(&a[c], &b[c], sizeof(double)) == 0, "%s: cell %lld: %.17g against %.17g", what, (long long)c,
+                b[c], a[c]);
+    REQUIRE(memcmp(la, lb, 3 * sizeof(double)) == 0, "%s: the ledger differs", what);
+}
+
+static void test_active_set_same_bits(void **state) {
+    (void)state;
+    run_with_and_without("DPSM_VISIT_ALL_CELLS", 60, 5u, "every cell visited", same_bits_and_ledger);
 }
 
 /* What a cell's sums read is ordered by the host's cell numbers (and on the
@@ -890,21 +903,7 @@ static void compare_runs(const char *what, const double *a, const double *b, int
 
 static void test_sums_ordered_by_host_numbers(void **state) {
     (void)state;
-    const scene_kind kinds[3] = {SCENE_TRIANGLES, SCENE_DUAL, SCENE_HEXAGONS};
-    for (int k = 0; k < 3; ++k) {
-        mesh_scene s = scene_make(kinds[k], 40, 2.5, 9u);
-        double *a = calloc((size_t)s.cells, sizeof(double)), *b = calloc((size_t)s.cells, sizeof(double));
-        double la[3], lb[3];
-        run_active_scene(&s, a, la);
-        setenv("DPSM_MESH_HOST_ORDER", "1", 1);
-        run_active_scene(&s, b, lb);
-        unsetenv("DPSM_MESH_HOST_ORDER");
-        char what[96];
-        snprintf(what, sizeof what, "%s, cells in the host's order", scene_name(kinds[k]));
-        compare_runs(what, a, b, s.cells, la, lb);
-        free(a), free(b);
-        scene_free(&s);
-    }
+    run_with_and_without("DPSM_MESH_HOST_ORDER", 40, 9u, "cells in the host's order", compare_runs);
     const int n = 40;
     mesh_scene s = scene_make(SCENE_QUADS, n, 2.5, 1u);
     quad_graph q = quad_graph_make(n, 2.5);

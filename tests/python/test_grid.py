@@ -14,22 +14,7 @@ import zlib
 
 import dpsm
 
-try:
-    import numpy as np
-except ImportError:
-    np = None
-
-
-def as_list(values):
-    """numpy arrays and lists alike as (nested) lists."""
-    return values.tolist() if hasattr(values, "tolist") else values
-
-
-def flat(values):
-    values = as_list(values)
-    if values and isinstance(values[0], list):
-        return [v for row in values for v in row]
-    return list(values)
+from support import as_list, flat, np
 
 
 class LedgerMixin:

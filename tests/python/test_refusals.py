@@ -19,21 +19,7 @@ import warnings
 
 import dpsm
 
-try:
-    import numpy as np
-except ImportError:
-    np = None
-
-
-def as_list(values):
-    return values.tolist() if hasattr(values, "tolist") else values
-
-
-def flat(values):
-    values = as_list(values)
-    if values and isinstance(values[0], list):
-        return [v for row in values for v in row]
-    return list(values)
+from support import as_list, flat, np
 
 
 def changed(rows, j, i, value):
