@@ -86,8 +86,9 @@ class Test2D(LedgerMixin, unittest.TestCase):
         self.g.close()
 
     def test_shape(self):
-        self.assertEqual(self.g.get_shape(), (self.nx, self.ny))
+        self.assertEqual(self.g.get_shape(), (self.ny, self.nx))  # numpy's order, as shape (not C's)
         self.assertEqual(self.g.shape, (self.ny, self.nx))
+        self.assertEqual((self.g.nx, self.g.ny), (self.nx, self.ny))
         self.assertEqual(self.g.kind, "2d")
         self.assertIn("nx=24", repr(self.g))
 
@@ -361,7 +362,7 @@ class TestOtherGrids(LedgerMixin, unittest.TestCase):
     def test_1d(self):
         nx, dx = 30, 0.2
         with dpsm.Grid.create_1d(nx, dx) as g:
-            self.assertEqual(g.get_shape(), (nx, 1))
+            self.assertEqual(g.get_shape(), (nx,))
             self.assertEqual(g.shape, (nx,))
             self.assertEqual(g.kind, "1d")
             self.assertAlmostEqual(g.stable_dt(), dx**2 / (2 * dpsm.DEFAULT_MOBILITY * math.cos(dpsm.DEFAULT_REPOSE_ANGLE)),
@@ -412,8 +413,79 @@ class TestOtherGrids(LedgerMixin, unittest.TestCase):
         # Grids are independent, and released when dropped.
         grids = [dpsm.Grid.create_1d(8 + k, 0.1) for k in range(50)]
         for k, g in enumerate(grids):
-            self.assertEqual(g.get_shape(), (8 + k, 1))
+            self.assertEqual(g.get_shape(), (8 + k,))
         del grids
+
+
+class TestShapesAndIndices(LedgerMixin, unittest.TestCase):
+    """One convention (docs/guide_bindings.md, "Shapes and indices"): every shape the package reports
+    is numpy's, get_shape() == shape; nx and ny are C's sizes; offsets and sizes passed as separate
+    arguments are C's, x before y, and a block's values have the shape (nj, ni)."""
+
+    def assertShapes(self, g, shape, nx, ny):
+        self.assertEqual(g.shape, shape)
+        self.assertEqual(g.get_shape(), g.shape)
+        self.assertIsInstance(g.get_shape(), tuple)
+        self.assertEqual((g.nx, g.ny), (nx, ny))
+        for name in ("nx", "ny"):
+            with self.assertRaises(AttributeError):  # read-only
+                setattr(g, name, 3)
+        self.assertEqual((g.nx, g.ny), (nx, ny))
+        h = g.get_heights()
+        if np is not None:
+            self.assertEqual(h.shape, g.get_shape())
+        else:
+            self.assertEqual(len(h), shape[0])
+            if len(shape) == 2:
+                self.assertEqual({len(row) for row in h}, {shape[1]})
+            else:
+                self.assertIsInstance(h[0], float)
+
+    def test_every_kind_of_grid(self):
+        with dpsm.Grid.create_2d(7, 5, 0.1, 0.2) as g:
+            self.assertShapes(g, (5, 7), 7, 5)
+            self.assertEqual(g.get_shape(), (g.ny, g.nx))
+        with dpsm.Grid.create_1d(9, 0.1) as g:
+            self.assertShapes(g, (9,), 9, 1)
+        with dpsm.Grid.create_axisymmetric(6, 0.1) as g:
+            self.assertShapes(g, (6,), 6, 1)
+        square = [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)]
+        with dpsm.Grid.create_dual_mesh(square, [(0, 1, 2), (0, 2, 3)]) as g:
+            self.assertShapes(g, (4,), 4, 1)
+        g = dpsm.Grid.create_2d(7, 5, 0.1, 0.2)
+        g.close()
+        self.assertFails(dpsm.ERR_NULL_POINTER, g.get_shape)
+
+    def test_region_lands_where_c_says(self):
+        nx, ny = 7, 5
+        i0, j0, ni, nj = 2, 1, 4, 3  # x before y, as in C
+        block = [[100.0 * (j + 1) + (i + 1) for i in range(ni)] for j in range(nj)]  # shape (nj, ni), distinct
+        inputs = [block, [v for row in block for v in row]]  # rows j, or flat with x fastest
+        if np is not None:
+            inputs.append(np.array(block))
+        for values in inputs:
+            with dpsm.Grid.create_2d(nx, ny, 0.1, 0.2) as g:
+                g.set_heights_region(i0, j0, ni, nj, values)
+                h = as_list(g.get_heights())
+                c_order = flat(h)  # as C's h[ny][nx]: cell (i, j) at i + nx*j
+                for y in range(ny):
+                    for x in range(nx):
+                        inside = i0 <= x < i0 + ni and j0 <= y < j0 + nj
+                        want = block[y - j0][x - i0] if inside else 0.0
+                        self.assertEqual(h[y][x], want, (x, y))
+                        self.assertEqual(c_order[x + nx * y], want, (x, y))
+                self.assertEqual(h[j0][i0], 101.0)               # the block's first value at (i0, j0)
+                self.assertEqual(h[j0 + nj - 1][i0 + ni - 1], 100.0 * nj + ni)
+                self.assertEqual(as_list(g.get_heights_region(i0, j0, ni, nj)), block)
+                g.add_heights_region(i0, j0, ni, nj, values)
+                self.assertEqual(as_list(g.get_heights())[j0 + 2][i0 + 3], 2 * block[2][3])
+                # C's (ni, nj) as an array's shape is the transpose: refused, the grid unchanged.
+                transposed = [[block[j][i] for j in range(nj)] for i in range(ni)]
+                self.assertFails(dpsm.ERR_INVALID_SIZE, g.set_heights_region, i0, j0, ni, nj, transposed)
+                self.assertEqual(as_list(g.get_heights_region(i0, j0, ni, nj)), [[2 * v for v in row] for row in block])
+        with dpsm.Grid.create_1d(9, 0.1) as g:
+            g.set_heights_region(3, 0, 4, 1, [1.0, 2.0, 3.0, 4.0])
+            self.assertEqual(as_list(g.get_heights()), [0.0] * 3 + [1.0, 2.0, 3.0, 4.0] + [0.0] * 2)
 
 
 def cone(nx, ny, d, height, slope):
@@ -703,7 +775,7 @@ class TestMesh(LedgerMixin, unittest.TestCase):
     def test_quad_mesh(self):
         with dpsm.Grid.create_mesh(self.node_xy, self.cell_start, self.cell_nodes) as g:
             self.assertEqual(g.kind, "mesh")
-            self.assertEqual(g.get_shape(), (4, 1))
+            self.assertEqual(g.get_shape(), (4,))
             self.assertEqual(g.shape, (4,))
             self.assertIn("ncells=4", repr(g))
             self.assertEqual(g.get_face_count(), 12)
@@ -814,7 +886,7 @@ class TestMesh(LedgerMixin, unittest.TestCase):
         square = [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)]
         triangles = [(0, 1, 2), (0, 2, 3)]
         with dpsm.Grid.create_dual_mesh(square, triangles) as g:
-            self.assertEqual(g.get_shape(), (4, 1))
+            self.assertEqual(g.get_shape(), (4,))
             # The 5 triangle edges, then the halves of the 4 boundary edges.
             self.assertEqual(g.get_face_count(), 13)
             faces = as_list(g.get_mesh_faces())
@@ -835,7 +907,7 @@ class TestMesh(LedgerMixin, unittest.TestCase):
         face_cells = [(0, 1), (0, -1), (0, -1), (0, -1), (1, -1), (1, -1), (1, -1)]
         face_xy = [(1.0, 0.5), (0.0, 0.5), (0.5, 0.0), (0.5, 1.0), (2.0, 0.5), (1.5, 0.0), (1.5, 1.0)]
         g = dpsm.Grid.create_graph(cell_xy, [1.0, 1.0], face_cells, face_xy, [1.0] * 7)
-        self.assertEqual(g.get_shape(), (2, 1))
+        self.assertEqual(g.get_shape(), (2,))
         self.assertEqual(g.get_face_count(), 7)
         self.assertEqual(as_list(g.get_mesh_faces()), [list(p) for p in face_cells])  # the host's order
         g.set_heights([2.0, 0.0])
@@ -965,7 +1037,7 @@ class TestMesh(LedgerMixin, unittest.TestCase):
         cell_start = [3 * t for t in range(len(triangles) + 1)]
         cell_nodes = [v for tri in triangles for v in tri]
         g = dpsm.Grid.create_mesh(node_xy, cell_start, cell_nodes)
-        self.assertEqual(g.get_shape(), (2 * n * n, 1))
+        self.assertEqual(g.get_shape(), (2 * n * n,))
         centre = n * d / 2
         h = []
         for tri in triangles:
@@ -1008,25 +1080,25 @@ class TestMesh(LedgerMixin, unittest.TestCase):
                  FakeBlock("quad", [[0, 1, 4, 3], [1, 2, 5, 4]]),
                  FakeBlock("triangle", [[3, 4, 6], [4, 5, 6]])]
         with dpsm.Grid.from_meshio(FakeMesh(points, cells)) as g:
-            self.assertEqual(g.get_shape(), (4, 1))
+            self.assertEqual(g.get_shape(), (4,))
             faces = as_list(g.get_mesh_faces())
             self.assertEqual(sorted(tuple(sorted(p)) for p in faces if p[1] >= 0), [(0, 1), (0, 2), (1, 3), (2, 3)])
             g.set_heights([1.0, 1.0, 1.0, 1.0])
             self.assertAlmostEqual(g.get_mass(dpsm.MASS_TOTAL), 3.0, delta=1e-12)  # 1 + 1 + 1/2 + 1/2
         # (type, data) pairs and 2D points; a polygon block.
         with dpsm.Grid.from_meshio(FakeMesh([p[:2] for p in points], [("polygon", [[0, 1, 2, 5, 4, 3]])])) as g:
-            self.assertEqual(g.get_shape(), (1, 1))
+            self.assertEqual(g.get_shape(), (1,))
             self.assertEqual(g.get_face_count(), 6)
         # Polygons of several sizes in one block: a quad and a triangle.
         with dpsm.Grid.from_meshio(FakeMesh(points, [FakeBlock("polygon", [[0, 1, 4, 3], [3, 4, 6]])])) as g:
-            self.assertEqual(g.get_shape(), (2, 1))
+            self.assertEqual(g.get_shape(), (2,))
             self.assertEqual(g.get_face_count(), 6)
         if np is not None:
             mesh = FakeMesh(np.array(points), [FakeBlock("line", np.array([[0, 1]])),
                                                FakeBlock("quad", np.array([[0, 1, 4, 3], [1, 2, 5, 4]])),
                                                FakeBlock("triangle", np.array([[3, 4, 6], [4, 5, 6]]))])
             with dpsm.Grid.from_meshio(mesh) as g:
-                self.assertEqual(g.get_shape(), (4, 1))
+                self.assertEqual(g.get_shape(), (4,))
         e = self.assertFails(dpsm.ERR_INVALID_VALUE, dpsm.Grid.from_meshio,
                              FakeMesh(points, [FakeBlock("tetra", [[0, 1, 3, 6]])]))
         self.assertIn("tetra", e.message)

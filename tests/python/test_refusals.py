@@ -289,9 +289,9 @@ class TestGridRefusals(RefusalMixin, unittest.TestCase):
                     e = self.assertRefused(TypeError, None, create, *bad, names=(f, name, what))
                     self.assertIn("%s: %s must be %s" % (f, name, "an integer" if size else "a real number"), str(e))
             with create(*args) as g:  # the good arguments make a grid
-                self.assertEqual(g.get_shape()[0], 10)
+                self.assertEqual(g.nx, 10)
         with dpsm.Grid.create_2d(10, 4, fractions.Fraction(1, 10), 1) as g:
-            self.assertEqual(g.get_shape(), (10, 4))
+            self.assertEqual(g.get_shape(), (4, 10))
 
 
 class TestMeshRefusals(RefusalMixin, unittest.TestCase):
@@ -353,7 +353,7 @@ class TestMeshRefusals(RefusalMixin, unittest.TestCase):
             self.assertRefused(TypeError, None, dpsm.Grid.from_meshio, Mesh(np.array(self.square) + 0j),
                                names=(f, "points", "complex128"))
         with dpsm.Grid.from_meshio(Mesh(self.square)) as g:
-            self.assertEqual(g.get_shape(), (2, 1))
+            self.assertEqual(g.get_shape(), (2,))
 
     def test_edge_kinds_refuse_floats_and_booleans(self):
         f = "dpsm_set_edge_kinds"

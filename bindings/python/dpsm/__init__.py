@@ -21,6 +21,9 @@ A ctypes binding of the C library (no compiled extension)::
   and the others take it first, as the C functions); their arrays hold one value
   per cell (``g.shape == (ncells,)``) and ``g.get_mesh_faces()`` lists the faces
   (from the start index), edge side ``MESH_EDGE``.
+- Shapes are numpy's: ``g.shape == g.get_shape() == (g.ny, g.nx)`` in 2D;
+  sizes and offsets passed as separate arguments are C's, x first (see
+  ``Grid``, "Shapes and indices").
 - ``Grid`` methods are the C functions without the ``dpsm_`` prefix and
   without the grid argument; ``close()`` (or leaving the ``with`` block)
   releases the grid, as ``dpsm_destroy``.

@@ -416,12 +416,19 @@ class Grid:
     (``Grid.graph``), ``Grid.create_dual_mesh`` (``Grid.dual_mesh``) or
     ``Grid.from_meshio``, or read one from a restart file with ``Grid.load``.
 
-    Arrays of heights, sources and cell kinds have the grid's ``shape``:
-    ``(ny, nx)`` on a 2D grid (row ``j`` holds cells ``(0..nx-1, j)``, as a C
-    ``h[ny][nx]``; a flat sequence of ``nx*ny`` values, x fastest, is also
-    accepted) and ``(nx,)`` on 1D and axisymmetric grids; on a mesh
-    (``kind == "mesh"``) ``(ncells,)``, one value per cell in the host's cell
-    order (``nx`` is the number of cells, ``ny`` is 1).
+    Shapes and indices. Arrays are as numpy holds a grid: on a 2D grid
+    ``(ny, nx)``, row ``j`` (y) holding cells ``(0..nx-1, j)``, x fastest, as
+    a C ``h[ny][nx]`` (a flat sequence of ``nx*ny`` values, x fastest, is also
+    accepted); ``(nx,)`` on 1D and axisymmetric grids; ``(ncells,)`` on a mesh
+    (``kind == "mesh"``), one value per cell in the host's cell order. Every
+    shape the package reports is that shape: ``shape`` and ``get_shape()``
+    give the same tuple. ``nx`` and ``ny`` are C's sizes, x first (``ny`` is
+    1 on 1D, axisymmetric and mesh grids, ``nx`` the number of cells of a
+    mesh). Sizes, offsets and indices passed as separate arguments keep C's
+    order, x before y: ``set_heights_region(i0, j0, ni, nj, h)`` is the
+    block of ``ni`` cells along x by ``nj`` along y from cell ``(i0, j0)``,
+    and ``h`` has the numpy shape ``(nj, ni)``: ``h[j][i]`` is cell
+    ``(i0 + i, j0 + j)``.
 
     Nothing is converted silently: numbers are ints, floats or numpy
     scalars (not str, bytes, bool or complex), arrays of reals hold only
@@ -441,8 +448,8 @@ class Grid:
         self.kind = _kind
         nx, ny = ctypes.c_int64(), ctypes.c_int64()
         _check(lib.dpsm_get_shape(_handle, ctypes.byref(nx), ctypes.byref(ny)), "dpsm_get_shape", _handle)
-        ## The shape (dpsm_get_shape): nx and ny, the cells along x and y (ny is 1 on 1D, axisymmetric and mesh grids).
-        self.nx, self.ny = nx.value, ny.value
+        # C's sizes (dpsm_get_shape), read through the properties nx and ny.
+        self._nx, self._ny = nx.value, ny.value
 
     # ---- creating and releasing --------------------------------------------
 
@@ -732,9 +739,23 @@ class Grid:
         return "<dpsm.Grid %s %s>" % (self.kind, state)
 
     @property
+    def nx(self):
+        """The cells along x, C's ``nx`` of dpsm_get_shape (the number of cells of a mesh). Read-only."""
+        return self._nx
+
+    @property
+    def ny(self):
+        """The cells along y, C's ``ny`` of dpsm_get_shape (1 on 1D, axisymmetric and mesh grids). Read-only."""
+        return self._ny
+
+    @property
     def shape(self):
-        """The shape of this grid's arrays: ``(ny, nx)`` in 2D, ``(nx,)`` otherwise (``(ncells,)`` on a mesh)."""
-        return (self.ny, self.nx) if self.kind == "2d" else (self.nx,)
+        """The shape of this grid's arrays, as numpy holds them: ``(ny, nx)`` in 2D, ``(nx,)`` otherwise
+        (``(ncells,)`` on a mesh). ``get_shape()`` returns the same tuple."""
+        return self._numpy_shape(self._nx, self._ny)
+
+    def _numpy_shape(self, nx, ny):
+        return (ny, nx) if self.kind == "2d" else (nx,)
 
     def _call(self, function, *args):
         _check(getattr(lib, function)(self._handle, *args), function, self._handle)
@@ -1033,8 +1054,10 @@ class Grid:
 
     def set_heights_region(self, i0, j0, ni, nj, h):
         """``dpsm_set_heights_region``: the heights of the block of ``ni`` by
-        ``nj`` cells from cell ``(i0, j0)`` (0-based), ``h`` of shape
-        ``(nj, ni)`` in 2D (``(ni,)`` otherwise) or ``ni*nj`` values."""
+        ``nj`` cells from cell ``(i0, j0)`` (0-based; offsets and sizes x
+        before y, as in C), ``h`` of shape ``(nj, ni)`` in 2D (``(ni,)``
+        otherwise) or ``ni*nj`` values, x fastest: ``h[j][i]`` is cell
+        ``(i0 + i, j0 + j)``."""
         f = "dpsm_set_heights_region"
         block = self._block(f, i0, j0, ni, nj)
         pointer, keep = self._doubles_in(h, self._block_shape(block[2], block[3]), "h", f)
@@ -1042,7 +1065,9 @@ class Grid:
         del keep
 
     def add_heights_region(self, i0, j0, ni, nj, dh):
-        """``dpsm_add_heights_region``: adds ``dh`` to a block (deposition > 0, erosion < 0)."""
+        """``dpsm_add_heights_region``: adds ``dh`` to a block (deposition > 0, erosion < 0), arguments
+        as ``set_heights_region``: ``dh`` of shape ``(nj, ni)`` in 2D, ``dh[j][i]`` added to cell
+        ``(i0 + i, j0 + j)``."""
         f = "dpsm_add_heights_region"
         block = self._block(f, i0, j0, ni, nj)
         pointer, keep = self._doubles_in(dh, self._block_shape(block[2], block[3]), "dh", f)
@@ -1050,7 +1075,8 @@ class Grid:
         del keep
 
     def get_heights_region(self, i0, j0, ni, nj, out=None):
-        """``dpsm_get_heights_region``: the heights of a block, shape ``(nj, ni)`` in 2D (``(ni,)`` otherwise)."""
+        """``dpsm_get_heights_region``: the heights of a block, arguments as ``set_heights_region``,
+        shape ``(nj, ni)`` in 2D (``(ni,)`` otherwise)."""
         f = "dpsm_get_heights_region"
         block = self._block(f, i0, j0, ni, nj)
         pointer, result, finish = self._doubles_out(self._block_shape(block[2], block[3]), out, "h", f)
@@ -1121,10 +1147,15 @@ class Grid:
         return (x_finish() if x_finish else x_result), (y_finish() if y_finish else y_result)
 
     def get_shape(self):
-        """``dpsm_get_shape``: ``(nx, ny)``, as C gives them (``ny`` is 1 on 1D grids)."""
+        """``dpsm_get_shape``: the shape of this grid's arrays, the same tuple as ``shape``:
+        ``(ny, nx)`` in 2D, ``(nx,)`` on 1D and axisymmetric grids, ``(ncells,)`` on a mesh.
+
+        Changed in 0.1.0, before its release: ``get_shape()`` used to return C's ``(nx, ny)``
+        (``(nx, 1)`` on 1D grids and meshes), the reverse of ``shape`` in 2D. C's sizes in C's
+        order are ``(g.nx, g.ny)``."""
         nx, ny = ctypes.c_int64(), ctypes.c_int64()
         self._call("dpsm_get_shape", ctypes.byref(nx), ctypes.byref(ny))
-        return nx.value, ny.value
+        return self._numpy_shape(nx.value, ny.value)
 
     def last_error(self):
         """``dpsm_last_error``: the message of the last failed call on this grid, ``""`` if it succeeded."""
