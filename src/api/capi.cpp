@@ -615,57 +615,22 @@ int dpsm_stable_dt(const dpsm_grid *g, double *dt) {
     });
 }
 
-namespace {
-
-// The first sand cell (library order) whose source would carry its height
-// beyond the supported range within dt (the height it would reach in
-// `reaches`), or -1. Sliding sand never leaves the range of the heights and
-// what the sources add, so these are the only way out of it; erosion stops
-// at a bed, which lies inside.
-std::int64_t cell_sourced_beyond_range(const dpsm::Grid &grid, double dt, double &reaches) {
-    if (!grid.source_active()) return -1;
-    const std::vector<double> &h = grid.heights(), &q = grid.source();
-    const std::vector<std::uint8_t> &kind = grid.kinds();
-    const bool bed = !grid.bed().empty();
-    for (std::size_t c = 0; c < h.size(); ++c) {
-        if (kind[c] != dpsm::kSand || q[c] == 0.0 || (bed && q[c] < 0.0)) continue;
-        reaches = h[c] + q[c] * dt;
-        if (!(std::fabs(reaches) <= dpsm::kMaxMagnitude)) return static_cast<std::int64_t>(c);
-    }
-    return -1;
-}
-
-}  // namespace
-
 int dpsm_step(dpsm_grid *g, double dt) {
     const char *fn = "dpsm_step";
     return guarded(g, fn, [&] {
         require_grid(g, fn);
-        dpsm::Grid &core = g->core;
-        const bool dt_valid = std::isfinite(dt) && dt > 0.0;
-        double reaches = 0.0;
-        const std::int64_t beyond =
-            dt_valid && core.relaxation() != dpsm::kToRest ? cell_sourced_beyond_range(core, dt, reaches) : -1;
-        dpsm::Decomposition *decomposition = core.decomposition();
-        if (decomposition && (!dt_valid || beyond >= 0)) {
+        dpsm::Decomposition *decomposition = g->core.decomposition();
+        if (decomposition && !(std::isfinite(dt) && dt > 0.0)) {
             // The other ranks wait in the step's first agreement: take part,
             // refusing, so that they fail too instead of waiting for ever.
             try {
-                decomposition->agree_before_step(core, 0.0, true);
+                decomposition->agree_before_step(g->core, 0.0, true);
             } catch (const dpsm::Error &) {
                 // every rank throws; this one reports its own reason below
             }
         }
         require_positive(dt, fn, "dt");
-        if (beyond >= 0) {
-            const dpsm::Mesh *mesh = mesh_of(g);
-            const std::int64_t host = mesh ? mesh->host_cell[static_cast<std::size_t>(beyond)] : beyond;
-            fail(DPSM_ERR_INVALID_VALUE, fn, "dt = ", dt, " would carry ", host_cell_name(g, host), " from ",
-                 core.heights()[static_cast<std::size_t>(beyond)], " to ", reaches, " under its source q = ",
-                 core.source()[static_cast<std::size_t>(beyond)], ", beyond the supported range [-1e50, 1e50];"
-                 " take shorter steps or a smaller source");
-        }
-        dpsm::step(core, dt);
+        dpsm::step(g->core, dt);
     });
 }
 

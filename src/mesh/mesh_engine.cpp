@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <limits>
 #include <vector>
 
 #include "model/flux_law.hpp"
@@ -199,7 +200,10 @@ public:
     bool may_move(const Grid &grid) const override { return grid.mesh_activity().may_move(); }
 
     // Every source cell takes its source at every sub-step and counts as driven.
-    bool drive_sources(Grid &, double, double, bool) const override { return true; }
+    bool drive_sources(Grid &, double, double, bool, double &reach) const override {
+        reach = std::numeric_limits<double>::infinity();
+        return true;
+    }
     void forget_driven(Grid &) const override {}
 
     void advance(Grid &grid, const SubstepPlan &plan, const BookSubstep &book, StepInfo &info) const override {

@@ -64,8 +64,10 @@ public:
     // marks what the sources may make steep and returns whether a source
     // keeps some face steep at the end of the step (it may then flow for
     // ever). Without lazy sources every source cell is marked and the answer
-    // is true.
-    virtual bool drive_sources(Grid &grid, double dt, double sub_dt, bool lazy) const = 0;
+    // is true. `reach` receives a bound on |h + q dt| over the cells with a
+    // source where the engine's pass found one on the way (the stepper then
+    // need not look at every cell), else +infinity.
+    virtual bool drive_sources(Grid &grid, double dt, double sub_dt, bool lazy, double &reach) const = 0;
     // Undoes drive_sources for a step that is refused.
     virtual void forget_driven(Grid &grid) const = 0;
     // Advances the plan's sub-steps, calling book after each, until book

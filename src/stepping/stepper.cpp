@@ -4,10 +4,12 @@
 #include <cmath>
 #include <limits>
 #include <sstream>
+#include <string>
 
 #include "mpi/decomposition.hpp"
 #include "dpsm/dpsm.h"
 #include "model/error.hpp"
+#include "model/limits.hpp"
 #include "stepping/engine.hpp"
 
 namespace dpsm {
@@ -41,6 +43,47 @@ bool can_flow_forever(const Grid &grid, const StepAgreement &state, bool driven)
         highest = std::max(highest, state.side_level_max);
     }
     return lowest != highest;
+}
+
+// A cell as the host numbers it, for messages: (i, j) on a grid, its index
+// from the mesh's start index on a mesh.
+std::string host_cell_name(const Grid &grid, std::int64_t c) {
+    const Geometry &geo = grid.geometry();
+    if (const Mesh *mesh = geo.mesh.get())
+        return "cell " + std::to_string(mesh->host_cell[static_cast<std::size_t>(c)] + mesh->input.start_index);
+    return "cell i = " + std::to_string(c % geo.nx) + ", j = " + std::to_string(c / geo.nx);
+}
+
+// A source that would carry a sand cell beyond the supported range within
+// dt (dpsm.h) refuses the step before anything changes. Sliding sand never
+// leaves the range of the heights and what the sources add, and erosion stops
+// at a bed, which lies inside. `reach`, the engine's bound on |h + q dt|,
+// spares the look at every cell where it is inside. Collective on a
+// distributed grid.
+void require_sources_within_range(Grid &grid, double dt, double reach) {
+    std::int64_t beyond = -1;
+    double reaches = 0.0;
+    if (!(reach <= kMaxMagnitude)) {
+        const std::vector<double> &h = grid.heights(), &q = grid.source();
+        const std::vector<std::uint8_t> &kind = grid.kinds();
+        const bool bed = !grid.bed().empty();
+        for (std::size_t c = 0; c < h.size() && beyond < 0; ++c) {
+            if (kind[c] != kSand || q[c] == 0.0 || (bed && q[c] < 0.0)) continue;
+            reaches = h[c] + q[c] * dt;
+            if (!(std::fabs(reaches) <= kMaxMagnitude)) beyond = static_cast<std::int64_t>(c);
+        }
+    }
+    const bool anywhere = grid.decomposition() ? grid.global_sum(beyond >= 0 ? 1.0 : 0.0) > 0.0 : beyond >= 0;
+    if (!anywhere) return;
+    std::ostringstream msg;
+    msg << "dpsm_step: dt = " << dt << " would carry ";
+    if (beyond >= 0)
+        msg << host_cell_name(grid, beyond) << " from " << grid.heights()[static_cast<std::size_t>(beyond)] << " to "
+            << reaches << " under its source q = " << grid.source()[static_cast<std::size_t>(beyond)];
+    else
+        msg << "a cell of another rank";
+    msg << ", beyond the supported range [-1e50, 1e50]; take shorter steps or a smaller source";
+    throw Error(DPSM_ERR_INVALID_VALUE, msg.str());
 }
 
 // What decides the step's work: the grid's own figures, or on a block of a
@@ -113,7 +156,16 @@ void step_in_time(Grid &grid, double dt, std::int64_t most) {
     plan.lazy_sources = lazy;
     bool driven = source_active;
     if (source_active) {
-        const bool steep_at_end = engine.drive_sources(grid, dt, plan.sub_dt, lazy);
+        double reach = 0.0;
+        const bool steep_at_end = engine.drive_sources(grid, dt, plan.sub_dt, lazy, reach);
+        if (std::isfinite(dt)) {
+            try {
+                require_sources_within_range(grid, dt, reach);
+            } catch (const Error &) {
+                engine.forget_driven(grid);
+                throw;
+            }
+        }
         if (lazy) driven = grid.global_sum(steep_at_end ? 1.0 : 0.0) > 0.0;  // collective on a distributed grid
     }
     plan.something_may_move = driven || state.may_move;

@@ -1,6 +1,7 @@
 #include "structured/structured_engine.hpp"
 
 #include <algorithm>
+#include <limits>
 #include <vector>
 
 #include "model/flux_law.hpp"
@@ -36,8 +37,9 @@ public:
     void prepare(Grid &grid) const override { prepare_tiled_sweep(grid, grid.step_threads()); }
     bool may_move(const Grid &grid) const override { return grid.active_set().may_move(); }
 
-    bool drive_sources(Grid &grid, double dt, double sub_dt, bool lazy) const override {
-        if (lazy) return dpsm::drive_sources(grid, dt, sub_dt);
+    bool drive_sources(Grid &grid, double dt, double sub_dt, bool lazy, double &reach) const override {
+        reach = std::numeric_limits<double>::infinity();
+        if (lazy) return dpsm::drive_sources(grid, dt, sub_dt, reach);
         grid.active_set().drive_every_source();
         return true;
     }
@@ -87,7 +89,8 @@ public:
     void prepare(Grid &) const override {}
     bool may_move(const Grid &) const override { return true; }
 
-    bool drive_sources(Grid &grid, double dt, double, bool lazy) const override {
+    bool drive_sources(Grid &grid, double dt, double, bool lazy, double &reach) const override {
+        reach = std::numeric_limits<double>::infinity();
         return lazy ? source_may_steepen_1d(grid, dt) : true;
     }
     void forget_driven(Grid &) const override {}

@@ -833,7 +833,7 @@ SlopeBound bound_slopes(const Grid &grid, const CellBox &box, double T) {
 
 }  // namespace
 
-bool drive_sources(Grid &grid, double T, double dt) {
+bool drive_sources(Grid &grid, double T, double dt, double &reach) {
     const Geometry &geo = grid.geometry();
     ActiveSet &active = grid.active_set();
     Decomposition *decomposition = grid.decomposition();
@@ -859,6 +859,7 @@ bool drive_sources(Grid &grid, double T, double dt) {
     };
     std::vector<CellBox> driven(tiles.size());
     std::vector<std::uint8_t> steep_later(tiles.size(), 0);
+    std::vector<double> reached(tiles.size(), 0.0);
 
     auto classify = [&](std::int64_t k, TileBuffers &b) {
         const std::int64_t t = tiles[static_cast<std::size_t>(k)];
@@ -883,6 +884,7 @@ bool drive_sources(Grid &grid, double T, double dt) {
                                   (read.j0 >= 0 || !grid.side_open(kYMin)) && (read.j1 <= geo.ny || !grid.side_open(kYMax));
         if (!active.masked(t) && walls_beyond && (inside || !halo_store)) {
             const SlopeBound bound = bound_slopes(grid, read.grown_within(0, domain), T);
+            reached[static_cast<std::size_t>(k)] = bound.largest;
             const double below = tan_theta * margin_factor(bound.largest);
             if (std::isfinite(bound.largest) && std::max(bound.now2, bound.later2) <= below * below) return;
         }
@@ -892,6 +894,7 @@ bool drive_sources(Grid &grid, double T, double dt) {
         double largest = 0.0;
         for (std::size_t c = 0; c < count; ++c)
             largest = std::max({largest, std::fabs(b.h[0][c]), std::fabs(b.h[0][c] + b.source[c] * T)});
+        reached[static_cast<std::size_t>(k)] = largest;
         if (!std::isfinite(largest)) {  // beyond the supported range: every cell may move
             driven[static_cast<std::size_t>(k)] = region;
             steep_later[static_cast<std::size_t>(k)] = 1;
@@ -919,9 +922,11 @@ bool drive_sources(Grid &grid, double T, double dt) {
     }
     for_tiles_in_parallel(grid, static_cast<std::int64_t>(tiles.size()), cells, classify);
     bool any = false;
+    reach = 0.0;
     for (std::size_t k = 0; k < tiles.size(); ++k) {
         active.driven(tiles[k]) = driven[k];
         any = any || steep_later[k];
+        if (!std::isnan(reach) && !(reached[k] <= reach)) reach = reached[k];  // NaN stays
     }
     return any;
 }

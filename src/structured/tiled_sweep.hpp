@@ -83,7 +83,9 @@ inline double source_lag(double q, double dt, double substeps) { return (q * dt)
 // (a face steep only now comes to rest by itself). Changes no height. On a
 // distributed grid it exchanges the halo first (collective); the result is
 // this block's.
-bool drive_sources(Grid &grid, double T, double dt);
+// `reach` receives the largest |h| and |h + q T| over the cells it read
+// (every cell with a source), as its bound on slopes finds them.
+bool drive_sources(Grid &grid, double T, double dt, double &reach);
 
 // Lazy sources, at the end of a step: every source cell not current after
 // sub-step `substeps` of dt gets its source since in closed form (a TwoSum
