@@ -24,6 +24,7 @@ DPSM_APT_PACKAGES=(
     abigail-tools      # the `abi` test: abidw/abidiff against tests/abi/libdpsm.abi
     libopenmpi-dev     # the MPI component (libdpsm_mpi, dpsm_mpi.h): Open MPI's headers and libraries
     openmpi-bin        # mpiexec, which runs the MPI tests (tests/mpi) on 1, 2 and 4 ranks
+    libmetis-dev       # the MPI mesh tests and benchmark partition meshes with METIS (dpsm itself does not need it)
 )
 
 DPSM_ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)

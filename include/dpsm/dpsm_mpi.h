@@ -172,6 +172,159 @@ DPSM_API int dpsm_load_mpi(MPI_Comm comm, const char *path, dpsm_grid **out);
  */
 DPSM_API int dpsm_load_mpi_f(MPI_Fint comm, const char *path, dpsm_grid **out);
 
+/**
+ * @name Distributed meshes
+ *
+ * A host that partitions an unstructured mesh (with METIS, Scotch or its own
+ * partitioner) hands each rank's part to dpsm as it holds it: the cells the
+ * rank owns and the ghost cells around them that other ranks own, in the
+ * host's own local numbering, each with a global id and its owner.
+ *
+ *  - **Ghosts needed.** Every cell across a face from an owned cell must be on
+ *    the rank (one layer of ghosts). On meshes whose cells have fewer than 4
+ *    faces on average (triangles), whose gradients read the cells within two
+ *    faces, so must every cell across a face from those (two layers). With
+ *    fewer, the constructor fails on every rank, naming an owned cell whose
+ *    neighbourhood is incomplete. Faces between two ghosts may be given or
+ *    left out: dpsm learns each ghost's neighbours from its owner.
+ *  - **Global ids** number all cells of the mesh from 0 (from 1 in the `_f`
+ *    constructors), each owned by exactly one rank; `owner[k]` is the rank of
+ *    the communicator that owns local cell k (this rank for its own cells).
+ *    Inconsistent partitions (a cell owned twice or by no rank, a ghost whose
+ *    named owner does not own it, a face one side has and the other has not)
+ *    fail on every rank with a message naming the cell.
+ *  - **Arrays per cell** of the other functions (heights, sources, kinds,
+ *    bed, angles) hold one value per local cell, owned and ghost, in the
+ *    host's order. Ghost values must be valid, but are replaced by their
+ *    owners' at the next dpsm_step(); after a step, dpsm_get_heights() gives
+ *    the owners' values on the ghosts too.
+ *  - **Faces** are the rank's (the host's list on a graph; those derived from
+ *    the polygons on a mesh, dpsm_get_mesh_faces()): a face between an owned
+ *    cell and a ghost is computed on both ranks, with the same flux; faces
+ *    between two ghosts, and a ghost's outer edges, carry nothing on this
+ *    rank (their fluxes read 0); edge kinds and levels are read on the faces
+ *    of owned cells.
+ *  - **Results** equal those of one serial mesh holding all cells (built with
+ *    dpsm_create_graph() or dpsm_create_mesh() from the same cells in any
+ *    order), bit for bit, for any partition and any number of ranks: every
+ *    sum over a cell's faces or its gradient's neighbours is taken in the
+ *    order of their global ids. Mass figures and step information are global,
+ *    as on distributed 2D grids (their sums over ranks differ from the serial
+ *    ones by round-off).
+ *  - **Communication:** each sub-step exchanges the ghosts' gradients and,
+ *    after the update, their heights with the neighbouring ranks only (a
+ *    distributed-graph communicator and neighbourhood all-to-alls), plus one
+ *    all-reduce of a few numbers.
+ *  - **Collective calls** are those of distributed 2D grids; restart files
+ *    (dpsm_save()) are not written for distributed meshes in this version.
+ * @{
+ */
+
+/**
+ * @brief Creates this rank's part of a mesh given as a finite-volume graph,
+ *        distributed over @p comm.
+ *
+ * Collective over @p comm. The arguments after @p owner are those of
+ * dpsm_create_graph() for the rank's local cells (owned and ghost, indices
+ * from 0; `face_cells` pairs of local cells, -1 for the domain edge). Every
+ * face of an owned cell must be given, domain edges included; a ghost's faces
+ * need not be.
+ *
+ * @param comm        the host's communicator (an intracommunicator); MPI must be initialized.
+ * @param ncells      local cells, owned and ghost, at least 1 (at least one owned).
+ * @param global_id   per local cell, its id in the whole mesh, from 0.
+ * @param owner       per local cell, the rank of @p comm that owns it.
+ * @param cell_xy     per local cell, its centre (x, y).
+ * @param cell_area   per local cell, its area.
+ * @param nfaces      local faces.
+ * @param face_cells  per face, its two local cells a, b (b = -1: the domain edge).
+ * @param face_xy     per face, its midpoint.
+ * @param face_length per face, its length.
+ * @param out         receives the handle (NULL on failure); release it with dpsm_destroy() on every rank.
+ * @return #DPSM_OK; the errors of dpsm_create_graph() for this rank's own
+ *         arrays; #DPSM_ERR_INVALID_VALUE (inconsistent partitions, too few
+ *         ghosts, MPI not initialized); #DPSM_ERR_INVALID_SIZE (a rank owns no
+ *         cell); #DPSM_ERR_NULL_POINTER; #DPSM_ERR_OUT_OF_MEMORY;
+ *         #DPSM_ERR_INTERNAL (an MPI call failed). Every rank returns the same
+ *         status; dpsm_last_error(NULL) names the rank and the cell.
+ */
+DPSM_API int dpsm_create_graph_mpi(MPI_Comm comm, int64_t ncells, const int64_t *global_id, const int *owner,
+                                   const double *cell_xy, const double *cell_area, int64_t nfaces,
+                                   const int64_t *face_cells, const double *face_xy, const double *face_length,
+                                   dpsm_grid **out);
+
+/**
+ * @brief dpsm_create_graph_mpi() for a Fortran host: a Fortran communicator,
+ *        indices and global ids from 1.
+ *
+ * @p comm is the integer handle of a Fortran communicator; `face_cells` holds
+ * local cells from 1 (0 for the domain edge) and `global_id` counts from 1,
+ * as the Fortran module `dpsm_mpi` passes them; messages count from 1 too.
+ *
+ * @param comm        the Fortran handle of the host's communicator.
+ * @param ncells      local cells.
+ * @param global_id   per local cell, its id in the whole mesh, from 1.
+ * @param owner       per local cell, its owner's rank (from 0, as MPI counts).
+ * @param cell_xy     per local cell, its centre.
+ * @param cell_area   per local cell, its area.
+ * @param nfaces      local faces.
+ * @param face_cells  per face, its two local cells from 1 (0: the domain edge).
+ * @param face_xy     per face, its midpoint.
+ * @param face_length per face, its length.
+ * @param out         receives the handle (NULL on failure).
+ * @return as dpsm_create_graph_mpi().
+ */
+DPSM_API int dpsm_create_graph_mpi_f(MPI_Fint comm, int64_t ncells, const int64_t *global_id, const int *owner,
+                                     const double *cell_xy, const double *cell_area, int64_t nfaces,
+                                     const int64_t *face_cells, const double *face_xy, const double *face_length,
+                                     dpsm_grid **out);
+
+/**
+ * @brief Creates this rank's part of a mesh given as polygons over nodes,
+ *        distributed over @p comm.
+ *
+ * Collective over @p comm. The arguments before @p global_id are those of
+ * dpsm_create_mesh() for the rank's local cells (owned and ghost) over its
+ * local nodes (indices from 0); two local cells share a face where they share
+ * an edge. An edge of an owned cell that no other local cell shares lies on
+ * the domain edge.
+ *
+ * @param comm       the host's communicator (an intracommunicator); MPI must be initialized.
+ * @param nnodes     local nodes.
+ * @param node_xy    per node, (x, y).
+ * @param ncells     local cells, owned and ghost (at least one owned).
+ * @param cell_start ncells + 1 offsets into @p cell_nodes.
+ * @param cell_nodes each cell's nodes in order around it.
+ * @param global_id  per local cell, its id in the whole mesh, from 0.
+ * @param owner      per local cell, the rank of @p comm that owns it.
+ * @param out        receives the handle (NULL on failure); release it with dpsm_destroy() on every rank.
+ * @return as dpsm_create_graph_mpi().
+ */
+DPSM_API int dpsm_create_mesh_mpi(MPI_Comm comm, int64_t nnodes, const double *node_xy, int64_t ncells,
+                                  const int64_t *cell_start, const int64_t *cell_nodes, const int64_t *global_id,
+                                  const int *owner, dpsm_grid **out);
+
+/**
+ * @brief dpsm_create_mesh_mpi() for a Fortran host: a Fortran communicator,
+ *        indices and global ids from 1.
+ *
+ * @param comm       the Fortran handle of the host's communicator.
+ * @param nnodes     local nodes.
+ * @param node_xy    per node, (x, y).
+ * @param ncells     local cells.
+ * @param cell_start ncells + 1 offsets from 1 (`cell_start(1) = 1`).
+ * @param cell_nodes each cell's nodes, from 1.
+ * @param global_id  per local cell, its id in the whole mesh, from 1.
+ * @param owner      per local cell, its owner's rank (from 0, as MPI counts).
+ * @param out        receives the handle (NULL on failure).
+ * @return as dpsm_create_graph_mpi().
+ */
+DPSM_API int dpsm_create_mesh_mpi_f(MPI_Fint comm, int64_t nnodes, const double *node_xy, int64_t ncells,
+                                    const int64_t *cell_start, const int64_t *cell_nodes, const int64_t *global_id,
+                                    const int *owner, dpsm_grid **out);
+
+/** @} */
+
 #ifdef __cplusplus
 }
 #endif

@@ -825,7 +825,7 @@ int dpsm_get_side_outflow(const dpsm_grid *g, int side, double *value) {
         // sum, a refusing one too, so that none waits for ever.
         bool all_agreed = true;
         if (dpsm::Decomposition *decomposition = g->core.decomposition())
-            all_agreed = decomposition->sum_unless_refused(local, !value || !known, total);
+            all_agreed = decomposition->sum_unless_refused(local, !value || !(known || mesh_edge), total);
         require_pointer(value, fn, "value");
         require_side(g, side, fn);
         if (!all_agreed)

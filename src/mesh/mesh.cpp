@@ -125,7 +125,7 @@ void order_each_cells_faces(Mesh &m, const std::vector<RawFace> &faces) {
         for (std::int64_t k = k0; k < k1; ++k) entries.push_back({m.cell_faces[k], m.other[k], m.into[k]});
         std::sort(entries.begin(), entries.end(), [&](const Entry &l, const Entry &r) {
             if ((l.other < 0) != (r.other < 0)) return r.other < 0;
-            if (l.other >= 0) return m.host_cell[l.other] < m.host_cell[r.other];
+            if (l.other >= 0) return m.global_id[l.other] < m.global_id[r.other];
             const Vec &ml = faces[m.host_face[l.face]].mid, &mr = faces[m.host_face[r.face]].mid;
             return ml.x < mr.x || (ml.x == mr.x && ml.y < mr.y);
         });
@@ -136,40 +136,45 @@ void order_each_cells_faces(Mesh &m, const std::vector<RawFace> &faces) {
     }
 }
 
-// The least-squares gradient weights of every cell, weighted by inverse
-// distance squared, over one ring of neighbours across faces or, where cells
-// have fewer than 4 of them on average, two; a cell whose neighbours do not
-// span the plane gets none (its faces use the two-point slope alone).
-void gradient_weights(Mesh &m) {
-    const double mean_neighbours =
-        static_cast<double>(m.cell_faces.size()) / static_cast<double>(m.cells);  // edges count: an upper figure
-    const int rings = mean_neighbours < 4.0 ? 2 : 1;
+// The least-squares gradient weights of every owned cell, weighted by
+// inverse distance squared, over one ring of neighbours across faces or two
+// (gradients_over_two_rings); a cell whose neighbours do not span the plane
+// gets none (its faces use the two-point slope alone). The second ring
+// through a ghost n is ghost_neighbours[ghost_start[n - owned] ..
+// ghost_start[n - owned + 1]), as n's owner knows them.
+void gradient_weights(Mesh &m, int rings, const std::vector<std::int64_t> &ghost_start,
+                      const std::vector<std::int64_t> &ghost_neighbours) {
     m.grad_start.assign(m.cells + 1, 0);
     m.grad_cells.clear();
     std::vector<std::int64_t> seen(m.cells, -1), ring;
-    for (std::int64_t c = 0; c < m.cells; ++c) {
+    for (std::int64_t c = 0; c < m.owned; ++c) {
         ring.clear();
         seen[c] = c;
-        for (std::int64_t k = m.cell_face_start[c]; k < m.cell_face_start[c + 1]; ++k) {
-            const std::int64_t n = m.other[k];
+        const auto visit = [&](std::int64_t n) {
             if (n >= 0 && seen[n] != c) seen[n] = c, ring.push_back(n);
-        }
+        };
+        for (std::int64_t k = m.cell_face_start[c]; k < m.cell_face_start[c + 1]; ++k) visit(m.other[k]);
         if (rings > 1) {
             const std::size_t first = ring.size();
-            for (std::size_t r = 0; r < first; ++r)
-                for (std::int64_t k = m.cell_face_start[ring[r]]; k < m.cell_face_start[ring[r] + 1]; ++k) {
-                    const std::int64_t n = m.other[k];
-                    if (n >= 0 && seen[n] != c) seen[n] = c, ring.push_back(n);
+            for (std::size_t r = 0; r < first; ++r) {
+                const std::int64_t n = ring[r];
+                if (n < m.owned) {
+                    for (std::int64_t k = m.cell_face_start[n]; k < m.cell_face_start[n + 1]; ++k) visit(m.other[k]);
+                } else {
+                    const std::size_t g = static_cast<std::size_t>(n - m.owned);
+                    for (std::int64_t k = ghost_start[g]; k < ghost_start[g + 1]; ++k) visit(ghost_neighbours[k]);
                 }
+            }
         }
         std::sort(ring.begin(), ring.end(),
-                  [&](std::int64_t l, std::int64_t r) { return m.host_cell[l] < m.host_cell[r]; });
+                  [&](std::int64_t l, std::int64_t r) { return m.global_id[l] < m.global_id[r]; });
         m.grad_cells.insert(m.grad_cells.end(), ring.begin(), ring.end());
         m.grad_start[c + 1] = static_cast<std::int64_t>(m.grad_cells.size());
     }
+    for (std::int64_t c = m.owned; c < m.cells; ++c) m.grad_start[c + 1] = m.grad_start[c];
     m.grad_wx.assign(m.grad_cells.size(), 0.0);
     m.grad_wy.assign(m.grad_cells.size(), 0.0);
-    for (std::int64_t c = 0; c < m.cells; ++c) {
+    for (std::int64_t c = 0; c < m.owned; ++c) {
         double sxx = 0.0, sxy = 0.0, syy = 0.0;
         const std::int64_t k0 = m.grad_start[c], k1 = m.grad_start[c + 1];
         for (std::int64_t k = k0; k < k1; ++k) {
@@ -192,9 +197,12 @@ void gradient_weights(Mesh &m) {
 }
 
 // Renumbers cells and faces, derives what a face's slope needs and checks
-// the faces' geometry. `cells` and `faces` are in the host's numbering.
-std::shared_ptr<const Mesh> assemble(MeshInput &&input, const RawCells &cells, const std::vector<RawFace> &faces,
-                                     const char *function, int base) {
+// the faces' geometry. `cells` and `faces` are in the host's numbering; on a
+// part of a distributed mesh the owned cells come first, then the ghosts,
+// and the faces that touch an owned cell come before the others. Everything
+// but the gradients and the sub-step's scale (finish_serial, finish_part).
+std::shared_ptr<Mesh> assemble(MeshInput &&input, const RawCells &cells, const std::vector<RawFace> &faces,
+                               const PartOfMesh *part, const char *function, int base) {
     auto mesh = std::make_shared<Mesh>();
     Mesh &m = *mesh;
     m.input = std::move(input);
@@ -208,6 +216,11 @@ std::shared_ptr<const Mesh> assemble(MeshInput &&input, const RawCells &cells, c
     } else {
         m.host_cell = hilbert_order(cells.centre);
     }
+    if (part)
+        std::stable_partition(m.host_cell.begin(), m.host_cell.end(), [&](std::int64_t h) { return !part->ghost[h]; });
+    m.owned = part ? static_cast<std::int64_t>(std::count(part->ghost, part->ghost + m.cells, 0)) : m.cells;
+    m.global_id.resize(m.cells);
+    for (std::int64_t c = 0; c < m.cells; ++c) m.global_id[c] = part ? part->global_id[m.host_cell[c]] : m.host_cell[c];
     m.cell_of_host.assign(m.cells, 0);
     for (std::int64_t c = 0; c < m.cells; ++c) m.cell_of_host[m.host_cell[c]] = c;
     m.area.resize(m.cells), m.x.resize(m.cells), m.y.resize(m.cells);
@@ -272,7 +285,10 @@ std::shared_ptr<const Mesh> assemble(MeshInput &&input, const RawCells &cells, c
         m.orthogonal[f] = std::max(0.0, dot(nl, e));
         m.skew[f] = dot(nl, Vec{m.tangent_x[f], m.tangent_y[f]});
         m.conductance[f] = norm(nl) / d;
-        smallest = f == 0 ? d : std::min(smallest, d);
+        if (a < m.owned) {
+            smallest = smallest == 0.0 ? d : std::min(smallest, d);
+            m.live_faces = static_cast<std::int64_t>(f) + 1;
+        }
     }
     m.min_distance = smallest;
     // Each cell's faces (order_each_cells_faces sorts them).
@@ -298,13 +314,29 @@ std::shared_ptr<const Mesh> assemble(MeshInput &&input, const RawCells &cells, c
         }
     }
     order_each_cells_faces(m, faces);
-    gradient_weights(m);
-    for (std::int64_t c = 0; c < m.cells; ++c) {
+    m.face_count.resize(m.cells);
+    for (std::int64_t c = 0; c < m.cells; ++c)
+        m.face_count[c] = static_cast<double>(m.cell_face_start[c + 1] - m.cell_face_start[c]);
+    return mesh;
+}
+
+// The smallest area over summed conductance of any owned cell (1 where no
+// face conducts: nothing ever moves).
+void set_step_scale(Mesh &m) {
+    m.step_scale = 0.0;
+    for (std::int64_t c = 0; c < m.owned; ++c) {
         double sum = 0.0;
         for (std::int64_t k = m.cell_face_start[c]; k < m.cell_face_start[c + 1]; ++k) sum += m.conductance[m.cell_faces[k]];
         if (sum > 0.0 && (m.step_scale == 0.0 || m.area[c] / sum < m.step_scale)) m.step_scale = m.area[c] / sum;
     }
-    if (m.step_scale == 0.0) m.step_scale = 1.0;  // no face conducts: nothing ever moves
+    if (m.step_scale == 0.0) m.step_scale = 1.0;
+}
+
+std::shared_ptr<const Mesh> finish_serial(std::shared_ptr<Mesh> mesh) {
+    Mesh &m = *mesh;
+    const int rings = gradients_over_two_rings(static_cast<std::int64_t>(m.cell_faces.size()), m.cells) ? 2 : 1;
+    gradient_weights(m, rings, {}, {});
+    set_step_scale(m);
     return mesh;
 }
 
@@ -330,11 +362,9 @@ std::size_t end_of_edge(const std::vector<EdgeUse> &edges, std::size_t k, const 
     return end;
 }
 
-}  // namespace
-
-std::shared_ptr<const Mesh> mesh_from_polygons(std::int64_t nnodes, const double *node_xy, std::int64_t ncells,
-                                               const std::int64_t *cell_start, const std::int64_t *cell_nodes,
-                                               const char *function, int base) {
+std::shared_ptr<Mesh> assemble_polygons(std::int64_t nnodes, const double *node_xy, std::int64_t ncells,
+                                        const std::int64_t *cell_start, const std::int64_t *cell_nodes,
+                                        const PartOfMesh *part, const char *function, int base) {
     require_count(nnodes, function, "nnodes");
     require_count(ncells, function, "ncells");
     require_coordinates(node_xy, nnodes, function, "node_xy", "node", base);
@@ -431,13 +461,13 @@ std::shared_ptr<const Mesh> mesh_from_polygons(std::int64_t nnodes, const double
     // host's order, edge by edge in each cell's order.
     std::sort(faces.begin(), faces.end(),
               [](const RawFace &l, const RawFace &r) { return l.a != r.a ? l.a < r.a : l.along < r.along; });
-    return assemble(std::move(input), cells, faces, function, base);
+    return assemble(std::move(input), cells, faces, part, function, base);
 }
 
-std::shared_ptr<const Mesh> mesh_from_graph(std::int64_t ncells, const double *cell_xy, const double *cell_area,
-                                            std::int64_t nfaces, const std::int64_t *face_cells,
-                                            const double *face_xy, const double *face_length, const char *function,
-                                            int base) {
+std::shared_ptr<Mesh> assemble_graph(std::int64_t ncells, const double *cell_xy, const double *cell_area,
+                                     std::int64_t nfaces, const std::int64_t *face_cells, const double *face_xy,
+                                     const double *face_length, const PartOfMesh *part, const char *function,
+                                     int base) {
     require_count(ncells, function, "ncells");
     require_count(nfaces, function, "nfaces");
     require_coordinates(cell_xy, ncells, function, "cell_xy", "cell", base);
@@ -490,6 +520,7 @@ std::shared_ptr<const Mesh> mesh_from_graph(std::int64_t ncells, const double *c
     // A cell is closed when its faces surround its centre: no gap of half a
     // turn or more between the directions to their midpoints.
     for (std::int64_t c = 0; c < ncells; ++c) {
+        if (part && part->ghost[c]) continue;  // a ghost's faces beyond the owned cells need not be given
         std::vector<double> &dir = angles[c];
         std::sort(dir.begin(), dir.end());
         double gap = dir.empty() ? 7.0 : dir.front() + 2.0 * M_PI - dir.back();
@@ -508,7 +539,48 @@ std::shared_ptr<const Mesh> mesh_from_graph(std::int64_t ncells, const double *c
     input.face_cells.assign(face_cells, face_cells + 2 * nfaces);
     input.face_xy.assign(face_xy, face_xy + 2 * nfaces);
     input.face_length.assign(face_length, face_length + nfaces);
-    return assemble(std::move(input), cells, faces, function, base);
+    return assemble(std::move(input), cells, faces, part, function, base);
+}
+
+}  // namespace
+
+std::shared_ptr<const Mesh> mesh_from_polygons(std::int64_t nnodes, const double *node_xy, std::int64_t ncells,
+                                               const std::int64_t *cell_start, const std::int64_t *cell_nodes,
+                                               const char *function, int base) {
+    return finish_serial(assemble_polygons(nnodes, node_xy, ncells, cell_start, cell_nodes, nullptr, function, base));
+}
+
+std::shared_ptr<const Mesh> mesh_from_graph(std::int64_t ncells, const double *cell_xy, const double *cell_area,
+                                            std::int64_t nfaces, const std::int64_t *face_cells,
+                                            const double *face_xy, const double *face_length, const char *function,
+                                            int base) {
+    return finish_serial(
+        assemble_graph(ncells, cell_xy, cell_area, nfaces, face_cells, face_xy, face_length, nullptr, function, base));
+}
+
+std::shared_ptr<Mesh> part_from_polygons(std::int64_t nnodes, const double *node_xy, std::int64_t ncells,
+                                         const std::int64_t *cell_start, const std::int64_t *cell_nodes,
+                                         const PartOfMesh &part, const char *function, int base) {
+    return assemble_polygons(nnodes, node_xy, ncells, cell_start, cell_nodes, &part, function, base);
+}
+
+std::shared_ptr<Mesh> part_from_graph(std::int64_t ncells, const double *cell_xy, const double *cell_area,
+                                      std::int64_t nfaces, const std::int64_t *face_cells, const double *face_xy,
+                                      const double *face_length, const PartOfMesh &part, const char *function,
+                                      int base) {
+    return assemble_graph(ncells, cell_xy, cell_area, nfaces, face_cells, face_xy, face_length, &part, function, base);
+}
+
+bool gradients_over_two_rings(std::int64_t cell_faces, std::int64_t cells) {
+    // Edges count: an upper figure of the neighbours.
+    return static_cast<double>(cell_faces) / static_cast<double>(cells) < 4.0;
+}
+
+void finish_part(Mesh &m, int rings, const std::vector<std::int64_t> &ghost_start,
+                 const std::vector<std::int64_t> &ghost_neighbours, const std::vector<double> &ghost_faces) {
+    gradient_weights(m, rings, ghost_start, ghost_neighbours);
+    for (std::int64_t c = m.owned; c < m.cells; ++c) m.face_count[c] = ghost_faces[c - m.owned];
+    set_step_scale(m);
 }
 
 std::shared_ptr<const Mesh> mesh_from_dual(std::int64_t nnodes, const double *node_xy, std::int64_t ntriangles,
@@ -601,7 +673,7 @@ std::shared_ptr<const Mesh> mesh_from_dual(std::int64_t nnodes, const double *no
         k = end;
     }
     faces.insert(faces.end(), edge_faces.begin(), edge_faces.end());
-    return assemble(std::move(input), cells, faces, function, base);
+    return finish_serial(assemble(std::move(input), cells, faces, nullptr, function, base));
 }
 
 std::shared_ptr<const Mesh> mesh_from_input(const MeshInput &input, const char *function) {

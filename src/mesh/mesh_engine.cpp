@@ -11,6 +11,7 @@
 #include "model/grid.hpp"
 #include "model/ledger.hpp"
 #include "model/threads.hpp"
+#include "mpi/decomposition.hpp"
 #include "stepping/engine.hpp"
 
 namespace dpsm {
@@ -122,8 +123,7 @@ struct FaceLaw {
             // A face takes from its sand cell at most its share of the sand there.
             const std::int64_t up = flux > 0.0 ? a : b;
             if (up >= 0 && kind[up] == kSand) {
-                const double share = static_cast<double>(m.cell_face_start[up + 1] - m.cell_face_start[up]);
-                const double cap = available[up] * m.area[up] / (share * dt);
+                const double cap = available[up] * m.area[up] / (m.face_count[up] * dt);
                 flux = flux > 0.0 ? std::min(flux, cap) : std::max(flux, -cap);
             }
         }
@@ -184,16 +184,20 @@ public:
         s.lists_current = true;
         s.masks_seen = grid.masks_version();
         s.edges_seen = grid.edges_version();
-        // Faces onto a sink: the outflow is summed over them alone, in one order.
+        // Faces onto a sink: the outflow is summed over them alone, in one
+        // order. On a distributed mesh the rank that owns the cell the sand
+        // leaves books it.
         s.sink_faces.clear();
         const std::vector<std::uint8_t> &kind = grid.kinds();
-        for (std::int64_t f = 0; f < m.faces; ++f) {
+        for (std::int64_t f = 0; f < m.live_faces; ++f) {
             const std::int64_t a = m.face_a[f], b = m.face_b[f];
-            if (b < 0 ? grid.edge_open(f) : (kind[a] == kOpen || kind[b] == kOpen)) s.sink_faces.push_back(f);
+            const bool sink = b < 0 ? grid.edge_open(f) : (kind[a] == kOpen || kind[b] == kOpen);
+            const std::int64_t leaves = b >= 0 && kind[a] == kOpen ? b : a;
+            if (sink && leaves < m.owned) s.sink_faces.push_back(f);
         }
         s.source_cells.clear();
         const std::vector<double> &q = grid.source();
-        for (std::int64_t c = 0; c < static_cast<std::int64_t>(q.size()); ++c)
+        for (std::int64_t c = 0; c < std::min<std::int64_t>(m.owned, static_cast<std::int64_t>(q.size())); ++c)
             if (kind[c] == kSand && q[c] != 0.0) s.source_cells.push_back(c);
     }
 
@@ -215,10 +219,17 @@ public:
             info.at_rest = true;
             return;
         }
+        Decomposition *parts = grid.decomposition();
         for (std::int64_t k = 0; k < plan.substeps; ++k) {
             double visited = 0.0;
-            const SubstepSummary did = substep(grid, m, s, plan.sub_dt, record, visited);
+            SubstepSummary did = substep(grid, m, s, plan.sub_dt, record, visited);
             info.cell_updates += visited;
+            if (parts) {
+                // Every rank takes the same sub-steps and stops at the same one.
+                std::vector<SubstepSummary> agreed{did};
+                parts->after_sweep(agreed);
+                did = agreed[0];
+            }
             if (!book(did)) break;
         }
     }
@@ -233,7 +244,10 @@ private:
     SubstepSummary substep(Grid &grid, const Mesh &m, MeshScratch &s, double dt, bool record, double &visited) const {
         MeshActivity &act = grid.mesh_activity();
         const bool physics = grid.hysteresis() || !grid.bed().empty();
-        const bool dense = physics || act.all_hot || visit_all_cells() ||
+        // A part of a distributed mesh visits all its cells (its ghosts' heights
+        // and gradients arrive whole from their owners at every sub-step).
+        Decomposition *parts = grid.decomposition();
+        const bool dense = parts || physics || act.all_hot || visit_all_cells() ||
                            static_cast<double>(act.hot_list.size()) > kDenseShare * static_cast<double>(m.cells);
         std::vector<double> &h = grid.heights_for_stepping();
         std::vector<float> &residual = grid.residuals_for_stepping();
@@ -268,11 +282,13 @@ private:
         bool moved = false;
 
         if (dense) {
-            const std::int64_t n = m.cells, nf = m.faces;
+            // The owned cells and the faces that touch them: all of a serial mesh.
+            const std::int64_t n = m.owned, nf = m.live_faces;
             const bool parallel = threads > 1 && n >= kCellsForThreads;
             if (law.isotropic) {
 #pragma omp parallel for num_threads(threads) if (parallel) schedule(static)
                 for (std::int64_t c = 0; c < n; ++c) gradient_of(m, h.data(), kind.data(), c, s.gx.data(), s.gy.data());
+                if (parts) parts->exchange_ghost_gradients(grid, s.gx.data(), s.gy.data());
             }
             double *flux = s.flux.data();
 #pragma omp parallel for num_threads(threads) if (parallel) schedule(static) reduction(max : max_excess) reduction(|| : moved)
@@ -309,6 +325,7 @@ private:
                 std::vector<std::uint8_t> &moving = grid.moving_for_stepping();
                 for (std::int64_t c = 0; c < n; ++c) moving[c] = kind[c] == kSand && changed[c];
             }
+            if (parts) parts->exchange_ghost_heights(grid);
             // The next sub-step looks at the cells that changed and those whose
             // gradients read them; where that is most of the mesh, at all.
             const std::size_t most = static_cast<std::size_t>(kDenseShare * static_cast<double>(n));
@@ -442,10 +459,10 @@ private:
             double applied = asked;
             if (asked < 0.0) {
                 applied = -std::min(-asked, sand);
-                unmet.add((applied - asked) * m.area[c]);
+                if (c < m.owned) unmet.add((applied - asked) * m.area[c]);
                 sand += applied;
             }
-            sourced.add(applied * m.area[c]);
+            if (c < m.owned) sourced.add(applied * m.area[c]);  // a ghost's owner books it
             s.available[c] = sand > film ? sand : 0.0;
         }
         did.unmet_mass = unmet.value();

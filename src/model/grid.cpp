@@ -101,6 +101,7 @@ void Grid::write_heights(const Block &block, const double *values, bool add) {
             residuals_[c] = 0.0f;
         }
     ledger_.external.add(change.value());
+    ++heights_version_;
     if (open_cells_ > 0) update_open_levels();
     if (active_) active_->mark_block(block.i0, block.j0, block.ni, block.nj);
     if (tiled_ && active_) {
@@ -245,6 +246,7 @@ void Grid::restore(GridState &&s) {
     update_held_levels();
     set_face_flux_recording(s.record_fluxes);
     heights_ = std::move(s.heights);
+    ++heights_version_;
     residuals_ = std::move(s.residuals);
     residual_bounds_ = CellBox{};
     residual_bounds_.add(0, geometry_.nx, 0, geometry_.ny);
@@ -318,6 +320,7 @@ void Grid::lift_to_bed() {
         lifted = true;
     }
     if (!lifted) return;
+    ++heights_version_;
     ledger_.external.add(change.value());
     if (open_cells_ > 0) update_open_levels();
     if (tiled_) tiled_->all_stale = true;
@@ -407,7 +410,7 @@ void Grid::update_held_levels() {
         const std::vector<double> &levels = side_levels_[0];
         bool any = false;
         double lo = 0.0, hi = 0.0;
-        for (std::int64_t f = 0; f < mesh.faces; ++f) {
+        for (std::int64_t f = 0; f < mesh.live_faces; ++f) {
             if (mesh.face_b[f] >= 0 || !edge_open(f)) continue;
             const double level = levels.empty() ? 0.0 : levels[f];
             lo = any ? std::min(lo, level) : level;

@@ -49,8 +49,9 @@ struct Geometry {
     bool tiled() const { return dim == 2 && !mesh; }
     // The area (1D: length; axisymmetric: the ring's area 2 pi r dr) that
     // turns a cell's height into its mass.
+    // A ghost of a distributed mesh weighs nothing here: its owner counts it.
     double cell_area(std::int64_t c) const {
-        if (mesh) return mesh->area[static_cast<std::size_t>(c)];
+        if (mesh) return c < mesh->owned ? mesh->area[static_cast<std::size_t>(c)] : 0.0;
         return axisymmetric ? kTwoPi * (static_cast<double>(c) + 0.5) * dx * dx : dx * dy;
     }
     // The length (axisymmetric: circumference) of the x face on the high side
@@ -333,6 +334,8 @@ public:
     // Changes whenever the host sets cell kinds or sources: a distributed grid
     // refreshes its halo's copies of them when it does.
     std::uint64_t masks_version() const { return masks_version_; }
+    // Counts the host's writes of heights (and a bed lifting them).
+    std::uint64_t heights_version() const { return heights_version_; }
     // Changes whenever the host sets side levels: a distributed grid then
     // assembles the levels along the global domain's sides again.
     std::uint64_t side_levels_version() const { return side_levels_version_; }
@@ -398,6 +401,7 @@ private:
     StepInfo last_step_;
     std::unique_ptr<Decomposition> decomposition_;
     std::uint64_t masks_version_ = 0;
+    std::uint64_t heights_version_ = 0;
     std::uint64_t side_levels_version_ = 0;
 };
 

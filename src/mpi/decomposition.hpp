@@ -94,6 +94,7 @@ struct StepAgreement {
     bool may_move = false;        // some tile anywhere is hot or has a source
     double open_level_min = 0.0, open_level_max = 0.0;  // over all open cells (when there are any)
     double side_level_min = 0.0, side_level_max = 0.0;  // over the levels beyond the open sides (0 where none)
+    bool any_side_open = false;  // a side, or a face of a mesh's domain edge, is open
 };
 
 class Decomposition {
@@ -117,6 +118,12 @@ public:
     virtual void before_sweep(Grid &grid) = 0;
     // Collective, after each sweep: moved and max_excess_slope of every level over all ranks.
     virtual void after_sweep(std::vector<SubstepSummary> &levels) = 0;
+    // A distributed mesh's hooks (mpi/distributed_mesh.cpp), collective, in
+    // every sub-step: the ghosts' gradients from their owners once the owned
+    // cells' are known, and the ghosts' heights (and moving flags) once the
+    // owned cells changed. Nothing on a block of a grid.
+    virtual void exchange_ghost_gradients(Grid &, double * /*gx*/, double * /*gy*/) {}
+    virtual void exchange_ghost_heights(Grid &) {}
     // Collective: the sum over all ranks, the same on every rank.
     virtual double sum(double local) const = 0;
     // Collective: as sum(), for a call that a rank may have refused (its

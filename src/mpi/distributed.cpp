@@ -40,6 +40,7 @@
 #include <vector>
 
 #include "structured/active_set.hpp"
+#include "mpi/collective.hpp"
 #include "mpi/decomposition.hpp"
 #include "dpsm/dpsm.h"
 #include "dpsm/dpsm_mpi.h"
@@ -78,14 +79,6 @@ std::string describe(const Rect &r) {
     return s.str();
 }
 
-void check_mpi(int code, const char *what) {
-    if (code == MPI_SUCCESS) return;
-    char text[MPI_MAX_ERROR_STRING];
-    int length = 0;
-    MPI_Error_string(code, text, &length);
-    throw Error(DPSM_ERR_INTERNAL, std::string("dpsm (MPI): ") + what + " failed: " + std::string(text, length));
-}
-
 // One rank whose cells this block reads, or which reads this block's cells
 // (always both: the halo is as deep both ways).
 struct Neighbour {
@@ -97,11 +90,11 @@ struct Neighbour {
     std::vector<double> send_buffer, receive_buffer;
 };
 
-class MpiDecomposition final : public Decomposition {
+class MpiDecomposition final : public CollectiveDecomposition {
 public:
     MpiDecomposition(MPI_Comm comm, int rank, const std::vector<Rect> &blocks, std::int64_t global_nx,
                      std::int64_t global_ny)
-        : comm_(comm), block_(blocks[static_cast<std::size_t>(rank)]) {
+        : CollectiveDecomposition(comm), block_(blocks[static_cast<std::size_t>(rank)]) {
         halo_.resize(kHaloDepth, block_.ni, block_.nj);
         halo_.i0 = block_.i0;
         halo_.j0 = block_.j0;
@@ -124,77 +117,20 @@ public:
         requests_.resize(2 * neighbours_.size());
     }
 
-    ~MpiDecomposition() override {
-        int finalized = 0;
-        MPI_Finalized(&finalized);
-        if (!finalized) MPI_Comm_free(&comm_);
-    }
-
     StepAgreement agree_before_step(Grid &grid, double dt, bool refused) override {
         // Everything as a maximum: minima are maxima of the negated values.
         const double none = -std::numeric_limits<double>::infinity();
         const bool open = grid.has_open_cells();
-        std::vector<double> v = {grid.source_active() ? 1.0 : 0.0,
-                                 open ? 1.0 : 0.0,
-                                 grid.active_set().may_move() ? 1.0 : 0.0,
-                                 grid.masks_version() != exchanged_masks_ ? 1.0 : 0.0,
-                                 open ? -grid.open_level_min() : none,
-                                 open ? grid.open_level_max() : none};
-        v.push_back(-grid.own_min_repose_angle());
-        v.push_back(refused ? 1.0 : 0.0);
-        v.push_back(grid.side_levels_version() != exchanged_levels_ ? 1.0 : 0.0);
-        const std::size_t first_parameter = v.size();
-        const double parameters[] = {refused ? 0.0 : dt,
-                                     grid.repose_angle(),
-                                     grid.mobility(),
-                                     grid.rest_tolerance(),
-                                     static_cast<double>(grid.scheme()),
-                                     static_cast<double>(grid.max_substeps()),
-                                     grid.side_open(kXMin) ? 1.0 : 0.0,
-                                     grid.side_open(kXMax) ? 1.0 : 0.0,
-                                     grid.side_open(kYMin) ? 1.0 : 0.0,
-                                     grid.side_open(kYMax) ? 1.0 : 0.0,
-                                     // Every block must run the same kernel on its shared faces.
-                                     grid.bed().empty() ? 0.0 : 1.0,
-                                     grid.angle_field().empty() ? 0.0 : 1.0,
-                                     grid.flux_exponent(),
-                                     grid.static_angle()};
-        for (double p : parameters) {
-            v.push_back(p);
-            v.push_back(-p);
-        }
-        check_mpi(MPI_Allreduce(MPI_IN_PLACE, v.data(), static_cast<int>(v.size()), MPI_DOUBLE, MPI_MAX, comm_),
-                  "MPI_Allreduce before dpsm_step");
-        if (v[7] != 0.0)
-            throw Error(DPSM_ERR_INVALID_VALUE,
-                        "dpsm_step: another rank of the distributed grid refused the step (its dt is not finite "
-                        "or not positive, or it was set to DPSM_RELAX_TO_REST), so no rank stepped; every rank "
-                        "must step the same dt");
-        static const char *const names[] = {"dt",         "the repose angle (dpsm_set_repose_angle)",
-                                            "the mobility (dpsm_set_mobility)",
-                                            "the rest tolerance (dpsm_set_rest_tolerance)",
-                                            "the scheme (dpsm_set_scheme)",
-                                            "the sub-step limit (dpsm_set_max_substeps)",
-                                            "side DPSM_XMIN (dpsm_set_boundary)", "side DPSM_XMAX (dpsm_set_boundary)",
-                                            "side DPSM_YMIN (dpsm_set_boundary)", "side DPSM_YMAX (dpsm_set_boundary)",
-                                            "whether they have a bed (dpsm_set_bedrock, on every rank or none)",
-                                            "whether they have an angle field (dpsm_set_repose_angle_field, on "
-                                            "every rank or none)",
-                                            "the flux exponent (dpsm_set_flux_exponent)",
-                                            "the static angle (dpsm_set_static_angle)"};
-        for (std::size_t k = 0; k < sizeof(parameters) / sizeof(parameters[0]); ++k) {
-            const double hi = v[first_parameter + 2 * k], lo = -v[first_parameter + 2 * k + 1];
-            if (hi != lo) {
-                std::ostringstream msg;
-                msg.precision(17);
-                msg << "dpsm_step: the ranks of the distributed grid differ in " << names[k] << " (from " << lo
-                    << " to " << hi << "); every rank must step the same dt with the same parameters";
-                throw Error(DPSM_ERR_INVALID_VALUE, msg.str());
-            }
-        }
+        const std::vector<double> v =
+            agree_on_step(grid, dt, refused,
+                          {grid.source_active() ? 1.0 : 0.0, open ? 1.0 : 0.0,
+                           grid.active_set().may_move() ? 1.0 : 0.0,
+                           grid.masks_version() != exchanged_masks_ ? 1.0 : 0.0, open ? -grid.open_level_min() : none,
+                           open ? grid.open_level_max() : none, -grid.own_min_repose_angle(),
+                           grid.side_levels_version() != exchanged_levels_ ? 1.0 : 0.0});
         grid.set_distributed_min_repose_angle(-v[6]);
         if (v[3] != 0.0) exchange_masks(grid);
-        if (v[8] != 0.0) assemble_side_levels(grid);
+        if (v[7] != 0.0) assemble_side_levels(grid);
         StepAgreement state;
         state.source_active = v[0] != 0.0;
         // Lazy sources (structured/tiled_sweep.hpp): the halo carries each cell's clock.
@@ -209,6 +145,7 @@ public:
         const SideLevelRange range = side_level_range(open_sides, halo_.side_levels);
         state.side_level_min = range.lowest;
         state.side_level_max = range.highest;
+        state.any_side_open = grid.any_side_open();  // the sides are agreed on
         return state;
     }
 
@@ -284,82 +221,6 @@ public:
             }
         }
         active.set_remote_activity(remote_hot_, remote_sources_);
-    }
-
-    void after_sweep(std::vector<SubstepSummary> &levels) override {
-        std::vector<double> v;
-        for (const SubstepSummary &level : levels) {
-            v.push_back(level.moved ? 1.0 : 0.0);
-            v.push_back(level.max_excess_slope);
-        }
-        check_mpi(MPI_Allreduce(MPI_IN_PLACE, v.data(), static_cast<int>(v.size()), MPI_DOUBLE, MPI_MAX, comm_),
-                  "MPI_Allreduce after a sweep");
-        for (std::size_t s = 0; s < levels.size(); ++s) {
-            levels[s].moved = v[2 * s] != 0.0;
-            levels[s].max_excess_slope = v[2 * s + 1];
-        }
-    }
-
-    bool sum_unless_refused(double local, bool refused, double &total) const override {
-        std::vector<double> mine = {refused ? 0.0 : local, refused ? 1.0 : 0.0}, all(2 * static_cast<std::size_t>(ranks()));
-        check_mpi(MPI_Allgather(mine.data(), 2, MPI_DOUBLE, all.data(), 2, MPI_DOUBLE, comm_),
-                  "MPI_Allgather of a sum");
-        CompensatedSum sum;
-        bool any_refused = false;
-        for (std::size_t r = 0; r < all.size(); r += 2) {
-            sum.add(all[r]);
-            any_refused = any_refused || all[r + 1] != 0.0;
-        }
-        total = sum.value();
-        return !any_refused;
-    }
-
-    double sum(double local) const override {
-        double total = 0.0;
-        sum_unless_refused(local, false, total);
-        return total;
-    }
-
-    int rank() const override {
-        int rank = 0;
-        MPI_Comm_rank(comm_, &rank);
-        return rank;
-    }
-
-    int ranks() const override {
-        int size = 1;
-        MPI_Comm_size(comm_, &size);
-        return size;
-    }
-
-    std::uint64_t shared_mark() const override {
-        std::uint64_t mark = 0;
-        if (rank() == 0) {
-            // The clock alone would do between saves of one run; the random
-            // bits tell apart runs that save at the same instant.
-            mark = static_cast<std::uint64_t>(std::chrono::system_clock::now().time_since_epoch().count());
-            try {
-                std::random_device device;
-                mark ^= (static_cast<std::uint64_t>(device()) << 32) ^ device();
-            } catch (const std::exception &) {
-                // No random device here: the clock's mark stands.
-            }
-        }
-        check_mpi(MPI_Bcast(&mark, 1, MPI_UINT64_T, 0, comm_), "MPI_Bcast of the save's mark");
-        return mark;
-    }
-
-    void first_failure(int status, int &failed_rank, int &failed_status) const override {
-        std::vector<int> all(static_cast<std::size_t>(ranks()));
-        check_mpi(MPI_Allgather(&status, 1, MPI_INT, all.data(), 1, MPI_INT, comm_), "MPI_Allgather of the statuses");
-        failed_rank = -1;
-        failed_status = DPSM_OK;
-        for (std::size_t r = 0; r < all.size(); ++r)
-            if (all[r] != DPSM_OK) {
-                failed_rank = static_cast<int>(r);
-                failed_status = all[r];
-                return;
-            }
     }
 
 private:
@@ -451,7 +312,6 @@ private:
         exchanged_masks_ = grid.masks_version();
     }
 
-    MPI_Comm comm_;
     Rect block_;
     std::vector<Neighbour> neighbours_;
     std::vector<MPI_Request> requests_;
@@ -550,22 +410,6 @@ void check_decomposition(const std::vector<Arguments> &all, const char *fn) {
     }
 }
 
-// Checks that MPI is running and `comm` is an intracommunicator; its rank and size.
-void check_communicator(MPI_Comm comm, const char *fn, int &rank, int &size) {
-    int initialized = 0, finalized = 0;
-    MPI_Initialized(&initialized);
-    MPI_Finalized(&finalized);
-    if (!initialized || finalized)
-        fail(DPSM_ERR_INVALID_VALUE, fn, "MPI is ", finalized ? "finalized" : "not initialized", "; call ", fn,
-             " between MPI_Init and MPI_Finalize");
-    if (comm == MPI_COMM_NULL) fail(DPSM_ERR_INVALID_VALUE, fn, "comm is MPI_COMM_NULL");
-    int inter = 0;
-    check_mpi(MPI_Comm_test_inter(comm, &inter), "MPI_Comm_test_inter");
-    if (inter) fail(DPSM_ERR_INVALID_VALUE, fn, "comm is an intercommunicator; pass an intracommunicator");
-    check_mpi(MPI_Comm_rank(comm, &rank), "MPI_Comm_rank");
-    check_mpi(MPI_Comm_size(comm, &size), "MPI_Comm_size");
-}
-
 // Gathers every rank's arguments and checks them together, so that all fail alike.
 std::vector<Rect> agreed_blocks(MPI_Comm comm, int size, const Arguments &mine, const char *fn) {
     std::vector<Arguments> all(static_cast<std::size_t>(size));
@@ -604,29 +448,6 @@ dpsm_grid *distributed_grid(MPI_Comm comm, int rank, const std::vector<Rect> &bl
         throw;
     }
     return made.release();
-}
-
-// Runs `body` (which makes a grid without a handle to report on) and turns
-// whatever it throws into a status and the message of dpsm_last_error(NULL).
-template <class Body>
-int without_grid(const char *fn, Body &&body) noexcept {
-    try {
-        body();
-        set_error_without_grid("");
-        return DPSM_OK;
-    } catch (const Error &e) {
-        set_error_without_grid(e.what());
-        return e.status();
-    } catch (const std::bad_alloc &) {
-        set_error_without_grid((std::string(fn) + ": out of memory").c_str());
-        return DPSM_ERR_OUT_OF_MEMORY;
-    } catch (const std::exception &e) {
-        set_error_without_grid(e.what());
-        return DPSM_ERR_INTERNAL;
-    } catch (...) {
-        set_error_without_grid("dpsm: internal error of unknown kind");
-        return DPSM_ERR_INTERNAL;
-    }
 }
 
 int create_distributed(MPI_Comm comm, std::int64_t nx_global, std::int64_t ny_global, std::int64_t i0,

@@ -32,9 +32,9 @@ void begin_face_fluxes(Grid &grid) {
 // held level (open cells, and the outside of open sides) is the same L: the
 // surface must come to rest. Held levels that differ can keep sand flowing
 // between them forever.
-bool can_flow_forever(const Grid &grid, const StepAgreement &state, bool driven) {
+bool can_flow_forever(const StepAgreement &state, bool driven) {
     if (driven) return true;
-    const bool any_side_open = grid.any_side_open();
+    const bool any_side_open = state.any_side_open;
     if (!state.has_open_cells && !any_side_open) return false;
     double lowest = state.has_open_cells ? state.open_level_min : state.side_level_min;
     double highest = state.has_open_cells ? state.open_level_max : state.side_level_max;
@@ -98,6 +98,7 @@ StepAgreement agree_before_step(Grid &grid, double dt) {
     state.open_level_max = grid.open_level_max();
     state.side_level_min = grid.side_level_min();
     state.side_level_max = grid.side_level_max();
+    state.any_side_open = grid.any_side_open();
     return state;
 }
 
@@ -111,8 +112,10 @@ void step(Grid &grid, double dt) {
         return;
     }
     // Not on a distributed grid (relax_to_rest refuses it): its peers may
-    // be waiting in the step's first agreement, so take part, refusing.
-    if (Decomposition *decomposition = grid.decomposition()) {
+    // be waiting in the step's first agreement, so take part, refusing. A
+    // mesh relaxes by time-accurate sub-steps to rest, which its parts take together.
+    Decomposition *decomposition = grid.decomposition();
+    if (decomposition && !grid.geometry().is_mesh()) {
         try {
             decomposition->agree_before_step(grid, 0.0, true);
         } catch (const Error &) {
@@ -169,7 +172,7 @@ void step_in_time(Grid &grid, double dt, std::int64_t most) {
         if (lazy) driven = grid.global_sum(steep_at_end ? 1.0 : 0.0) > 0.0;  // collective on a distributed grid
     }
     plan.something_may_move = driven || state.may_move;
-    if (can_flow_forever(grid, state, driven) && (!bounded || needed > static_cast<double>(grid.max_substeps()))) {
+    if (can_flow_forever(state, driven) && (!bounded || needed > static_cast<double>(grid.max_substeps()))) {
         engine.forget_driven(grid);
         std::ostringstream msg;
         msg << "dpsm_step: dt = " << dt << " needs " << needed << " sub-steps of at most " << dt_max

@@ -1,0 +1,638 @@
+// The MPI component's distributed meshes (include/dpsm/dpsm_mpi.h): a mesh as
+// one rank's part, the cells it owns and the ghost cells around them that
+// other ranks own. The mesh engine runs the part as it runs any mesh, over
+// its owned cells and the faces that touch them (mesh/mesh_engine.cpp); this
+// file is its Decomposition (mpi/decomposition.hpp):
+//
+//  - construction: every rank builds its part (mesh/mesh.cpp), then the ranks
+//    check together that the owners agree (each global id owned once, every
+//    ghost held by the rank that claims to own it, faces seen alike from both
+//    sides), learn each ghost's neighbours and face count from its owner, and
+//    agree on what a serial mesh decides over all cells (one or two rings of
+//    neighbours for the gradients, the sub-step's scale, the smallest face
+//    distance). Each cell's faces and gradient neighbours are summed in the
+//    order of their global ids, so an owned cell is computed from the same
+//    values by the same arithmetic as in the serial mesh: bit for bit;
+//  - sub-steps: two neighbourhood exchanges over a distributed-graph
+//    communicator, with the ranks that own this part's ghosts or hold its
+//    cells as ghosts only: the owned cells' gradients (for the faces between
+//    an owned cell and a ghost) and, after the update, their heights;
+//  - agreement: one MAX all-reduce before a step (parameters, flags, and
+//    whether a host changed heights or masks anywhere, which then go to the
+//    ghosts), one after each sub-step, and gathers for sums.
+#include <mpi.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <memory>
+#include <sstream>
+#include <string>
+#include <unordered_map>
+#include <utility>
+#include <vector>
+
+#include "api/handle.hpp"
+#include "dpsm/dpsm.h"
+#include "dpsm/dpsm_mpi.h"
+#include "mesh/mesh.hpp"
+#include "model/error.hpp"
+#include "model/grid.hpp"
+#include "mpi/collective.hpp"
+#include "mpi/decomposition.hpp"
+
+namespace dpsm {
+namespace {
+
+// Cells this rank sends to (or receives from) each neighbouring rank, as
+// library indices, each rank's in ascending global id: the order both sides
+// of an exchange agree on without telling each other.
+struct CellLists {
+    std::vector<int> ranks;  // ascending
+    std::vector<int> counts, offsets;
+    std::vector<std::int64_t> cells;
+
+    void add(int rank, std::vector<std::int64_t> list) {
+        ranks.push_back(rank);
+        offsets.push_back(static_cast<int>(cells.size()));
+        counts.push_back(static_cast<int>(list.size()));
+        cells.insert(cells.end(), list.begin(), list.end());
+    }
+};
+
+// The first failure of any rank, told to every rank: each passes its own
+// status and message; when any failed, every rank throws the lowest failing
+// rank's status, with its message (the others add which rank it was).
+void agree_or_throw(MPI_Comm comm, int status, const std::string &message, const char *fn) {
+    int rank = 0, size = 1;
+    MPI_Comm_rank(comm, &rank);
+    MPI_Comm_size(comm, &size);
+    std::vector<int> statuses(static_cast<std::size_t>(size));
+    check_mpi(MPI_Allgather(&status, 1, MPI_INT, statuses.data(), 1, MPI_INT, comm), "MPI_Allgather of the statuses");
+    int first = -1;
+    for (int r = 0; r < size && first < 0; ++r)
+        if (statuses[static_cast<std::size_t>(r)] != DPSM_OK) first = r;
+    if (first < 0) return;
+    int length = rank == first ? static_cast<int>(message.size()) : 0;
+    check_mpi(MPI_Bcast(&length, 1, MPI_INT, first, comm), "MPI_Bcast of a message");
+    std::string text = rank == first ? message : std::string(static_cast<std::size_t>(length), ' ');
+    check_mpi(MPI_Bcast(&text[0], length, MPI_CHAR, first, comm), "MPI_Bcast of a message");
+    if (rank == first) throw Error(statuses[static_cast<std::size_t>(first)], text);
+    const std::string prefix = std::string(fn) + ": ";
+    if (text.compare(0, prefix.size(), prefix) == 0) text = text.substr(prefix.size());
+    throw Error(statuses[static_cast<std::size_t>(first)], std::string(fn) + ": on rank " + std::to_string(first) +
+                                                              ": " + text);
+}
+
+// Runs `body`, which may throw Error, on this rank; then every rank learns
+// whether any failed and throws alike.
+template <class Body>
+void on_every_rank(MPI_Comm comm, const char *fn, Body &&body) {
+    int status = DPSM_OK;
+    std::string message;
+    try {
+        body();
+    } catch (const Error &e) {
+        status = e.status();
+        message = e.what();
+    } catch (const std::bad_alloc &) {
+        status = DPSM_ERR_OUT_OF_MEMORY;
+        message = std::string(fn) + ": out of memory for this rank's part";
+    }
+    agree_or_throw(comm, status, message, fn);
+}
+
+// Sends each rank r the values `to[r]` and returns what every rank sent this
+// one, by rank (an all-to-all of counts, then of the values).
+std::vector<std::vector<std::int64_t>> all_to_all(MPI_Comm comm, const std::vector<std::vector<std::int64_t>> &to) {
+    const int size = static_cast<int>(to.size());
+    std::vector<int> send_counts(static_cast<std::size_t>(size)), receive_counts(static_cast<std::size_t>(size));
+    std::vector<int> send_offsets(static_cast<std::size_t>(size)), receive_offsets(static_cast<std::size_t>(size));
+    std::vector<std::int64_t> out;
+    for (int r = 0; r < size; ++r) {
+        send_offsets[static_cast<std::size_t>(r)] = static_cast<int>(out.size());
+        send_counts[static_cast<std::size_t>(r)] = static_cast<int>(to[static_cast<std::size_t>(r)].size());
+        out.insert(out.end(), to[static_cast<std::size_t>(r)].begin(), to[static_cast<std::size_t>(r)].end());
+    }
+    check_mpi(MPI_Alltoall(send_counts.data(), 1, MPI_INT, receive_counts.data(), 1, MPI_INT, comm),
+              "MPI_Alltoall of counts");
+    int total = 0;
+    for (int r = 0; r < size; ++r) {
+        receive_offsets[static_cast<std::size_t>(r)] = total;
+        total += receive_counts[static_cast<std::size_t>(r)];
+    }
+    std::vector<std::int64_t> in(static_cast<std::size_t>(total));
+    check_mpi(MPI_Alltoallv(out.data(), send_counts.data(), send_offsets.data(), MPI_INT64_T, in.data(),
+                            receive_counts.data(), receive_offsets.data(), MPI_INT64_T, comm),
+              "MPI_Alltoallv");
+    std::vector<std::vector<std::int64_t>> from(static_cast<std::size_t>(size));
+    for (int r = 0; r < size; ++r) {
+        const auto begin = in.begin() + receive_offsets[static_cast<std::size_t>(r)];
+        from[static_cast<std::size_t>(r)].assign(begin, begin + receive_counts[static_cast<std::size_t>(r)]);
+    }
+    return from;
+}
+
+// A cell for messages: the host's number on this rank and its global id.
+std::string name_cell(const Mesh &m, std::int64_t c) {
+    const int base = m.input.start_index;
+    return "cell " + std::to_string(m.host_cell[static_cast<std::size_t>(c)] + base) + " (global id " +
+           std::to_string(m.global_id[static_cast<std::size_t>(c)] + base) + ")";
+}
+
+// What the ranks learn about a part when they make it, beyond the part itself.
+struct PartLinks {
+    CellLists send_heights, receive_heights;      // every ghost
+    CellLists send_gradients, receive_gradients;  // the ghosts across a face from an owned cell
+    std::int64_t global_cells = 0;
+};
+
+// Checks the owners and the ghosts of all ranks' parts together, learns each
+// ghost's neighbours and faces from its owner, and finishes the part as the
+// serial mesh of all cells would be. Collective; throws on every rank alike.
+PartLinks link_parts(MPI_Comm comm, Mesh &m, const std::vector<int> &owner_of_cell, const char *fn) {
+    int rank = 0, size = 1;
+    MPI_Comm_rank(comm, &rank);
+    MPI_Comm_size(comm, &size);
+    const std::size_t ranks = static_cast<std::size_t>(size);
+    PartLinks links;
+    std::int64_t sums[2] = {m.owned, m.cell_face_start[static_cast<std::size_t>(m.owned)]};
+    check_mpi(MPI_Allreduce(MPI_IN_PLACE, sums, 2, MPI_INT64_T, MPI_SUM, comm), "MPI_Allreduce of the cell counts");
+    links.global_cells = sums[0];
+    const std::int64_t n_global = sums[0];
+
+    // Each global id in [0, n_global), owned once, its ghosts held by their owner:
+    // checked at a home rank for every id (id % size).
+    on_every_rank(comm, fn, [&] {
+        for (std::int64_t c = 0; c < m.cells; ++c)
+            if (m.global_id[c] >= n_global)
+                fail(DPSM_ERR_INVALID_VALUE, fn, name_cell(m, c), ": its global id is beyond ",
+                     n_global - 1 + m.input.start_index, "; the ", n_global, " cells the ranks own are numbered from ",
+                     m.input.start_index, " without gaps");
+    });
+    const int base = m.input.start_index;
+    std::vector<std::vector<std::int64_t>> claims(ranks);
+    for (std::int64_t c = 0; c < m.cells; ++c) {
+        auto &to = claims[static_cast<std::size_t>(m.global_id[c] % size)];
+        to.push_back(m.global_id[c]);
+        to.push_back(owner_of_cell[static_cast<std::size_t>(c)]);
+    }
+    const std::vector<std::vector<std::int64_t>> at_home = all_to_all(comm, claims);
+    on_every_rank(comm, fn, [&] {
+        std::unordered_map<std::int64_t, int> owner;
+        for (int r = 0; r < size; ++r) {
+            const std::vector<std::int64_t> &v = at_home[static_cast<std::size_t>(r)];
+            for (std::size_t k = 0; k < v.size(); k += 2) {
+                if (v[k + 1] != r) continue;
+                const auto placed = owner.emplace(v[k], r);
+                if (!placed.second)
+                    fail(DPSM_ERR_INVALID_VALUE, fn, "the cell of global id ", v[k] + base, " is owned by rank ",
+                         placed.first->second, " and by rank ", r, "; every cell has one owner");
+            }
+        }
+        for (int r = 0; r < size; ++r) {
+            const std::vector<std::int64_t> &v = at_home[static_cast<std::size_t>(r)];
+            for (std::size_t k = 0; k < v.size(); k += 2) {
+                if (v[k + 1] == r) continue;
+                const auto found = owner.find(v[k]);
+                if (found == owner.end())
+                    fail(DPSM_ERR_INVALID_VALUE, fn, "rank ", r, " holds the cell of global id ", v[k] + base,
+                         " as a ghost of rank ", v[k + 1], ", which does not own it; no rank does");
+                if (found->second != v[k + 1])
+                    fail(DPSM_ERR_INVALID_VALUE, fn, "rank ", r, " holds the cell of global id ", v[k] + base,
+                         " as a ghost of rank ", v[k + 1], ", but rank ", found->second, " owns it");
+            }
+        }
+    });
+
+    // Which ghosts lie across a face from an owned cell (the first layer).
+    std::vector<std::uint8_t> first_layer(static_cast<std::size_t>(m.cells), 0);
+    for (std::int64_t f = 0; f < m.live_faces; ++f)
+        if (m.face_b[f] >= m.owned) first_layer[static_cast<std::size_t>(m.face_b[f])] = 1;
+    // Each ghost asked of its owner, in ascending global id: its faces over the
+    // whole mesh and the global ids of the cells across them.
+    std::vector<std::vector<std::int64_t>> asked(ranks);
+    std::vector<std::vector<std::int64_t>> ghosts_of(ranks);  // library indices, the same order
+    {
+        std::vector<std::int64_t> ghosts;
+        for (std::int64_t c = m.owned; c < m.cells; ++c) ghosts.push_back(c);
+        std::sort(ghosts.begin(), ghosts.end(), [&](std::int64_t l, std::int64_t r) { return m.global_id[l] < m.global_id[r]; });
+        for (const std::int64_t c : ghosts) {
+            const std::size_t o = static_cast<std::size_t>(owner_of_cell[static_cast<std::size_t>(c)]);
+            asked[o].push_back(m.global_id[c]);
+            asked[o].push_back(first_layer[static_cast<std::size_t>(c)]);
+            ghosts_of[o].push_back(c);
+        }
+    }
+    const std::vector<std::vector<std::int64_t>> requests = all_to_all(comm, asked);
+    std::unordered_map<std::int64_t, std::int64_t> local_of_id;
+    local_of_id.reserve(static_cast<std::size_t>(m.cells));
+    for (std::int64_t c = 0; c < m.cells; ++c) local_of_id.emplace(m.global_id[c], c);
+    std::vector<std::vector<std::int64_t>> answers(ranks);
+    for (int r = 0; r < size; ++r) {
+        const std::vector<std::int64_t> &v = requests[static_cast<std::size_t>(r)];
+        std::vector<std::int64_t> heights, gradients;
+        std::vector<std::int64_t> &out = answers[static_cast<std::size_t>(r)];
+        for (std::size_t k = 0; k < v.size(); k += 2) {
+            const std::int64_t c = local_of_id.at(v[k]);  // owned here: checked at home above
+            heights.push_back(c);
+            if (v[k + 1]) gradients.push_back(c);
+            const std::int64_t k0 = m.cell_face_start[c], k1 = m.cell_face_start[c + 1];
+            out.push_back(k1 - k0);
+            std::int64_t across = 0;
+            for (std::int64_t j = k0; j < k1; ++j) across += m.other[j] >= 0;
+            out.push_back(across);
+            for (std::int64_t j = k0; j < k1; ++j)
+                if (m.other[j] >= 0) out.push_back(m.global_id[m.other[j]]);
+        }
+        if (!heights.empty()) links.send_heights.add(r, heights);
+        if (!heights.empty()) links.send_gradients.add(r, gradients);
+    }
+    const std::vector<std::vector<std::int64_t>> told = all_to_all(comm, answers);
+
+    // The ghosts' neighbours as library indices (-1: not on this rank); faces
+    // seen alike from both sides; the second ring complete where it is used.
+    const int rings = gradients_over_two_rings(sums[1], n_global) ? 2 : 1;
+    const std::size_t nghosts = static_cast<std::size_t>(m.cells - m.owned);
+    std::vector<std::int64_t> ghost_start(nghosts + 1, 0), ghost_neighbours;
+    std::vector<double> ghost_faces(nghosts, 0.0);
+    std::vector<std::vector<std::int64_t>> neighbours_of(nghosts);
+    on_every_rank(comm, fn, [&] {
+        for (int r = 0; r < size; ++r) {
+            const std::vector<std::int64_t> &v = told[static_cast<std::size_t>(r)];
+            std::size_t k = 0;
+            for (const std::int64_t c : ghosts_of[static_cast<std::size_t>(r)]) {
+                const std::size_t g = static_cast<std::size_t>(c - m.owned);
+                ghost_faces[g] = static_cast<double>(v[k]);
+                const std::int64_t across = v[k + 1];
+                for (std::int64_t j = 0; j < across; ++j) {
+                    const auto found = local_of_id.find(v[k + 2 + static_cast<std::size_t>(j)]);
+                    neighbours_of[g].push_back(found == local_of_id.end() ? -1 : found->second);
+                }
+                k += 2 + static_cast<std::size_t>(across);
+                // The faces its owner gives this ghost with cells owned here are faces here too.
+                for (const std::int64_t n : neighbours_of[g])
+                    if (n >= 0 && n < m.owned) {
+                        bool face = false;
+                        for (std::int64_t j = m.cell_face_start[n]; j < m.cell_face_start[n + 1]; ++j)
+                            face = face || m.other[j] == c;
+                        if (!face)
+                            fail(DPSM_ERR_INVALID_VALUE, fn, "rank ", r, ", the owner of ghost ", name_cell(m, c),
+                                 ", gives it a face with owned ", name_cell(m, n), ", which this rank does not have");
+                    }
+            }
+        }
+        for (std::int64_t c = 0; c < m.owned; ++c)
+            for (std::int64_t j = m.cell_face_start[c]; j < m.cell_face_start[c + 1]; ++j) {
+                const std::int64_t n = m.other[j];
+                if (n < m.owned) continue;
+                const std::vector<std::int64_t> &of_n = neighbours_of[static_cast<std::size_t>(n - m.owned)];
+                if (std::find(of_n.begin(), of_n.end(), c) == of_n.end())
+                    fail(DPSM_ERR_INVALID_VALUE, fn, "owned ", name_cell(m, c), " has a face with ghost ",
+                         name_cell(m, n), ", which the ghost's owner, rank ", owner_of_cell[static_cast<std::size_t>(n)],
+                         ", does not have");
+                if (rings < 2) continue;
+                for (const std::int64_t far : of_n)
+                    if (far < 0)
+                        fail(DPSM_ERR_INVALID_VALUE, fn, "the neighbourhood of owned ", name_cell(m, c),
+                             " is incomplete: its gradient reads the cells within two faces, and ghost ",
+                             name_cell(m, n), " has a neighbour that this rank does not hold; on meshes whose "
+                             "cells have fewer than 4 faces on average dpsm needs two layers of ghost cells");
+            }
+    });
+    for (std::size_t g = 0; g < nghosts; ++g) {
+        ghost_neighbours.insert(ghost_neighbours.end(), neighbours_of[g].begin(), neighbours_of[g].end());
+        ghost_start[g + 1] = static_cast<std::int64_t>(ghost_neighbours.size());
+    }
+    finish_part(m, rings, ghost_start, ghost_neighbours, ghost_faces);
+    double smallest[2] = {m.step_scale, m.min_distance};
+    check_mpi(MPI_Allreduce(MPI_IN_PLACE, smallest, 2, MPI_DOUBLE, MPI_MIN, comm), "MPI_Allreduce of the scales");
+    m.step_scale = smallest[0];
+    m.min_distance = smallest[1];
+
+    for (int r = 0; r < size; ++r) {
+        const std::vector<std::int64_t> &ghosts = ghosts_of[static_cast<std::size_t>(r)];
+        if (ghosts.empty()) continue;
+        std::vector<std::int64_t> across;
+        for (const std::int64_t c : ghosts)
+            if (first_layer[static_cast<std::size_t>(c)]) across.push_back(c);
+        links.receive_heights.add(r, ghosts);
+        links.receive_gradients.add(r, across);
+    }
+    return links;
+}
+
+class MeshPartDecomposition final : public CollectiveDecomposition {
+public:
+    // `comm` is this part's own duplicate; `neighbours` its distributed-graph
+    // communicator over the ranks in `links` (both freed with it).
+    MeshPartDecomposition(MPI_Comm comm, MPI_Comm neighbours, PartLinks links)
+        : CollectiveDecomposition(comm), neighbours_(neighbours), links_(std::move(links)) {}
+
+    ~MeshPartDecomposition() override {
+        int finalized = 0;
+        MPI_Finalized(&finalized);
+        if (!finalized) MPI_Comm_free(&neighbours_);
+    }
+
+    StepAgreement agree_before_step(Grid &grid, double dt, bool refused) override {
+        std::vector<double> flags = {grid.masks_version() != exchanged_masks_ ? 1.0 : 0.0,
+                                     grid.heights_version() != exchanged_heights_ ? 1.0 : 0.0,
+                                     static_cast<double>(grid.relaxation())};
+        const std::vector<double> state = local_state(grid);
+        flags.insert(flags.end(), state.begin(), state.end());
+        // The relaxation mode: every rank steps in time or every rank relaxes.
+        flags.push_back(-static_cast<double>(grid.relaxation()));
+        std::vector<double> v = agree_on_step(grid, dt, refused, flags);
+        if (v[2] != -v.back())
+            throw Error(DPSM_ERR_INVALID_VALUE, "dpsm_step: the ranks of the distributed mesh differ in the relaxation "
+                                                "(dpsm_set_relaxation); every rank must step the same way");
+        std::vector<double> agreed(v.begin() + 3, v.end() - 1);
+        if (v[0] != 0.0 || v[1] != 0.0) {
+            // A host changed something on some rank: the ghosts take their owners' values, then the flags again.
+            if (v[0] != 0.0) exchange_masks(grid);
+            exchange_ghost_heights(grid);
+            exchanged_heights_ = grid.heights_version();
+            agreed = local_state(grid);
+            check_mpi(MPI_Allreduce(MPI_IN_PLACE, agreed.data(), static_cast<int>(agreed.size()), MPI_DOUBLE, MPI_MAX,
+                                    comm_),
+                      "MPI_Allreduce before dpsm_step");
+        }
+        grid.set_distributed_min_repose_angle(-agreed[5]);
+        StepAgreement out;
+        out.source_active = agreed[0] != 0.0;
+        out.has_open_cells = agreed[1] != 0.0;
+        out.may_move = agreed[2] != 0.0;
+        out.open_level_min = out.has_open_cells ? -agreed[3] : 0.0;
+        out.open_level_max = out.has_open_cells ? agreed[4] : 0.0;
+        const bool edge_levels = agreed[6] != 0.0;
+        out.side_level_min = edge_levels ? -agreed[7] : 0.0;
+        out.side_level_max = edge_levels ? agreed[8] : 0.0;
+        out.any_side_open = agreed[9] != 0.0;
+        return out;
+    }
+
+    void before_sweep(Grid &) override {}
+
+    void exchange_ghost_gradients(Grid &, double *gx, double *gy) override {
+        exchange(links_.send_gradients, links_.receive_gradients, 2,
+                 [&](std::int64_t c, double *out) { out[0] = gx[c], out[1] = gy[c]; },
+                 [&](std::int64_t c, const double *in) { gx[c] = in[0], gy[c] = in[1]; });
+    }
+
+    void exchange_ghost_heights(Grid &grid) override {
+        std::vector<double> &h = grid.heights_for_stepping();
+        if (!grid.hysteresis()) {
+            exchange(links_.send_heights, links_.receive_heights, 1, [&](std::int64_t c, double *out) { out[0] = h[c]; },
+                     [&](std::int64_t c, const double *in) { h[c] = in[0]; });
+            return;
+        }
+        std::vector<std::uint8_t> &moving = grid.moving_for_stepping();
+        exchange(links_.send_heights, links_.receive_heights, 2,
+                 [&](std::int64_t c, double *out) { out[0] = h[c], out[1] = moving[c]; },
+                 [&](std::int64_t c, const double *in) {
+                     h[c] = in[0];
+                     moving[c] = static_cast<std::uint8_t>(in[1]);
+                 });
+    }
+
+private:
+    // This rank's figures for the step's agreement, each as a maximum (minima
+    // negated): a source, open cells, something that may move, the lowest and
+    // highest open cell, the smallest angle, the open edge faces' levels, an
+    // open edge. Over its owned cells and the faces that touch them.
+    std::vector<double> local_state(const Grid &grid) const {
+        const double none = -std::numeric_limits<double>::infinity();
+        const Mesh &m = *grid.geometry().mesh;
+        bool open = false;
+        double lo = 0.0, hi = 0.0;
+        if (grid.has_open_cells()) {
+            const std::vector<std::uint8_t> &kind = grid.kinds();
+            const std::vector<double> &h = grid.heights();
+            for (std::int64_t c = 0; c < m.owned; ++c) {
+                if (kind[c] != kOpen) continue;
+                lo = open ? std::min(lo, h[c]) : h[c];
+                hi = open ? std::max(hi, h[c]) : h[c];
+                open = true;
+            }
+        }
+        bool edge = false, any_open_edge = false;
+        double edge_lo = 0.0, edge_hi = 0.0;
+        const std::vector<double> &levels = grid.side_levels(0);
+        for (std::int64_t f = 0; f < m.live_faces; ++f) {
+            if (m.face_b[f] >= 0 || !grid.edge_open(f)) continue;
+            any_open_edge = true;
+            const double level = levels.empty() ? 0.0 : levels[f];
+            edge_lo = edge ? std::min(edge_lo, level) : level;
+            edge_hi = edge ? std::max(edge_hi, level) : level;
+            edge = true;
+        }
+        return {grid.source_active() ? 1.0 : 0.0,
+                open ? 1.0 : 0.0,
+                grid.mesh_activity().may_move() ? 1.0 : 0.0,
+                open ? -lo : none,
+                open ? hi : none,
+                -grid.own_min_repose_angle(),
+                edge ? 1.0 : 0.0,
+                edge ? -edge_lo : none,
+                edge ? edge_hi : none,
+                any_open_edge || grid.side_open(0) ? 1.0 : 0.0};
+    }
+
+    // One neighbourhood all-to-all of `per_cell` values per listed cell.
+    template <class Pack, class Unpack>
+    void exchange(const CellLists &send, const CellLists &receive, int per_cell, Pack &&pack, Unpack &&unpack) {
+        const std::size_t width = static_cast<std::size_t>(per_cell);
+        send_buffer_.resize(send.cells.size() * width);
+        receive_buffer_.resize(receive.cells.size() * width);
+        for (std::size_t k = 0; k < send.cells.size(); ++k) pack(send.cells[k], &send_buffer_[k * width]);
+        scaled(send, per_cell, send_counts_, send_offsets_);
+        scaled(receive, per_cell, receive_counts_, receive_offsets_);
+        check_mpi(MPI_Neighbor_alltoallv(send_buffer_.data(), send_counts_.data(), send_offsets_.data(), MPI_DOUBLE,
+                                         receive_buffer_.data(), receive_counts_.data(), receive_offsets_.data(),
+                                         MPI_DOUBLE, neighbours_),
+                  "MPI_Neighbor_alltoallv of the ghosts");
+        for (std::size_t k = 0; k < receive.cells.size(); ++k) unpack(receive.cells[k], &receive_buffer_[k * width]);
+    }
+
+    // Counts and offsets of `lists`, times `per_cell`, one per neighbour of
+    // the distributed graph (the lists of gradients name the same ranks as
+    // those of heights, some with no cells).
+    static void scaled(const CellLists &lists, int per_cell, std::vector<int> &counts, std::vector<int> &offsets) {
+        counts.resize(lists.counts.size());
+        offsets.resize(lists.offsets.size());
+        for (std::size_t r = 0; r < counts.size(); ++r) {
+            counts[r] = lists.counts[r] * per_cell;
+            offsets[r] = lists.offsets[r] * per_cell;
+        }
+    }
+
+    // The ghosts' kinds, sources, bed and angles from their owners, set as a
+    // host would set them (so that everything derived from them follows).
+    void exchange_masks(Grid &grid) {
+        const bool has_source = !grid.source().empty(), has_bed = !grid.bed().empty(),
+                   has_angles = !grid.angle_field().empty();
+        std::vector<std::uint8_t> kinds = grid.kinds();
+        std::vector<double> q = has_source ? grid.source() : std::vector<double>(kinds.size(), 0.0);
+        std::vector<double> zb = grid.bed(), theta = grid.angle_field();
+        const std::vector<double> &own_q = grid.source(), &own_zb = grid.bed(), &own_theta = grid.angle_field();
+        const std::vector<std::uint8_t> &own_kinds = grid.kinds();
+        bool any_source = false;
+        exchange(links_.send_heights, links_.receive_heights, 4,
+                 [&](std::int64_t c, double *out) {
+                     out[0] = own_kinds[c];
+                     out[1] = own_q.empty() ? 0.0 : own_q[c];
+                     out[2] = own_zb.empty() ? 0.0 : own_zb[c];
+                     out[3] = own_theta.empty() ? 0.0 : own_theta[c];
+                 },
+                 [&](std::int64_t c, const double *in) {
+                     kinds[c] = static_cast<std::uint8_t>(in[0]);
+                     q[c] = in[1];
+                     any_source = any_source || in[1] != 0.0;
+                     if (has_bed) zb[c] = in[2];
+                     if (has_angles) theta[c] = in[3];
+                 });
+        if (kinds != own_kinds) grid.set_cell_kinds(kinds.data());
+        if ((has_source && q != own_q) || (!has_source && any_source)) grid.set_source(q.data());
+        if (has_bed && zb != own_zb) grid.set_bed(zb.data());
+        if (has_angles && theta != own_theta) grid.set_angle_field(theta.data());
+        exchanged_masks_ = grid.masks_version();
+    }
+
+    MPI_Comm neighbours_;
+    PartLinks links_;
+    std::vector<double> send_buffer_, receive_buffer_;
+    std::vector<int> send_counts_, send_offsets_, receive_counts_, receive_offsets_;
+    std::uint64_t exchanged_masks_ = std::numeric_limits<std::uint64_t>::max();    // none yet
+    std::uint64_t exchanged_heights_ = std::numeric_limits<std::uint64_t>::max();  // none yet
+};
+
+// The part's grid, tied to a duplicate of `comm` and a distributed graph over
+// its neighbours. Collective.
+dpsm_grid *part_grid(MPI_Comm comm, std::shared_ptr<Mesh> mesh, const std::vector<int> &owner_of_cell, const char *fn) {
+    PartLinks links = link_parts(comm, *mesh, owner_of_cell, fn);
+    std::unique_ptr<dpsm_grid> made;
+    on_every_rank(comm, fn, [&] {
+        std::shared_ptr<const Mesh> done = mesh;
+        made = std::make_unique<dpsm_grid>(Geometry{2, false, done->cells, 1, done->min_distance, done->min_distance, done});
+    });
+    MPI_Comm own = MPI_COMM_NULL, neighbours = MPI_COMM_NULL;
+    check_mpi(MPI_Comm_dup(comm, &own), "MPI_Comm_dup");
+    MPI_Comm_set_errhandler(own, MPI_ERRORS_RETURN);
+    const std::vector<int> &sources = links.receive_heights.ranks, &destinations = links.send_heights.ranks;
+    const int status = MPI_Dist_graph_create_adjacent(
+        own, static_cast<int>(sources.size()), sources.empty() ? MPI_WEIGHTS_EMPTY : sources.data(), MPI_UNWEIGHTED,
+        static_cast<int>(destinations.size()), destinations.empty() ? MPI_WEIGHTS_EMPTY : destinations.data(),
+        MPI_UNWEIGHTED, MPI_INFO_NULL, 0, &neighbours);
+    if (status != MPI_SUCCESS) {
+        MPI_Comm_free(&own);
+        check_mpi(status, "MPI_Dist_graph_create_adjacent");
+    }
+    made->core.set_decomposition(std::make_unique<MeshPartDecomposition>(own, neighbours, std::move(links)));
+    return made.release();
+}
+
+// The arguments every constructor checks on its own rank: the communicator,
+// out, and per cell a global id and an owner; which cells are ghosts.
+std::vector<std::uint8_t> ghosts_of_rank(MPI_Comm comm, std::int64_t ncells, const std::int64_t *global_id,
+                                         const int *owner, dpsm_grid **out, int base, const char *fn) {
+    int rank = 0, size = 1;
+    MPI_Comm_rank(comm, &rank);
+    MPI_Comm_size(comm, &size);
+    if (!out) fail(DPSM_ERR_NULL_POINTER, fn, "out is NULL");
+    if (ncells < 1) fail(DPSM_ERR_INVALID_SIZE, fn, "ncells = ", ncells, " must be at least 1");
+    if (!global_id) fail(DPSM_ERR_NULL_POINTER, fn, "global_id is NULL");
+    if (!owner) fail(DPSM_ERR_NULL_POINTER, fn, "owner is NULL");
+    std::vector<std::uint8_t> ghost(static_cast<std::size_t>(ncells));
+    std::int64_t owned = 0;
+    for (std::int64_t c = 0; c < ncells; ++c) {
+        if (global_id[c] < base)
+            fail(DPSM_ERR_INVALID_VALUE, fn, host_position("global_id", c, base), " (cell ", c + base, ") = ",
+                 global_id[c], " is below ", base, "; global ids number the cells from ", base);
+        if (owner[c] < 0 || owner[c] >= size)
+            fail(DPSM_ERR_INVALID_VALUE, fn, host_position("owner", c, base), " (cell ", c + base, ") = ", owner[c],
+                 " is not a rank of the communicator, [0, ", size - 1, "]");
+        ghost[static_cast<std::size_t>(c)] = owner[c] != rank;
+        owned += owner[c] == rank;
+    }
+    if (owned == 0) fail(DPSM_ERR_INVALID_SIZE, fn, "rank ", rank, " owns none of its ", ncells, " cells (owner[k] == ", rank, " for none)");
+    std::vector<std::int64_t> ids(global_id, global_id + ncells);
+    std::sort(ids.begin(), ids.end());
+    const auto twice = std::adjacent_find(ids.begin(), ids.end());
+    if (twice != ids.end()) {
+        std::int64_t first = -1, second = -1;
+        for (std::int64_t c = 0; c < ncells; ++c)
+            if (global_id[c] == *twice) (first < 0 ? first : second) = c;
+        fail(DPSM_ERR_INVALID_VALUE, fn, "cells ", first + base, " and ", second + base, " have the same global id, ",
+             *twice);
+    }
+    return ghost;
+}
+
+template <class Build>
+int create_part(MPI_Comm comm, int start_index, std::int64_t ncells, const std::int64_t *global_id, const int *owner,
+                dpsm_grid **out, const char *fn, Build &&build) noexcept {
+    if (out) *out = nullptr;
+    return without_grid(fn, [&] {
+        int rank = 0, size = 0;
+        check_communicator(comm, fn, rank, size);
+        std::shared_ptr<Mesh> mesh;
+        std::vector<int> owner_of_cell;
+        on_every_rank(comm, fn, [&] {
+            const std::vector<std::uint8_t> ghost = ghosts_of_rank(comm, ncells, global_id, owner, out, start_index, fn);
+            // From here on global ids count from 0 (the messages add start_index again).
+            std::vector<std::int64_t> ids(global_id, global_id + ncells);
+            for (std::int64_t &id : ids) id -= start_index;
+            mesh = build(PartOfMesh{ids.data(), ghost.data()});
+            owner_of_cell.resize(static_cast<std::size_t>(mesh->cells));
+            for (std::int64_t c = 0; c < mesh->cells; ++c) owner_of_cell[c] = owner[mesh->host_cell[c]];
+        });
+        *out = part_grid(comm, std::move(mesh), owner_of_cell, fn);
+    });
+}
+
+}  // namespace
+}  // namespace dpsm
+
+extern "C" {
+
+int dpsm_create_graph_mpi(MPI_Comm comm, int64_t ncells, const int64_t *global_id, const int *owner,
+                          const double *cell_xy, const double *cell_area, int64_t nfaces, const int64_t *face_cells,
+                          const double *face_xy, const double *face_length, dpsm_grid **out) {
+    const char *fn = "dpsm_create_graph_mpi";
+    return dpsm::create_part(comm, 0, ncells, global_id, owner, out, fn, [&](const dpsm::PartOfMesh &part) {
+        return dpsm::part_from_graph(ncells, cell_xy, cell_area, nfaces, face_cells, face_xy, face_length, part, fn, 0);
+    });
+}
+
+int dpsm_create_graph_mpi_f(MPI_Fint comm, int64_t ncells, const int64_t *global_id, const int *owner,
+                            const double *cell_xy, const double *cell_area, int64_t nfaces, const int64_t *face_cells,
+                            const double *face_xy, const double *face_length, dpsm_grid **out) {
+    const char *fn = "dpsm_create_graph_mpi_f";
+    return dpsm::create_part(MPI_Comm_f2c(comm), 1, ncells, global_id, owner, out, fn, [&](const dpsm::PartOfMesh &part) {
+        return dpsm::part_from_graph(ncells, cell_xy, cell_area, nfaces, face_cells, face_xy, face_length, part, fn, 1);
+    });
+}
+
+int dpsm_create_mesh_mpi(MPI_Comm comm, int64_t nnodes, const double *node_xy, int64_t ncells,
+                         const int64_t *cell_start, const int64_t *cell_nodes, const int64_t *global_id,
+                         const int *owner, dpsm_grid **out) {
+    const char *fn = "dpsm_create_mesh_mpi";
+    return dpsm::create_part(comm, 0, ncells, global_id, owner, out, fn, [&](const dpsm::PartOfMesh &part) {
+        return dpsm::part_from_polygons(nnodes, node_xy, ncells, cell_start, cell_nodes, part, fn, 0);
+    });
+}
+
+int dpsm_create_mesh_mpi_f(MPI_Fint comm, int64_t nnodes, const double *node_xy, int64_t ncells,
+                           const int64_t *cell_start, const int64_t *cell_nodes, const int64_t *global_id,
+                           const int *owner, dpsm_grid **out) {
+    const char *fn = "dpsm_create_mesh_mpi_f";
+    return dpsm::create_part(MPI_Comm_f2c(comm), 1, ncells, global_id, owner, out, fn,
+                             [&](const dpsm::PartOfMesh &part) {
+                                 return dpsm::part_from_polygons(nnodes, node_xy, ncells, cell_start, cell_nodes, part,
+                                                                 fn, 1);
+                             });
+}
+
+}  // extern "C"
