@@ -24,6 +24,8 @@ DPSM_APT_PACKAGES=(
     abigail-tools      # the `abi` test: abidw/abidiff against tests/abi/libdpsm.abi
     libopenmpi-dev     # the MPI component (libdpsm_mpi, dpsm_mpi.h): Open MPI's headers and libraries
     openmpi-bin        # mpiexec, which runs the MPI tests (tests/mpi) on 1, 2 and 4 ranks
+    libyaml-dev        # the run configuration (src/config): libdpsm_bmi and dpsm run read YAML with libyaml
+    libnetcdf-dev      # the run configuration's netCDF inputs and UGRID meshes, dpsm run's output
 )
 
 DPSM_ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
