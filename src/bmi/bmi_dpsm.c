@@ -78,6 +78,7 @@ int component_grid_of(const struct component *c, enum place p) {
 }
 
 int component_place_of_grid(const struct component *c, int grid) {
+    if (grid < 0) return -1;
     for (int p = PLACE_CELLS; p <= PLACE_SCALAR; ++p)
         if (component_grid_of(c, (enum place)p) == grid) return p;
     return -1;

@@ -128,6 +128,7 @@ static int coordinates(Bmi *self, int grid, double *out, int axis, const char *f
     if (!c) return BMI_FAILURE;
     if (place == PLACE_SCALAR) return component_fail(function, "grid %d holds scalars: it has no coordinates", grid);
     if (unstructured(c, place)) {
+        if (axis == 2) return component_fail(function, "grid %d is a flat mesh: its nodes have x and y only", grid);
         const double *from = axis == 0 ? c->scene.mesh.node_x : c->scene.mesh.node_y;
         memcpy(out, from, (size_t)c->scene.mesh.node_count * sizeof(double));
         return BMI_SUCCESS;
