@@ -40,6 +40,7 @@ extern "C" {
 #endif
 
 #ifndef BMI_H
+/** The include guard of CSDMS's `bmi.h`: defined here, a framework's copy included later adds nothing. */
 #define BMI_H
 
 /** A BMI function succeeded. */
