@@ -26,6 +26,7 @@ DPSM_APT_PACKAGES=(
     openmpi-bin        # mpiexec, which runs the MPI tests (tests/mpi) on 1, 2 and 4 ranks
     libyaml-dev        # the run configuration (src/config): libdpsm_bmi and dpsm run read YAML with libyaml
     libnetcdf-dev      # the run configuration's netCDF inputs and UGRID meshes, dpsm run's output
+    netcdf-bin         # the dpsm_run test: ncgen makes its mesh, ncdump reads the output back
 )
 
 DPSM_ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)

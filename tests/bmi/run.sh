@@ -41,6 +41,12 @@ exported=$(nm -D --defined-only "$lib" | awk 'NF >= 3 { sub(/@.*/, "", $3); prin
 [[ $exported == "register_bmi register_bmi_dpsm " ]] ||
     fail "libdpsm_bmi.so exports '$exported', expected register_bmi and register_bmi_dpsm only"
 
+# The installed dpsm program runs from the prefix, finding libdpsm through its rpath.
+if [[ -x $work/prefix/bin/dpsm ]]; then
+    [[ $(env -u LD_LIBRARY_PATH "$work/prefix/bin/dpsm" --version) == "dpsm "[0-9]* ]] ||
+        fail "the installed dpsm program does not run"
+fi
+
 echo "== $host $lib"
 env -u LD_LIBRARY_PATH "$host" "$lib" || fail "the conformance host failed"
 
