@@ -7,6 +7,7 @@
  *   usage: bmi_host <path of libdpsm_bmi.so>
  *
  * It writes its configurations and the UGRID mesh into a temporary folder. */
+#define _POSIX_C_SOURCE 200809L /* mkdtemp */
 #include <dlfcn.h>
 #include <math.h>
 #include <setjmp.h>

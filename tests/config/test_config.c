@@ -1,6 +1,7 @@
 /* The run configuration (src/config/): good files read and built into the
  * scene they describe; bad ones refused with the file, the line and the key
  * path of the problem. Each test writes its files into a fresh folder. */
+#define _POSIX_C_SOURCE 200809L /* mkdtemp */
 #include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
