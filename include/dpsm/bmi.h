@@ -113,7 +113,9 @@ typedef struct Bmi {
 
     /** Copies a variable's values into `dest`. */
     int (*get_value)(struct Bmi *self, const char *name, void *dest);
-    /** Points `*dest_ptr` at the component's copy of a variable. */
+    /** Points `*dest_ptr` at the component's copy of a variable: valid until
+     *  `finalize`, refreshed by every update and set, for reading only
+     *  (writing through it changes nothing in the model; use set_value). */
     int (*get_value_ptr)(struct Bmi *self, const char *name, void **dest_ptr);
     /** Copies the values at `count` flat indices `inds` into `dest`. */
     int (*get_value_at_indices)(struct Bmi *self, const char *name, void *dest, int *inds, int count);

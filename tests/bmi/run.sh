@@ -10,7 +10,8 @@
 #  3. <bmi_host> dlopen()s the installed libdpsm_bmi.so, with no
 #     LD_LIBRARY_PATH (it finds libdpsm next to itself), and checks it
 #  4. a C program built with `pkg-config --cflags --libs dpsm-bmi` calls
-#     register_bmi_dpsm() through the installed header
+#     register_bmi_dpsm() through the installed header; so does one built by
+#     CMake with find_package(dpsm) and dpsm::dpsm_bmi
 set -euo pipefail
 
 if [[ $# -ne 2 ]]; then
@@ -69,4 +70,18 @@ libdir=$(dirname "$lib")
     $(PKG_CONFIG_PATH=$(dirname "$pc") pkg-config --cflags --libs dpsm-bmi) -Wl,-rpath,"$libdir") ||
     fail "building against dpsm-bmi.pc failed"
 "$work/prog" || fail "the pkg-config program failed"
+echo "== CMake: find_package(dpsm) gives dpsm::dpsm_bmi"
+mkdir -p "$work/cmake"
+cp "$work/prog.c" "$work/cmake/prog.c"
+cat >"$work/cmake/CMakeLists.txt" <<'CMAKE'
+cmake_minimum_required(VERSION 3.16)
+project(bmi_consumer C)
+find_package(dpsm 0.1 CONFIG REQUIRED)
+add_executable(prog prog.c)
+target_link_libraries(prog PRIVATE dpsm::dpsm_bmi)
+CMAKE
+cmake -S "$work/cmake" -B "$work/cmake/build" -DCMAKE_PREFIX_PATH="$work/prefix" -DCMAKE_FIND_USE_PACKAGE_REGISTRY=OFF \
+    >"$work/cmake.log" 2>&1 && cmake --build "$work/cmake/build" >>"$work/cmake.log" 2>&1 ||
+    { cat "$work/cmake.log"; fail "the CMake consumer of dpsm::dpsm_bmi failed to build"; }
+"$work/cmake/build/prog" || fail "the CMake consumer of dpsm::dpsm_bmi failed"
 echo "== the C BMI conformance checks passed"
