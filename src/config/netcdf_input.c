@@ -52,12 +52,22 @@ int netcdf_read_field(const char *path, const char *variable, int rank, size_t l
         nc_close(file);
         return 1;
     }
+    /* Missing data reads as the fill value: refused, never taken for a height. */
+    double fill = NC_FILL_DOUBLE;
+    nc_type type;
+    if (nc_get_att_double(file, id, "_FillValue", &fill) != NC_NOERR && nc_inq_vartype(file, id, &type) == NC_NOERR &&
+        type == NC_FLOAT)
+        fill = NC_FILL_FLOAT;
     status = nc_get_var_double(file, id, values);
     nc_close(file);
     if (status != NC_NOERR) return nc_refuse(message, size, path, variable, status);
     size_t count = rank == 2 ? length0 * length1 : length0;
     for (size_t k = 0; k < count; ++k)
-        if (!isfinite(values[k]) || fabs(values[k]) > 1e50) {
+        if (values[k] == fill) {
+            snprintf(message, size, "%s: variable \"%s\": value %zu (from 0) is missing (the fill value)", path, variable,
+                     k);
+            return 1;
+        } else if (!isfinite(values[k]) || fabs(values[k]) > 1e50) {
             snprintf(message, size, "%s: variable \"%s\": value %zu (from 0) is %g, not a finite height or rate", path,
                      variable, k, values[k]);
             return 1;

@@ -199,6 +199,19 @@ static void fields_from_netcdf_files(void **state) {
     assert_int_equal(config_read(path, &c, message, sizeof message), 0);
     assert_int_not_equal(config_build(&c, &s, message, sizeof message), 0);
     assert_non_null(strstr(message, "fields.nc: no variable \"height\""));
+    /* Missing data (the default fill value) and values beyond the range. */
+    h[5] = 9.969209968386869e36;
+    assert_int_equal(write_field_file(file, "h", 2, dims, lengths, h), 0);
+    path = write_text("files.yaml", "grid: {kind: 2d, nx: 4, ny: 3, dx: 1, dy: 2}\n"
+                                    "initial: {file: fields.nc, variable: h}\n"
+                                    "time: {step: 1, end: 3}\n");
+    assert_int_equal(config_read(path, &c, message, sizeof message), 0);
+    assert_int_not_equal(config_build(&c, &s, message, sizeof message), 0);
+    assert_non_null(strstr(message, "fields.nc: variable \"h\": value 5 (from 0) is missing (the fill value)"));
+    h[5] = 1e51;
+    assert_int_equal(write_field_file(file, "h", 2, dims, lengths, h), 0);
+    assert_int_not_equal(config_build(&c, &s, message, sizeof message), 0);
+    assert_non_null(strstr(message, "fields.nc: variable \"h\": value 5 (from 0) is 1e+51, not a finite height or rate"));
     path = write_text("files.yaml", "grid: {kind: 2d, nx: 4, ny: 3, dx: 1, dy: 2}\n"
                                     "initial: {file: nowhere.nc, variable: h}\n"
                                     "time: {step: 1, end: 3}\n");
