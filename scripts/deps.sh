@@ -25,6 +25,9 @@ DPSM_APT_PACKAGES=(
     libopenmpi-dev     # the MPI component (libdpsm_mpi, dpsm_mpi.h): Open MPI's headers and libraries
     openmpi-bin        # mpiexec, which runs the MPI tests (tests/mpi) on 1, 2 and 4 ranks
     libmetis-dev       # the MPI mesh tests and benchmark partition meshes with METIS (dpsm itself does not need it)
+    libyaml-dev        # the run configuration (src/config): libdpsm_bmi and dpsm run read YAML with libyaml
+    libnetcdf-dev      # the run configuration's netCDF inputs and UGRID meshes, dpsm run's output
+    netcdf-bin         # the dpsm_run test: ncgen makes its mesh, ncdump reads the output back
 )
 
 DPSM_ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)

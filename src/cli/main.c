@@ -1,0 +1,171 @@
+/* dpsm: the command line.
+ *
+ *   dpsm run CONFIG.yaml   runs the configuration (docs/guide_bmi.md lists its
+ *                          keys) to its end time, shows progress, writes
+ *                          snapshots and the ledger to output.file every
+ *                          output.every seconds, prints the mass balance
+ *   dpsm --version
+ *
+ * Exit status: 0 done, 1 the run failed (the reason on stderr), 2 a usage error. */
+#define _POSIX_C_SOURCE 200809L
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "cli/netcdf_output.h"
+#include "config/config.h"
+
+static const int kLedgerQuantities[OUTPUT_LEDGER_FIGURES] = {DPSM_MASS_TOTAL, DPSM_MASS_SOURCED, DPSM_MASS_EXTERNAL,
+                                                             DPSM_MASS_OUTFLOW, DPSM_MASS_UNMET};
+
+static void usage(FILE *to) {
+    fprintf(to, "usage: dpsm run CONFIG.yaml    run a configuration to its end time (docs/guide_bmi.md)\n"
+                "       dpsm --version\n");
+}
+
+static double wall_seconds(void) {
+    struct timespec now;
+    clock_gettime(CLOCK_MONOTONIC, &now);
+    return (double)now.tv_sec + 1e-9 * (double)now.tv_nsec;
+}
+
+struct progress {
+    int terminal;
+    double started, end;
+    long steps;
+    size_t snapshots;
+};
+
+/* One line of progress: overwritten in place on a terminal, a line of its
+ * own otherwise (then only at snapshots, so a log stays short). */
+static void show(const struct progress *p, double t, long moving, int at_snapshot) {
+    if (!p->terminal && !at_snapshot) return;
+    double elapsed = wall_seconds() - p->started;
+    double left = t > 0 ? elapsed * (p->end - t) / t : 0;
+    printf("%st = %.6g / %.6g s  steps %ld  cells moving %ld  snapshots %zu  time left %.1f s%s",
+           p->terminal ? "\r" : "", t, p->end, p->steps, moving, p->snapshots, left, p->terminal ? "   " : "\n");
+    fflush(stdout);
+}
+
+struct run {
+    struct config config;
+    struct config_scene scene;
+    struct output output;
+    double *heights, *before;
+    char message[CONFIG_MESSAGE_MAX];
+};
+
+static int fail(struct run *r, const char *what) {
+    fprintf(stderr, "dpsm run: %s\n", what ? what : r->message);
+    return 1;
+}
+
+static void read_ledger(const struct run *r, double ledger[OUTPUT_LEDGER_FIGURES]) {
+    for (int k = 0; k < OUTPUT_LEDGER_FIGURES; ++k) dpsm_get_mass(r->scene.grid, kLedgerQuantities[k], &ledger[k]);
+}
+
+static int snapshot(struct run *r, double t, struct progress *p) {
+    if (!r->config.has_output) return 0;
+    double ledger[OUTPUT_LEDGER_FIGURES];
+    read_ledger(r, ledger);
+    if (output_snapshot(&r->output, t, r->heights, ledger, r->message, sizeof r->message)) return fail(r, NULL);
+    p->snapshots = r->output.snapshots;
+    return 0;
+}
+
+/* Steps from t to `target` in time steps and a final partial one that lands
+ * on it exactly, as the BMI component's update_until does. */
+static int advance(struct run *r, double *t, double target, struct progress *p, long *moving) {
+    double dt = r->config.time_step;
+    while (*t < target) {
+        int last = target - *t <= dt * (1 + 1e-6);
+        double this_dt = last ? target - *t : dt;
+        memcpy(r->before, r->heights, (size_t)r->scene.cell_count * sizeof *r->before);
+        if (dpsm_step(r->scene.grid, this_dt) != DPSM_OK) {
+            if (p->terminal) putchar('\n');
+            fprintf(stderr, "dpsm run: the step at t = %.17g s failed: %s\n", *t, dpsm_last_error(r->scene.grid));
+            return 1;
+        }
+        dpsm_get_heights(r->scene.grid, r->heights);
+        *moving = 0;
+        for (int64_t k = 0; k < r->scene.cell_count; ++k) *moving += r->heights[k] != r->before[k];
+        *t = last ? target : *t + dt;
+        ++p->steps;
+        show(p, *t, *moving, 0);
+    }
+    return 0;
+}
+
+static void print_balance(const struct run *r) {
+    double ledger[OUTPUT_LEDGER_FIGURES];
+    read_ledger(r, ledger);
+    double closing = ledger[0] - (ledger[1] + ledger[2] - ledger[3]);
+    printf("mass balance (m3, since the start):\n"
+           "  total     %.17g\n"
+           "  sourced   %.17g\n"
+           "  external  %.17g   (the initial heights included)\n"
+           "  outflow   %.17g\n"
+           "  unmet     %.17g\n"
+           "  total - (sourced + external - outflow) = %.3g\n",
+           ledger[0], ledger[1], ledger[2], ledger[3], ledger[4], closing);
+}
+
+static int run(const char *path) {
+    static struct run r; /* the configuration is large; nothing else uses it */
+    if (config_read(path, &r.config, r.message, sizeof r.message) ||
+        config_build(&r.config, &r.scene, r.message, sizeof r.message))
+        return fail(&r, NULL);
+    int64_t n = r.scene.cell_count;
+    r.heights = malloc((size_t)n * sizeof *r.heights);
+    r.before = malloc((size_t)n * sizeof *r.before);
+    if (!r.heights || !r.before) return fail(&r, "out of memory");
+    dpsm_get_heights(r.scene.grid, r.heights);
+    char history[CONFIG_PATH_MAX + 16];
+    snprintf(history, sizeof history, "dpsm run %s", path);
+    if (r.config.has_output && output_open(&r.output, &r.config, &r.scene, history, r.message, sizeof r.message))
+        return fail(&r, NULL);
+
+    struct progress p = {isatty(STDOUT_FILENO), wall_seconds(), r.config.time_end, 0, 0};
+    double t = 0, every = r.config.has_output ? r.config.output_every : r.config.time_end;
+    long moving = 0, intervals = 0;
+    int failed = snapshot(&r, 0, &p);
+    while (!failed && t < r.config.time_end) {
+        /* Snapshot times are multiples of `every`, the end time included; one
+         * that falls within a millionth of a step of the end is the end. */
+        double target = (double)(++intervals) * every;
+        if (target >= r.config.time_end - 1e-6 * r.config.time_step) target = r.config.time_end;
+        failed = advance(&r, &t, target, &p, &moving) || snapshot(&r, t, &p);
+        if (!failed) show(&p, t, moving, 1);
+    }
+    if (p.terminal) putchar('\n');
+    if (r.config.has_output && output_close(&r.output, r.message, sizeof r.message) && !failed) failed = fail(&r, NULL);
+    if (!failed) {
+        if (r.config.has_output) printf("wrote %zu snapshots to %s\n", r.output.snapshots, r.config.output_file);
+        print_balance(&r);
+    }
+    free(r.heights);
+    free(r.before);
+    config_scene_free(&r.scene);
+    return failed;
+}
+
+int main(int argc, char **argv) {
+    if (argc == 2 && (strcmp(argv[1], "--version") == 0 || strcmp(argv[1], "-V") == 0)) {
+        printf("dpsm %s\n", dpsm_version_string());
+        return 0;
+    }
+    if (argc == 2 && (strcmp(argv[1], "--help") == 0 || strcmp(argv[1], "-h") == 0)) {
+        usage(stdout);
+        return 0;
+    }
+    if (argc == 3 && strcmp(argv[1], "run") == 0) return run(argv[2]);
+    if (argc >= 2 && strcmp(argv[1], "run") != 0)
+        fprintf(stderr, "dpsm: unknown command \"%s\"\n", argv[1]);
+    else if (argc >= 2)
+        fprintf(stderr, "dpsm run: expected one configuration file\n");
+    usage(stderr);
+    return 2;
+}

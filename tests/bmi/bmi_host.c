@@ -1,0 +1,630 @@
+/* The C conformance host of the dpsm BMI component: it loads libdpsm_bmi.so
+ * with dlopen() as NextGen does, takes the registration function with
+ * dlsym(), and calls only the function table, checking every function
+ * against the BMI 2.0 specification and docs/guide_bmi.md: names, types,
+ * units, sizes, both grid types, time, values in and out, and refusals.
+ *
+ *   usage: bmi_host <path of libdpsm_bmi.so>
+ *
+ * It writes its configurations and the UGRID mesh into a temporary folder. */
+#define _POSIX_C_SOURCE 200809L /* mkdtemp */
+#include <dlfcn.h>
+#include <math.h>
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include <cmocka.h>
+
+#include <dpsm/bmi.h>
+
+#include "ugrid_file.h"
+
+static const char *library_path;
+static void *library;
+static Bmi *(*registration)(Bmi *);
+static char folder[256];
+
+static const char *write_text(const char *name, const char *text) {
+    static char path[512];
+    snprintf(path, sizeof path, "%s/%s", folder, name);
+    FILE *f = fopen(path, "w");
+    assert_non_null(f);
+    fputs(text, f);
+    fclose(f);
+    return path;
+}
+
+/* A fresh table from the library's registration function, initialized with `config`. */
+static Bmi *start(const char *name, const char *config) {
+    Bmi *model = calloc(1, sizeof *model);
+    assert_non_null(model);
+    assert_ptr_equal(registration(model), model);
+    assert_null(model->data);
+    const char *path = write_text(name, config);
+    assert_int_equal(model->initialize(model, path), BMI_SUCCESS);
+    assert_non_null(model->data);
+    return model;
+}
+
+static void stop(Bmi *model) {
+    assert_int_equal(model->finalize(model), BMI_SUCCESS);
+    assert_null(model->data);
+    free(model);
+}
+
+/* ---- the 2d grid ----------------------------------------------------- */
+
+static const char kGrid2d[] = "grid: {kind: 2d, nx: 8, ny: 6, dx: 0.5, dy: 0.25}\n"
+                              "repose_angle: 30\n"
+                              "boundaries: {xmin: wall, xmax: wall, ymin: wall, ymax: wall}\n"
+                              "initial: {scene: column, radius: 0.8, height: 2.0}\n"
+                              "time: {step: 0.1, end: 0.35}\n";
+#define NX 8
+#define NY 6
+
+static const char *const kInputs[] = {"land_surface__elevation", "bedrock_surface__elevation",
+                                      "land_surface__net_deposition_rate", "sediment__angle_of_repose"};
+static const char *const kOutputs2d[] = {"land_surface__elevation",
+                                         "bedrock_surface__elevation",
+                                         "sediment__angle_of_repose",
+                                         "land_surface_sediment__x_component_of_avalanche_volume_flux",
+                                         "land_surface_sediment__y_component_of_avalanche_volume_flux",
+                                         "land_surface_sediment__total_volume",
+                                         "land_surface_sediment__sourced_volume",
+                                         "land_surface_sediment__outflow_volume",
+                                         "land_surface_sediment__external_volume",
+                                         "land_surface_sediment__unmet_erosion_volume"};
+
+struct expected_variable {
+    const char *name, *units, *location;
+    int grid;
+};
+
+static const struct expected_variable kVariables2d[] = {
+    {"land_surface__elevation", "m", "node", 0},
+    {"bedrock_surface__elevation", "m", "node", 0},
+    {"land_surface__net_deposition_rate", "m s-1", "node", 0},
+    {"sediment__angle_of_repose", "deg", "node", 0},
+    {"land_surface_sediment__x_component_of_avalanche_volume_flux", "m3 s-1", "node", 1},
+    {"land_surface_sediment__y_component_of_avalanche_volume_flux", "m3 s-1", "node", 2},
+    {"land_surface_sediment__total_volume", "m3", "node", 3},
+    {"land_surface_sediment__sourced_volume", "m3", "node", 3},
+    {"land_surface_sediment__outflow_volume", "m3", "node", 3},
+    {"land_surface_sediment__external_volume", "m3", "node", 3},
+    {"land_surface_sediment__unmet_erosion_volume", "m3", "node", 3},
+};
+
+static void check_names(Bmi *m, int inputs, const char *const *expected, int n) {
+    int count = -1;
+    assert_int_equal((inputs ? m->get_input_item_count : m->get_output_item_count)(m, &count), BMI_SUCCESS);
+    assert_int_equal(count, n);
+    char **names = malloc((size_t)n * sizeof *names);
+    for (int k = 0; k < n; ++k) names[k] = calloc(BMI_MAX_VAR_NAME, 1);
+    assert_int_equal((inputs ? m->get_input_var_names : m->get_output_var_names)(m, names), BMI_SUCCESS);
+    for (int k = 0; k < n; ++k) {
+        assert_string_equal(names[k], expected[k]);
+        free(names[k]);
+    }
+    free(names);
+}
+
+/* Type, units, item size, bytes (= item size times the values of its
+ * location), location and grid of one variable. */
+static void check_variable(Bmi *m, const struct expected_variable *v, int values) {
+    char text[BMI_MAX_UNITS_NAME];
+    int grid = -1, itemsize = 0, nbytes = 0;
+    assert_int_equal(m->get_var_grid(m, v->name, &grid), BMI_SUCCESS);
+    assert_int_equal(grid, v->grid);
+    assert_int_equal(m->get_var_type(m, v->name, text), BMI_SUCCESS);
+    assert_string_equal(text, "double");
+    assert_int_equal(m->get_var_units(m, v->name, text), BMI_SUCCESS);
+    assert_string_equal(text, v->units);
+    assert_int_equal(m->get_var_location(m, v->name, text), BMI_SUCCESS);
+    assert_string_equal(text, v->location);
+    assert_int_equal(m->get_var_itemsize(m, v->name, &itemsize), BMI_SUCCESS);
+    assert_int_equal(itemsize, (int)sizeof(double));
+    assert_int_equal(m->get_var_nbytes(m, v->name, &nbytes), BMI_SUCCESS);
+    assert_int_equal(nbytes, itemsize * values);
+}
+
+static void check_rectilinear(Bmi *m, int grid, int rank, const int *shape, const double *spacing,
+                              const double *origin) {
+    char type[BMI_MAX_TYPE_NAME];
+    int got_rank = -1, size = -1, nodes = -1, got_shape[2] = {0, 0};
+    double got_spacing[2] = {0, 0}, got_origin[2] = {0, 0};
+    assert_int_equal(m->get_grid_type(m, grid, type), BMI_SUCCESS);
+    assert_string_equal(type, "uniform_rectilinear");
+    assert_int_equal(m->get_grid_rank(m, grid, &got_rank), BMI_SUCCESS);
+    assert_int_equal(got_rank, rank);
+    assert_int_equal(m->get_grid_shape(m, grid, got_shape), BMI_SUCCESS);
+    assert_int_equal(m->get_grid_spacing(m, grid, got_spacing), BMI_SUCCESS);
+    assert_int_equal(m->get_grid_origin(m, grid, got_origin), BMI_SUCCESS);
+    int product = 1;
+    for (int d = 0; d < rank; ++d) {
+        assert_int_equal(got_shape[d], shape[d]);
+        assert_true(got_spacing[d] == spacing[d]);
+        assert_true(got_origin[d] == origin[d]);
+        product *= shape[d];
+    }
+    assert_int_equal(m->get_grid_size(m, grid, &size), BMI_SUCCESS);
+    assert_int_equal(size, product);
+    assert_int_equal(m->get_grid_node_count(m, grid, &nodes), BMI_SUCCESS);
+    assert_int_equal(nodes, product);
+    /* The nodes along x (the last dimension) and y (the first). */
+    double x[64], y[64], z[64];
+    assert_int_equal(m->get_grid_x(m, grid, x), BMI_SUCCESS);
+    for (int k = 0; k < shape[rank - 1]; ++k) assert_true(fabs(x[k] - (origin[rank - 1] + k * spacing[rank - 1])) < 1e-15);
+    if (rank == 2) {
+        assert_int_equal(m->get_grid_y(m, grid, y), BMI_SUCCESS);
+        for (int k = 0; k < shape[0]; ++k) assert_true(fabs(y[k] - (origin[0] + k * spacing[0])) < 1e-15);
+    } else {
+        assert_int_equal(m->get_grid_y(m, grid, y), BMI_FAILURE);
+    }
+    assert_int_equal(m->get_grid_z(m, grid, z), BMI_FAILURE);
+    /* Edges and faces belong to unstructured grids. */
+    int count;
+    assert_int_equal(m->get_grid_edge_count(m, grid, &count), BMI_FAILURE);
+    assert_int_equal(m->get_grid_face_count(m, grid, &count), BMI_FAILURE);
+    assert_int_equal(m->get_grid_edge_nodes(m, grid, got_shape), BMI_FAILURE);
+}
+
+static void check_scalar_grid(Bmi *m, int grid) {
+    char type[BMI_MAX_TYPE_NAME];
+    int rank = -1, size = -1;
+    assert_int_equal(m->get_grid_type(m, grid, type), BMI_SUCCESS);
+    assert_string_equal(type, "scalar");
+    assert_int_equal(m->get_grid_rank(m, grid, &rank), BMI_SUCCESS);
+    assert_int_equal(rank, 0);
+    assert_int_equal(m->get_grid_size(m, grid, &size), BMI_SUCCESS);
+    assert_int_equal(size, 1);
+}
+
+static void check_no_grid(Bmi *m, int grid) {
+    char type[BMI_MAX_TYPE_NAME];
+    int rank;
+    assert_int_equal(m->get_grid_type(m, grid, type), BMI_FAILURE);
+    assert_int_equal(m->get_grid_rank(m, grid, &rank), BMI_FAILURE);
+    assert_int_equal(m->get_grid_size(m, grid, &rank), BMI_FAILURE);
+}
+
+static double scalar(Bmi *m, const char *name) {
+    double value = NAN;
+    assert_int_equal(m->get_value(m, name, &value), BMI_SUCCESS);
+    return value;
+}
+
+static void registration_and_information_2d(void **state) {
+    (void)state;
+    Bmi *m = start("grid2d.yaml", kGrid2d);
+    char name[BMI_MAX_COMPONENT_NAME];
+    assert_int_equal(m->get_component_name(m, name), BMI_SUCCESS);
+    assert_string_equal(name, "dpsm");
+    check_names(m, 1, kInputs, 4);
+    check_names(m, 0, kOutputs2d, 10);
+    int sizes[] = {NX * NY, NX * NY, NX * NY, NX * NY, (NX + 1) * NY, NX * (NY + 1), 1, 1, 1, 1, 1};
+    for (size_t v = 0; v < sizeof kVariables2d / sizeof kVariables2d[0]; ++v) {
+        check_variable(m, &kVariables2d[v], sizes[v]);
+        /* nbytes == itemsize * grid size on these grids */
+        int grid, size, nbytes;
+        m->get_var_grid(m, kVariables2d[v].name, &grid);
+        m->get_grid_size(m, grid, &size);
+        m->get_var_nbytes(m, kVariables2d[v].name, &nbytes);
+        assert_int_equal(nbytes, 8 * size);
+    }
+    check_rectilinear(m, 0, 2, (int[]){NY, NX}, (double[]){0.25, 0.5}, (double[]){0.125, 0.25});
+    check_rectilinear(m, 1, 2, (int[]){NY, NX + 1}, (double[]){0.25, 0.5}, (double[]){0.125, 0});
+    check_rectilinear(m, 2, 2, (int[]){NY + 1, NX}, (double[]){0.25, 0.5}, (double[]){0, 0.25});
+    check_scalar_grid(m, 3);
+    check_no_grid(m, 4);
+    check_no_grid(m, -1);
+
+    double t = -1;
+    char units[BMI_MAX_UNITS_NAME];
+    assert_int_equal(m->get_start_time(m, &t), BMI_SUCCESS);
+    assert_true(t == 0);
+    assert_int_equal(m->get_current_time(m, &t), BMI_SUCCESS);
+    assert_true(t == 0);
+    assert_int_equal(m->get_end_time(m, &t), BMI_SUCCESS);
+    assert_true(t == 0.35);
+    assert_int_equal(m->get_time_step(m, &t), BMI_SUCCESS);
+    assert_true(t == 0.1);
+    assert_int_equal(m->get_time_units(m, units), BMI_SUCCESS);
+    assert_string_equal(units, "s");
+    stop(m);
+}
+
+static void time_lands_on_the_end(void **state) {
+    (void)state;
+    Bmi *m = start("grid2d.yaml", kGrid2d);
+    double t, expected[] = {0.1, 0.2, 0.30000000000000004, 0.35};
+    for (int k = 0; k < 4; ++k) {
+        assert_int_equal(m->update(m), BMI_SUCCESS);
+        assert_int_equal(m->get_current_time(m, &t), BMI_SUCCESS);
+        assert_true(fabs(t - expected[k]) < 1e-15);
+    }
+    assert_true(t == 0.35); /* exactly the end time */
+    stop(m);
+
+    m = start("grid2d.yaml", kGrid2d);
+    double end;
+    m->get_end_time(m, &end);
+    assert_int_equal(m->update_until(m, end), BMI_SUCCESS);
+    m->get_current_time(m, &t);
+    assert_true(t == end);
+    assert_int_equal(m->update_until(m, 1.0), BMI_SUCCESS);
+    m->get_current_time(m, &t);
+    assert_true(t == 1.0);
+    assert_int_equal(m->update_until(m, 1.0), BMI_SUCCESS); /* no time to go: nothing moves */
+    assert_int_equal(m->update_until(m, 0.5), BMI_FAILURE); /* the past */
+    assert_int_equal(m->update_until(m, NAN), BMI_FAILURE);
+    m->get_current_time(m, &t);
+    assert_true(t == 1.0);
+    stop(m);
+}
+
+static void values_in_and_out_2d(void **state) {
+    (void)state;
+    Bmi *m = start("grid2d.yaml", kGrid2d);
+    double h[NX * NY], h2[NX * NY], *ptr = NULL;
+    assert_int_equal(m->get_value(m, "land_surface__elevation", h), BMI_SUCCESS);
+    double volume = 0;
+    for (int k = 0; k < NX * NY; ++k) volume += h[k] * 0.5 * 0.25;
+    assert_true(volume > 0);
+    assert_true(fabs(scalar(m, "land_surface_sediment__total_volume") - volume) < 1e-12);
+    assert_int_equal(m->get_value_ptr(m, "land_surface__elevation", (void **)&ptr), BMI_SUCCESS);
+    assert_memory_equal(ptr, h, sizeof h);
+
+    /* Fluxes read 0 before the first update. */
+    double fx[(NX + 1) * NY], fy[NX * (NY + 1)];
+    assert_int_equal(m->get_value(m, "land_surface_sediment__x_component_of_avalanche_volume_flux", fx), BMI_SUCCESS);
+    assert_int_equal(m->get_value(m, "land_surface_sediment__y_component_of_avalanche_volume_flux", fy), BMI_SUCCESS);
+    for (int k = 0; k < (NX + 1) * NY; ++k) assert_true(fx[k] == 0);
+
+    /* One update of the collapsing column: what the faces carried, times the
+     * duration, is each cell's change of volume (walls all round, no source),
+     * and the pointer from before shows the new heights. */
+    assert_int_equal(m->update(m), BMI_SUCCESS);
+    assert_int_equal(m->get_value(m, "land_surface__elevation", h2), BMI_SUCCESS);
+    assert_memory_equal(ptr, h2, sizeof h2);
+    assert_int_equal(m->get_value(m, "land_surface_sediment__x_component_of_avalanche_volume_flux", fx), BMI_SUCCESS);
+    assert_int_equal(m->get_value(m, "land_surface_sediment__y_component_of_avalanche_volume_flux", fy), BMI_SUCCESS);
+    double moved = 0;
+    for (int j = 0; j < NY; ++j)
+        for (int i = 0; i < NX; ++i) {
+            double in = fx[i + (NX + 1) * j] - fx[i + 1 + (NX + 1) * j] + fy[i + NX * j] - fy[i + NX * (j + 1)];
+            double change = (h2[i + NX * j] - h[i + NX * j]) * 0.5 * 0.25;
+            assert_true(fabs(in * 0.1 - change) < 1e-12);
+            moved += fabs(change);
+        }
+    assert_true(moved > 1e-3);
+    assert_true(fabs(scalar(m, "land_surface_sediment__total_volume") - volume) < 1e-12);
+
+    /* set_value then get_value; get_value_at_indices; set_value_at_indices. */
+    for (int k = 0; k < NX * NY; ++k) h[k] = 0.01 * k;
+    assert_int_equal(m->set_value(m, "land_surface__elevation", h), BMI_SUCCESS);
+    assert_int_equal(m->get_value(m, "land_surface__elevation", h2), BMI_SUCCESS);
+    assert_memory_equal(h, h2, sizeof h);
+    assert_memory_equal(ptr, h, sizeof h);
+    int inds[] = {0, 7, 47, 20};
+    double picked[4];
+    assert_int_equal(m->get_value_at_indices(m, "land_surface__elevation", picked, inds, 4), BMI_SUCCESS);
+    for (int k = 0; k < 4; ++k) assert_true(picked[k] == h[inds[k]]);
+    double put[] = {1.5, 2.5};
+    assert_int_equal(m->set_value_at_indices(m, "land_surface__elevation", inds, 2, put), BMI_SUCCESS);
+    m->get_value(m, "land_surface__elevation", h2);
+    h[0] = 1.5, h[7] = 2.5;
+    assert_memory_equal(h, h2, sizeof h);
+
+    /* The bed: no value before one is set, then what was set. */
+    double bed[NX * NY];
+    assert_int_equal(m->get_value(m, "bedrock_surface__elevation", bed), BMI_FAILURE);
+    assert_int_equal(m->get_value_ptr(m, "bedrock_surface__elevation", (void **)&ptr), BMI_FAILURE);
+    assert_int_equal(m->get_value_at_indices(m, "bedrock_surface__elevation", picked, inds, 1), BMI_FAILURE);
+    for (int k = 0; k < NX * NY; ++k) bed[k] = -1 + 0.001 * k;
+    assert_int_equal(m->set_value(m, "bedrock_surface__elevation", bed), BMI_SUCCESS);
+    double bed2[NX * NY];
+    assert_int_equal(m->get_value(m, "bedrock_surface__elevation", bed2), BMI_SUCCESS);
+    assert_memory_equal(bed, bed2, sizeof bed);
+
+    /* The angle: uniform 30 degrees until a field is set. */
+    double angle[NX * NY];
+    assert_int_equal(m->get_value(m, "sediment__angle_of_repose", angle), BMI_SUCCESS);
+    for (int k = 0; k < NX * NY; ++k) assert_true(fabs(angle[k] - 30) < 1e-12);
+    for (int k = 0; k < NX * NY; ++k) angle[k] = 20 + 0.2 * k;
+    assert_int_equal(m->set_value(m, "sediment__angle_of_repose", angle), BMI_SUCCESS);
+    double angle2[NX * NY];
+    m->get_value(m, "sediment__angle_of_repose", angle2);
+    assert_memory_equal(angle, angle2, sizeof angle);
+    angle[3] = 95; /* refused as a whole: nothing changes */
+    assert_int_equal(m->set_value(m, "sediment__angle_of_repose", angle), BMI_FAILURE);
+    m->get_value(m, "sediment__angle_of_repose", angle);
+    assert_memory_equal(angle, angle2, sizeof angle);
+
+    /* The source: deposits over the next update, booked as sourced volume. */
+    double q[NX * NY], q2[NX * NY];
+    for (int k = 0; k < NX * NY; ++k) q[k] = 0.02;
+    assert_int_equal(m->set_value(m, "land_surface__net_deposition_rate", q), BMI_SUCCESS);
+    m->get_value(m, "land_surface__net_deposition_rate", q2);
+    assert_memory_equal(q, q2, sizeof q);
+    double sourced = scalar(m, "land_surface_sediment__sourced_volume");
+    assert_int_equal(m->update(m), BMI_SUCCESS);
+    assert_true(fabs(scalar(m, "land_surface_sediment__sourced_volume") - sourced - 0.02 * 0.1 * NX * NY * 0.125) < 1e-12);
+    double total = scalar(m, "land_surface_sediment__total_volume");
+    double ledger = scalar(m, "land_surface_sediment__sourced_volume") +
+                    scalar(m, "land_surface_sediment__external_volume") -
+                    scalar(m, "land_surface_sediment__outflow_volume");
+    assert_true(fabs(total - ledger) < 1e-10);
+    assert_true(scalar(m, "land_surface_sediment__unmet_erosion_volume") == 0);
+    double *total_ptr;
+    assert_int_equal(m->get_value_ptr(m, "land_surface_sediment__total_volume", (void **)&total_ptr), BMI_SUCCESS);
+    assert_true(*total_ptr == total);
+    stop(m);
+}
+
+static void bad_input_fails_without_harm(void **state) {
+    (void)state;
+    /* Before initialize, and a configuration that is refused. */
+    Bmi blank;
+    memset(&blank, 0, sizeof blank);
+    registration(&blank);
+    double t;
+    int n;
+    assert_int_equal(blank.update(&blank), BMI_FAILURE);
+    assert_int_equal(blank.get_current_time(&blank, &t), BMI_FAILURE);
+    assert_int_equal(blank.get_input_item_count(&blank, &n), BMI_FAILURE);
+    assert_int_equal(blank.finalize(&blank), BMI_FAILURE);
+    assert_int_equal(blank.initialize(&blank, NULL), BMI_FAILURE);
+    const char *bad = write_text("bad.yaml", "grid: {kind: 2d, nx: sixty, ny: 4, dx: 1, dy: 1}\n");
+    assert_int_equal(blank.initialize(&blank, bad), BMI_FAILURE);
+    assert_null(blank.data);
+    char missing[512];
+    snprintf(missing, sizeof missing, "%s/nowhere.yaml", folder);
+    assert_int_equal(blank.initialize(&blank, missing), BMI_FAILURE);
+    assert_null(registration(NULL));
+
+    Bmi *m = start("grid2d.yaml", kGrid2d);
+    const char *path = write_text("grid2d.yaml", kGrid2d);
+    assert_int_equal(m->initialize(m, path), BMI_FAILURE); /* twice */
+    double h[NX * NY], before[NX * NY], v[4];
+    m->get_value(m, "land_surface__elevation", before);
+    char text[BMI_MAX_UNITS_NAME];
+    int grid;
+    void *ptr;
+    assert_int_equal(m->get_var_grid(m, "surface__elevation", &grid), BMI_FAILURE);
+    assert_int_equal(m->get_var_units(m, "nothing", text), BMI_FAILURE);
+    assert_int_equal(m->get_var_type(m, NULL, text), BMI_FAILURE);
+    assert_int_equal(m->get_var_type(m, "land_surface__elevation", NULL), BMI_FAILURE);
+    assert_int_equal(m->get_value(m, "nothing", h), BMI_FAILURE);
+    assert_int_equal(m->get_value(m, NULL, h), BMI_FAILURE);
+    assert_int_equal(m->get_value(m, "land_surface__elevation", NULL), BMI_FAILURE);
+    assert_int_equal(m->get_value_ptr(m, "nothing", &ptr), BMI_FAILURE);
+    assert_int_equal(m->get_value_ptr(m, "land_surface__elevation", NULL), BMI_FAILURE);
+    assert_int_equal(m->get_var_grid(m, "land_surface_sediment__avalanche_volume_flux", &grid), BMI_FAILURE);
+    int outside[] = {0, NX * NY}, negative[] = {-1};
+    assert_int_equal(m->get_value_at_indices(m, "land_surface__elevation", v, outside, 2), BMI_FAILURE);
+    assert_int_equal(m->get_value_at_indices(m, "land_surface__elevation", v, negative, 1), BMI_FAILURE);
+    assert_int_equal(m->get_value_at_indices(m, "land_surface__elevation", v, NULL, 1), BMI_FAILURE);
+    assert_int_equal(m->get_value_at_indices(m, "land_surface__elevation", v, outside, -1), BMI_FAILURE);
+    double put[] = {5, 5};
+    assert_int_equal(m->set_value_at_indices(m, "land_surface__elevation", outside, 2, put), BMI_FAILURE);
+    assert_int_equal(m->set_value(m, "land_surface__elevation", NULL), BMI_FAILURE);
+    assert_int_equal(m->set_value(m, "land_surface_sediment__total_volume", put), BMI_FAILURE); /* an output */
+    for (int k = 0; k < NX * NY; ++k) h[k] = 1;
+    h[5] = NAN;
+    assert_int_equal(m->set_value(m, "land_surface__elevation", h), BMI_FAILURE);
+    h[5] = INFINITY;
+    assert_int_equal(m->set_value(m, "land_surface__net_deposition_rate", h), BMI_FAILURE);
+    assert_int_equal(m->set_value_at_indices(m, "bedrock_surface__elevation", negative + 0, 0, put), BMI_FAILURE);
+    double after[NX * NY];
+    m->get_value(m, "land_surface__elevation", after);
+    assert_memory_equal(before, after, sizeof before);
+    assert_int_equal(m->get_component_name(m, NULL), BMI_FAILURE);
+    assert_int_equal(m->get_input_var_names(m, NULL), BMI_FAILURE);
+    assert_int_equal(m->get_current_time(m, NULL), BMI_FAILURE);
+    assert_int_equal(m->get_grid_shape(m, 0, NULL), BMI_FAILURE);
+    assert_int_equal(m->get_grid_x(m, 7, h), BMI_FAILURE);
+    stop(m);
+}
+
+/* ---- the 1d grid: grid numbers skip what it lacks --------------------- */
+
+static void grids_of_a_1d_grid(void **state) {
+    (void)state;
+    Bmi *m = start("grid1d.yaml", "grid: {kind: 1d, nx: 10, dx: 0.2}\n"
+                                  "initial: {scene: cone, radius: 0.5, height: 1}\n"
+                                  "source: {constant: 0.001}\n"
+                                  "time: {step: 0.5, end: 1.2}\n");
+    int count;
+    assert_int_equal(m->get_output_item_count(m, &count), BMI_SUCCESS);
+    assert_int_equal(count, 9);
+    check_variable(m, &(struct expected_variable){"land_surface__elevation", "m", "node", 0}, 10);
+    check_variable(
+        m, &(struct expected_variable){"land_surface_sediment__x_component_of_avalanche_volume_flux", "m3 s-1", "node", 1},
+        11);
+    check_variable(m, &(struct expected_variable){"land_surface_sediment__total_volume", "m3", "node", 2}, 1);
+    int grid;
+    assert_int_equal(m->get_var_grid(m, "land_surface_sediment__y_component_of_avalanche_volume_flux", &grid),
+                     BMI_FAILURE);
+    check_rectilinear(m, 0, 1, (int[]){10}, (double[]){0.2}, (double[]){0.1});
+    check_rectilinear(m, 1, 1, (int[]){11}, (double[]){0.2}, (double[]){0});
+    check_scalar_grid(m, 2);
+    check_no_grid(m, 3);
+    double q[10];
+    assert_int_equal(m->get_value(m, "land_surface__net_deposition_rate", q), BMI_SUCCESS);
+    assert_true(q[0] == 0.001 && q[9] == 0.001);
+    double t;
+    assert_int_equal(m->update_until(m, 1.2), BMI_SUCCESS);
+    m->get_current_time(m, &t);
+    assert_true(t == 1.2);
+    stop(m);
+}
+
+/* ---- the unstructured mesh ----------------------------------------- */
+
+static const char kMesh[] = "grid: {kind: mesh, file: bed.nc}\n"
+                            "initial: {scene: cone, radius: 1.5, height: 3}\n"
+                            "time: {step: 0.05, end: 0.12}\n";
+
+static void mesh_grid_and_values(void **state) {
+    (void)state;
+    char file[512];
+    snprintf(file, sizeof file, "%s/bed.nc", folder);
+    assert_int_equal(write_ugrid_test_mesh(file, 1), 0);
+    Bmi *m = start("mesh.yaml", kMesh);
+    int count;
+    assert_int_equal(m->get_output_item_count(m, &count), BMI_SUCCESS);
+    assert_int_equal(count, 9);
+    const char *flux = "land_surface_sediment__avalanche_volume_flux";
+    check_variable(m, &(struct expected_variable){"land_surface__elevation", "m", "face", 0}, UGRID_TEST_FACES);
+    check_variable(m, &(struct expected_variable){"sediment__angle_of_repose", "deg", "face", 0}, UGRID_TEST_FACES);
+    check_variable(m, &(struct expected_variable){flux, "m3 s-1", "edge", 1}, UGRID_TEST_EDGES);
+    check_variable(m, &(struct expected_variable){"land_surface_sediment__outflow_volume", "m3", "node", 2}, 1);
+    int grid;
+    assert_int_equal(m->get_var_grid(m, "land_surface_sediment__x_component_of_avalanche_volume_flux", &grid),
+                     BMI_FAILURE);
+    check_scalar_grid(m, 2);
+    check_no_grid(m, 3);
+
+    int face_nodes[32], face_edges[32], edge_nodes[2 * UGRID_TEST_EDGES], per_face[UGRID_TEST_FACES];
+    for (int g = 0; g <= 1; ++g) {
+        char type[BMI_MAX_TYPE_NAME];
+        int rank, size, nodes, edges, faces, shape[2];
+        assert_int_equal(m->get_grid_type(m, g, type), BMI_SUCCESS);
+        assert_string_equal(type, "unstructured");
+        assert_int_equal(m->get_grid_rank(m, g, &rank), BMI_SUCCESS);
+        assert_int_equal(rank, 2);
+        assert_int_equal(m->get_grid_size(m, g, &size), BMI_SUCCESS);
+        assert_int_equal(size, UGRID_TEST_NODES);
+        assert_int_equal(m->get_grid_node_count(m, g, &nodes), BMI_SUCCESS);
+        assert_int_equal(nodes, UGRID_TEST_NODES);
+        assert_int_equal(m->get_grid_edge_count(m, g, &edges), BMI_SUCCESS);
+        assert_int_equal(edges, UGRID_TEST_EDGES);
+        assert_int_equal(m->get_grid_face_count(m, g, &faces), BMI_SUCCESS);
+        assert_int_equal(faces, UGRID_TEST_FACES);
+        assert_int_equal(m->get_grid_shape(m, g, shape), BMI_FAILURE);
+        double x[UGRID_TEST_NODES], y[UGRID_TEST_NODES], z[UGRID_TEST_NODES];
+        assert_int_equal(m->get_grid_x(m, g, x), BMI_SUCCESS);
+        assert_int_equal(m->get_grid_y(m, g, y), BMI_SUCCESS);
+        assert_int_equal(m->get_grid_z(m, g, z), BMI_FAILURE);
+        for (int k = 0; k < UGRID_TEST_NODES; ++k) assert_true(x[k] == k % 3 && y[k] == k / 3);
+    }
+    /* UGRID's topology, from 0: faces as the file gives them, every edge of a
+     * face joining two consecutive nodes of it. */
+    assert_int_equal(m->get_grid_nodes_per_face(m, 0, per_face), BMI_SUCCESS);
+    assert_int_equal(m->get_grid_face_nodes(m, 0, face_nodes), BMI_SUCCESS);
+    assert_int_equal(m->get_grid_face_edges(m, 0, face_edges), BMI_SUCCESS);
+    assert_int_equal(m->get_grid_edge_nodes(m, 0, edge_nodes), BMI_SUCCESS);
+    int used[UGRID_TEST_EDGES] = {0};
+    for (int f = 0, p = 0; f < UGRID_TEST_FACES; p += per_face[f], ++f) {
+        int n = ugrid_test_face_nodes[f][3] < 0 ? 3 : 4;
+        assert_int_equal(per_face[f], n);
+        for (int k = 0; k < n; ++k) {
+            assert_int_equal(face_nodes[p + k], ugrid_test_face_nodes[f][k]);
+            int e = face_edges[p + k], u = face_nodes[p + k], w = face_nodes[p + (k + 1) % n];
+            assert_in_range(e, 0, UGRID_TEST_EDGES - 1);
+            assert_true((edge_nodes[2 * e] == u && edge_nodes[2 * e + 1] == w) ||
+                        (edge_nodes[2 * e] == w && edge_nodes[2 * e + 1] == u));
+            ++used[e];
+        }
+    }
+    int interior = 0;
+    for (int e = 0; e < UGRID_TEST_EDGES; ++e) {
+        assert_in_range(used[e], 1, 2);
+        interior += used[e] == 2;
+    }
+    assert_int_equal(interior, 5);
+
+    /* Values: the flux on an edge runs from the first face that lists it to
+     * the second (the faces' order); what the edges carried over an update
+     * is each face's change of volume (the mesh's edge is a wall). */
+    double h[UGRID_TEST_FACES], h2[UGRID_TEST_FACES], f[UGRID_TEST_EDGES];
+    const double area[UGRID_TEST_FACES] = {1, 1, 1, 0.5, 0.5};
+    const double pile[UGRID_TEST_FACES] = {3, 0, 0.5, 0, 1};
+    assert_int_equal(m->set_value(m, "land_surface__elevation", (void *)pile), BMI_SUCCESS);
+    assert_int_equal(m->get_value(m, "land_surface__elevation", h), BMI_SUCCESS);
+    assert_memory_equal(h, pile, sizeof h);
+    assert_int_equal(m->update(m), BMI_SUCCESS);
+    assert_int_equal(m->get_value(m, "land_surface__elevation", h2), BMI_SUCCESS);
+    assert_int_equal(m->get_value(m, flux, f), BMI_SUCCESS);
+    int first_face[UGRID_TEST_EDGES];
+    for (int e = 0; e < UGRID_TEST_EDGES; ++e) first_face[e] = -1;
+    double in[UGRID_TEST_FACES] = {0};
+    for (int face = 0, p = 0; face < UGRID_TEST_FACES; p += per_face[face], ++face)
+        for (int k = 0; k < per_face[face]; ++k) {
+            int e = face_edges[p + k];
+            if (first_face[e] < 0) first_face[e] = face, in[face] -= f[e];
+            else in[face] += f[e];
+        }
+    double moved = 0;
+    for (int face = 0; face < UGRID_TEST_FACES; ++face) {
+        assert_true(fabs(in[face] * 0.05 - (h2[face] - h[face]) * area[face]) < 1e-12);
+        moved += fabs(h2[face] - h[face]);
+    }
+    assert_true(moved > 1e-4);
+    double t;
+    assert_int_equal(m->update_until(m, 0.12), BMI_SUCCESS);
+    m->get_current_time(m, &t);
+    assert_true(t == 0.12);
+    int inds[] = {4, 0};
+    double picked[2];
+    assert_int_equal(m->get_value(m, "land_surface__elevation", h), BMI_SUCCESS);
+    assert_int_equal(m->get_value_at_indices(m, "land_surface__elevation", picked, inds, 2), BMI_SUCCESS);
+    assert_true(picked[0] == h[4] && picked[1] == h[0]);
+    int outside[] = {UGRID_TEST_FACES};
+    assert_int_equal(m->get_value_at_indices(m, "land_surface__elevation", picked, outside, 1), BMI_FAILURE);
+    int edge_outside[] = {UGRID_TEST_EDGES};
+    assert_int_equal(m->get_value_at_indices(m, flux, picked, edge_outside, 1), BMI_FAILURE);
+    stop(m);
+}
+
+static int setup(void **state) {
+    (void)state;
+    snprintf(folder, sizeof folder, "%s/dpsm-bmi-host-XXXXXX", getenv("TMPDIR") ? getenv("TMPDIR") : "/tmp");
+    return mkdtemp(folder) ? 0 : -1;
+}
+
+static int teardown(void **state) {
+    (void)state;
+    char command[512];
+    snprintf(command, sizeof command, "rm -rf '%s'", folder);
+    return system(command) == 0 ? 0 : -1;
+}
+
+int main(int argc, char **argv) {
+    if (argc != 2) {
+        fprintf(stderr, "usage: %s <path of libdpsm_bmi.so>\n", argv[0]);
+        return 2;
+    }
+    library_path = argv[1];
+    library = dlopen(library_path, RTLD_NOW | RTLD_LOCAL);
+    if (!library) {
+        fprintf(stderr, "bmi_host: cannot load %s: %s\n", library_path, dlerror());
+        return 1;
+    }
+    /* NextGen's default name, and the component's own. */
+    registration = (Bmi * (*)(Bmi *)) dlsym(library, "register_bmi");
+    Bmi *(*own)(Bmi *) = (Bmi * (*)(Bmi *)) dlsym(library, "register_bmi_dpsm");
+    if (!registration || !own) {
+        fprintf(stderr, "bmi_host: %s lacks register_bmi or register_bmi_dpsm\n", library_path);
+        return 1;
+    }
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(registration_and_information_2d),
+        cmocka_unit_test(time_lands_on_the_end),
+        cmocka_unit_test(values_in_and_out_2d),
+        cmocka_unit_test(bad_input_fails_without_harm),
+        cmocka_unit_test(grids_of_a_1d_grid),
+        cmocka_unit_test(mesh_grid_and_values),
+    };
+    int failed = cmocka_run_group_tests(tests, setup, teardown);
+    registration = own; /* the same table through the component's own name */
+    failed += cmocka_run_group_tests_name("register_bmi_dpsm", tests, setup, teardown);
+    dlclose(library);
+    return failed ? 1 : 0;
+}
