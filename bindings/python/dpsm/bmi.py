@@ -73,6 +73,9 @@ MASS_VARIABLES = (
     ("land_surface_sediment__unmet_erosion_volume", C.DPSM_MASS_UNMET),
 )
 
+## The library's default angle of repose in degrees (DPSM_DEFAULT_REPOSE_ANGLE is pi/6 radians).
+DEFAULT_REPOSE_ANGLE = round(math.degrees(C.DPSM_DEFAULT_REPOSE_ANGLE), 9)
+
 # How much longer than a step the time left may be and still be one step, so
 # that update() lands on the end time instead of leaving a sliver after it.
 _LANDING_SLACK = 1e-9
@@ -177,7 +180,7 @@ class BmiDpsm(_BmiBase):
         self._views = {name: _read_only(buffer) for name, buffer in self._values.items()}
         self._has_bedrock = False
         self._fill_values(self._values[DEPOSITION_RATE], config.source or [0.0] * config.ncells)
-        angle = config.repose_angle if config.repose_angle is not None else math.degrees(C.DPSM_DEFAULT_REPOSE_ANGLE)
+        angle = config.repose_angle if config.repose_angle is not None else DEFAULT_REPOSE_ANGLE
         self._fill_values(self._values[REPOSE_ANGLE], [angle] * config.ncells)
         self._flux_names = [name for name in (FLUX_X, FLUX_Y, FLUX_MESH) if name in self._variables]
         self._carried = {name: _doubles(len(self._values[name])) for name in self._flux_names}
