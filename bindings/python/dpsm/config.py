@@ -227,8 +227,11 @@ class _Reader:
     """Checks values of yaml's node tree and names where they stood."""
 
     def __init__(self, path):
-        import yaml  # python3-yaml; a dependency of this module only
-
+        try:
+            import yaml  # python3-yaml: needed to read a configuration, not to import dpsm
+        except ImportError:
+            raise ConfigError("%s: reading a configuration needs the Python package PyYAML (Debian: python3-yaml)"
+                              % os.fspath(path)) from None
         self.yaml = yaml
         self.path = path
         self.name = os.fspath(path)
