@@ -34,6 +34,7 @@ variables and grids. In short:
 """
 
 import array
+import collections
 import math
 import operator
 
@@ -81,27 +82,22 @@ DEFAULT_REPOSE_ANGLE = round(math.degrees(C.DPSM_DEFAULT_REPOSE_ANGLE), 9)
 _LANDING_SLACK = 1e-9
 
 
-class _Variable:
-    """A BMI variable: its grid, units, location and whether hosts set it."""
-
-    def __init__(self, name, units, grid, location, settable, readable):
-        self.name = name
-        self.units = units
-        self.grid = grid
-        self.location = location
-        self.settable = settable
-        self.readable = readable
+# A BMI variable: its grid, units, location and whether hosts set and read it.
+_Variable = collections.namedtuple("_Variable", "name units grid location settable readable")
 
 
-class _GridInfo:
-    """A BMI grid: ``kind`` is uniform_rectilinear, unstructured or scalar."""
+# Helpers hosts do not call: left out of the API reference.
+## @cond INTERNAL
+# A BMI grid: ``kind`` is uniform_rectilinear, unstructured or scalar; shape,
+# spacing and origin (BMI's order, slowest axis first) for rectilinear ones.
+class _GridInfo(collections.namedtuple("_GridInfo", "kind size shape spacing origin")):
+    __slots__ = ()
 
-    def __init__(self, kind, size, shape=(), spacing=(), origin=()):
-        self.kind = kind
-        self.size = size
-        self.shape = shape
-        self.spacing = spacing
-        self.origin = origin
+    def __new__(cls, kind, size, shape=(), spacing=(), origin=()):
+        return super().__new__(cls, kind, size, shape, spacing, origin)
+
+
+## @endcond
 
 
 def _doubles(n):
@@ -567,15 +563,22 @@ class BmiDpsm(_BmiBase):
                      integer=True)
 
 
+# Helpers hosts do not call: left out of the API reference.
+## @cond INTERNAL
 class _MeshEdges:
     """The BMI topology of a mesh: its edges are dpsm's faces, numbered as
     the library numbers them (as they first appear, cell by cell, edge by
     edge in each cell's node order), so that edge k carries face k's flux."""
 
     def __init__(self, topology, grid):
+        """The edges of ``topology`` (a dpsm.config.MeshTopology), checked against ``grid``'s faces."""
+        ## (x of each node, y of each node).
         self.node_xy = (topology.node_x, topology.node_y)
+        ## The nodes of each face (dpsm's cells), from 0.
         self.face_nodes = topology.face_nodes
+        ## The two nodes of each edge (dpsm's faces).
         self.edge_nodes = []
+        ## The edges of each face, in its node order.
         self.face_edges = []
         number = {}
         first_cell = []
@@ -589,11 +592,15 @@ class _MeshEdges:
                     first_cell.append(cell)
                 edges.append(number[key])
             self.face_edges.append(edges)
+        ## The number of edges.
         self.edge_count = len(self.edge_nodes)
         faces = grid.get_mesh_faces()
         if len(faces) != self.edge_count or any(int(faces[k][0]) != first_cell[k] for k in range(self.edge_count)):
             raise Error(C.DPSM_ERR_INTERNAL, "the mesh's edges (%d) do not match the library's faces (%d)"
                         % (self.edge_count, len(faces)), "initialize")
+
+
+## @endcond
 
 
 def _indices(inds, size, function):

@@ -223,6 +223,8 @@ class Config:
 # ---- reading the node tree ---------------------------------------------------
 
 
+# Helpers hosts do not call: left out of the API reference.
+## @cond INTERNAL
 class _Reader:
     """Checks values of yaml's node tree and names where they stood."""
 
@@ -308,6 +310,9 @@ class _Reader:
         """A file name, relative to the configuration's folder."""
         name = self.text(node, key)
         return os.path.join(os.path.dirname(os.path.abspath(self.name)), os.path.expanduser(name))
+
+
+## @endcond
 
 
 def read_config(path):
