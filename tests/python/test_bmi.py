@@ -250,6 +250,8 @@ class TestTime(BmiCase):
         self.assertEqual(m.get_current_time(), 0.3)
         with self.assertRaisesRegex(ValueError, "update_until: time = 0.2 lies before the current time 0.3"):
             m.update_until(0.2)
+        with self.assertRaisesRegex(ValueError, "update_until: time = inf is not finite"):
+            m.update_until(math.inf)
         with self.assertRaisesRegex(TypeError, "update_until: time must be a real number, not a str"):
             m.update_until("1")
 

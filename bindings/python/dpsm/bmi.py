@@ -212,7 +212,9 @@ class BmiDpsm(_BmiBase):
         if why is not None:
             raise TypeError("update_until: time must be a real number, not %s" % why)
         time = float(time)
-        if not math.isfinite(time) or time < self._time:
+        if not math.isfinite(time):
+            raise ValueError("update_until: time = %r is not finite" % time)
+        if time < self._time:
             raise ValueError("update_until: time = %r lies before the current time %r" % (time, self._time))
         dts, times, t = [], [], self._time
         while time - t > self._step * (1 + _LANDING_SLACK):
@@ -223,7 +225,6 @@ class BmiDpsm(_BmiBase):
             dts.append(time - t)
             times.append(time)
         if dts:
-            times[-1] = time
             self._advance(grid, dts, times)
 
     def _advance(self, grid, dts, times):
