@@ -92,8 +92,7 @@ class BmiCase(unittest.TestCase):
         self.tmp.cleanup()
 
     def value(self, name):
-        size = self.model.get_grid_size(self.model.get_var_grid(name))
-        return values(self.model.get_value(name, doubles(size)))
+        return values(self.model.get_value(name, doubles(self.model.get_var_nbytes(name) // 8)))
 
 
 class TestClass(unittest.TestCase):
@@ -469,8 +468,10 @@ class TestMesh(BmiCase):
         self.assertEqual([m.get_var_grid(name) for name in (ELEVATION, SOURCE, FLUX_MESH, MASSES[0])], [0, 0, 1, 2])
         self.assertEqual([m.get_var_location(name) for name in (ELEVATION, FLUX_MESH, MASSES[0])],
                          ["face", "edge", "none"])
+        count = {"face": m.get_grid_face_count, "edge": m.get_grid_edge_count, "none": m.get_grid_size}
         for name in set(m.get_input_var_names()) | set(m.get_output_var_names()):
-            self.assertEqual(m.get_var_nbytes(name), 8 * m.get_grid_size(m.get_var_grid(name)), name)
+            location = m.get_var_location(name)
+            self.assertEqual(m.get_var_nbytes(name), 8 * count[location](m.get_var_grid(name)), name)
         self.assertEqual(m.get_var_nbytes(ELEVATION), 8 * 10)
         self.assertEqual(m.get_var_nbytes(FLUX_MESH), 8 * 21)
 
@@ -485,7 +486,7 @@ class TestMesh(BmiCase):
             self.assertRaises(ValueError, m.get_grid_shape, grid, integers(2))
             self.assertRaises(ValueError, m.get_grid_spacing, grid, doubles(2))
             self.assertRaises(ValueError, m.get_grid_z, grid, doubles(12))
-        self.assertEqual((m.get_grid_size(0), m.get_grid_size(1)), (10, 21))
+        self.assertEqual((m.get_grid_size(0), m.get_grid_size(1)), (12, 12))  # BMI: the nodes
         per_face = [int(n) for n in m.get_grid_nodes_per_face(0, integers(10))]
         self.assertEqual(per_face, [len(f) for f in MESH_FACES])
         total = sum(per_face)

@@ -78,8 +78,9 @@ MASS_VARIABLES = (
 DEFAULT_REPOSE_ANGLE = round(math.degrees(C.DPSM_DEFAULT_REPOSE_ANGLE), 9)
 
 # How much longer than a step the time left may be and still be one step, so
-# that update() lands on the end time instead of leaving a sliver after it.
-_LANDING_SLACK = 1e-9
+# that update() lands on the end time instead of leaving a sliver after it
+# (the C component takes the same, so both step alike).
+_LANDING_SLACK = 1e-6
 
 
 # A BMI variable: its grid, units, location and whether hosts set and read it.
@@ -88,8 +89,9 @@ _Variable = collections.namedtuple("_Variable", "name units grid location settab
 
 # Helpers hosts do not call: left out of the API reference.
 ## @cond INTERNAL
-# A BMI grid: ``kind`` is uniform_rectilinear, unstructured or scalar; shape,
-# spacing and origin (BMI's order, slowest axis first) for rectilinear ones.
+# A BMI grid: ``kind`` is uniform_rectilinear, unstructured or scalar; ``size``
+# the number of values a variable on it holds; shape, spacing and origin (BMI's
+# order, slowest axis first) for rectilinear ones.
 class _GridInfo(collections.namedtuple("_GridInfo", "kind size shape spacing origin")):
     __slots__ = ()
 
@@ -335,7 +337,8 @@ class BmiDpsm(_BmiBase):
         return 8
 
     def get_var_nbytes(self, name):
-        """8 times the size of the variable's grid."""
+        """8 times the number of values at the variable's location: the size of its grid, except on a
+        mesh, whose variables sit on its faces or edges."""
         return 8 * self._grids[self._variable(name, "get_var_nbytes").grid].size
 
     def get_var_location(self, name):
@@ -483,9 +486,10 @@ class BmiDpsm(_BmiBase):
         return 2 if info.kind == "unstructured" else len(info.shape)
 
     def get_grid_size(self, grid):
-        """The number of values of a variable on ``grid``: nodes of a rectilinear grid, faces (cells)
-        of grid 0 of a mesh, edges of grid 1 of a mesh, 1 for scalars."""
-        return self._grid_info(grid, "get_grid_size").size
+        """The nodes of ``grid`` (as ``get_grid_node_count``; BMI's size of an unstructured grid is its
+        node count), 1 for scalars. A variable on the faces or edges of a mesh holds
+        ``get_grid_face_count`` or ``get_grid_edge_count`` values."""
+        return self.get_grid_node_count(grid)
 
     def get_grid_type(self, grid):
         """``"uniform_rectilinear"``, ``"unstructured"`` or ``"scalar"``."""
