@@ -245,8 +245,10 @@ class TestTime(BmiCase):
         self.assertEqual(m.get_current_time(), 0.1)
         m.update_until(m.get_end_time())
         self.assertEqual(m.get_current_time(), 0.3)
-        m.update_until(0.3)  # no time to go: nothing happens
+        self.assertNotEqual(set(self.value(FLUX_X)), {0.0})
+        m.update_until(0.3)  # no time to go: nothing moves, no face carries anything
         self.assertEqual(m.get_current_time(), 0.3)
+        self.assertEqual(set(self.value(FLUX_X)) | set(self.value(FLUX_Y)), {0.0})
         with self.assertRaisesRegex(ValueError, "update_until: time = 0.2 lies before the current time 0.3"):
             m.update_until(0.2)
         with self.assertRaisesRegex(ValueError, "update_until: time = inf is not finite"):

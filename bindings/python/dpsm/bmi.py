@@ -226,8 +226,7 @@ class BmiDpsm(_BmiBase):
         if time > t:
             dts.append(time - t)
             times.append(time)
-        if dts:
-            self._advance(grid, dts, times)
+        self._advance(grid, dts, times)
 
     def _advance(self, grid, dts, times):
         """Steps ``dts`` in turn, ``times`` the time after each; the face fluxes become the volume
@@ -244,10 +243,11 @@ class BmiDpsm(_BmiBase):
                 self._add_fluxes(grid)
         finally:
             duration = self._time - start
-            if done:
+            if done or not dts:  # an advance of no time carried nothing: the fluxes read 0
+                scale = 1.0 / duration if duration > 0 else 0.0
                 for name in self._flux_names:
-                    self._fill_values(self._values[name], [v / duration for v in self._carried[name]]
-                                      if np is None else self._carried[name] / duration)
+                    self._fill_values(self._values[name], [v * scale for v in self._carried[name]]
+                                      if np is None else self._carried[name] * scale)
             self._refresh_state()
 
     def _add_fluxes(self, grid):
