@@ -226,6 +226,10 @@ time: {step: 0.05, end: 1.0}
                      "4: repose_angle: expected an angle strictly between 0 and 90 degrees, got 95")
         self.refused(GOOD_2D + "mobility: fast\n", "4: mobility: expected a positive number, got 'fast'")
         self.refused(GOOD_2D.replace("step: 0.1", "step: -0.1"), "3: time.step: expected a positive number, got -0.1")
+        self.refused(GOOD_2D.replace("nx: 8", "nx: !!python/int 8"),
+                     "1: grid.nx: cannot read '8' as tag:yaml.org,2002:python/int")
+        self.refused(GOOD_2D.replace("dx: 0.5", "dx: !!float half"),
+                     "1: grid.dx: cannot read 'half' as tag:yaml.org,2002:float")
         self.refused(GOOD_2D.replace("{kind: 2d, nx: 8, ny: 6, dx: 0.5, dy: 0.25}", "2d"),
                      "1: grid: expected a mapping, got '2d'")
 

@@ -245,26 +245,29 @@ class _Reader:
         text = "%s: %s: %s" % (where, key, problem) if key else "%s: %s" % (where, problem)
         raise ConfigError(text, status, line, key)
 
-    def value(self, node):
+    def value(self, node, key=None):
         """The Python value of a scalar node (int, float, str, bool, None)."""
-        return self.constructor.construct_object(node, deep=True)
+        try:
+            return self.constructor.construct_object(node, deep=True)
+        except (self.yaml.YAMLError, ValueError, TypeError):  # a tag SafeLoader refuses, !!float abc
+            return self.fail(node, key, "cannot read %r as %s" % (node.value, node.tag))
 
-    def got(self, node):
+    def got(self, node, key=None):
         if isinstance(node, self.yaml.MappingNode):
             return "a mapping"
         if isinstance(node, self.yaml.SequenceNode):
             return "a list"
-        value = self.value(node)
+        value = self.value(node, key)
         return "nothing" if value is None else repr(value)
 
     def mapping(self, node, key, allowed, required=()):
         """{name: (key node, value node)} of a mapping node, refusing unknown,
         repeated and missing keys."""
         if not isinstance(node, self.yaml.MappingNode):
-            self.fail(node, key, "expected a mapping, got %s" % self.got(node))
+            self.fail(node, key, "expected a mapping, got %s" % self.got(node, key))
         entries = {}
         for key_node, value_node in node.value:
-            name = self.value(key_node) if isinstance(key_node, self.yaml.ScalarNode) else None
+            name = self.value(key_node, key or None) if isinstance(key_node, self.yaml.ScalarNode) else None
             path = "%s.%s" % (key, name) if key else str(name)
             if not isinstance(name, str):
                 self.fail(key_node, key or None, "keys are names, got %s" % self.got(key_node))
@@ -281,7 +284,7 @@ class _Reader:
     def scalar(self, node, key):
         if not isinstance(node, self.yaml.ScalarNode):
             self.fail(node, key, "expected a value, got %s" % self.got(node))
-        return self.value(node)
+        return self.value(node, key)
 
     def positive_integer(self, node, key):
         value = self.scalar(node, key)
