@@ -450,6 +450,29 @@ class TestOneD(BmiCase):
         self.assertEqual(self.value(ANGLE), [30.0] * 12)  # the library's default
 
 
+class TestAxisymmetric(BmiCase):
+    config_text = textwrap.dedent("""\
+        grid: {kind: axisymmetric, nr: 8, dr: 0.25}
+        boundaries: {xmax: wall}
+        initial: {scene: column, radius: 0.5, height: 1.0}
+        time: {step: 0.1, end: 0.4}
+        """)
+
+    def test_grids_and_volume(self):
+        m = self.model
+        self.assertEqual([m.get_grid_type(g) for g in range(3)], ["uniform_rectilinear"] * 2 + ["scalar"])
+        self.assertEqual(list(m.get_grid_shape(0, integers(1))), [8])
+        self.assertEqual(values(m.get_grid_origin(0, doubles(1))), [0.125])
+        self.assertEqual(m.get_var_nbytes(FLUX_X), 8 * 9)
+        self.assertEqual(self.value(ELEVATION), [1.0, 1.0] + [0.0] * 6)  # rings of radius 0.125, 0.375
+        volume = self.value(MASSES[0])[0]
+        self.assertAlmostEqual(volume, math.pi * 0.5 ** 2 * 1.0, places=12)  # rings of area 2 pi r dr
+        m.update_until(m.get_end_time())
+        self.assertEqual(m.get_current_time(), 0.4)
+        self.assertAlmostEqual(self.value(MASSES[0])[0], volume, delta=1e-12)
+        self.assertLess(self.value(ELEVATION)[1], 1.0)  # the column's edge has slumped
+
+
 @unittest.skipIf(netcdf4() is None, "netCDF4 is not importable (it needs numpy)")
 class TestMesh(BmiCase):
     config_text = textwrap.dedent("""\

@@ -125,7 +125,6 @@ class BmiDpsm(_BmiBase):
     def __init__(self):
         """A component to be initialized."""
         self._grid = None
-        self._config = None
 
     # ---- control ---------------------------------------------------------------
 
@@ -135,7 +134,7 @@ class BmiDpsm(_BmiBase):
             self.finalize()
         config = read_config(config_file)
         grid = config.create_grid()
-        self._config, self._grid = config, grid
+        self._grid = grid
         try:
             grid.set_face_flux_recording(1)
             self._setup(config, grid)
