@@ -17,7 +17,9 @@
 #     through LD_LIBRARY_PATH and through an rpath; before and after the move.
 #  6. Python: prog.py imports the installed package with PYTHONPATH=<its dir>
 #     and no DPSM_LIBRARY; it must load the library installed next to it, with
-#     numpy and with DPSM_NO_NUMPY=1; before and after the move.
+#     numpy and with DPSM_NO_NUMPY=1; before and after the move. The Python
+#     BMI conformance test (tests/python/test_bmi.py, test_config.py) runs
+#     against the installed package too.
 #  7. MPI (when the MPI component was built, i.e. dpsm-mpi.pc is installed):
 #     $CC prog_mpi.c $(pkg-config --cflags --libs dpsm-mpi), run on 2 ranks;
 #     before and after the move.
@@ -206,6 +208,10 @@ python_import() {
         "$PYTHON" "$here/prog.py" "$libdir" || fail "the installed Python package failed"
     env -u DPSM_LIBRARY PYTHONPATH="$pydir" PYTHONDONTWRITEBYTECODE=1 DPSM_NO_NUMPY=1 \
         "$PYTHON" "$here/prog.py" "$libdir" || fail "the installed Python package failed without numpy"
+    say "Python: the BMI conformance test (tests/python/test_bmi.py) against the installed package"
+    (cd "$work" && env -u DPSM_LIBRARY -u DPSM_NO_NUMPY PYTHONPATH="$pydir:$src/tests/python" \
+        PYTHONDONTWRITEBYTECODE=1 "$PYTHON" -m unittest -q test_bmi test_config) ||
+        fail "the Python BMI conformance test failed against the installed package"
 }
 
 # ---- 7. MPI: dpsm-mpi.pc ----------------------------------------------------

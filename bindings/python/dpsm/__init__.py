@@ -34,6 +34,10 @@ A ctypes binding of the C library (no compiled extension)::
 - Arrays are numpy arrays when numpy can be imported (and the environment
   variable ``DPSM_NO_NUMPY`` is not set to a non-empty value other than 0),
   plain lists otherwise; ``dpsm.HAVE_NUMPY`` tells which.
+- ``dpsm.bmi.BmiDpsm`` is dpsm as a BMI 2.0 component (for Landlab, pymt
+  and other BMI hosts), configured by a YAML file that ``dpsm.config``
+  reads (docs: The BMI component in Python); import them as
+  ``from dpsm.bmi import BmiDpsm``.
 - The C library is found through ``DPSM_LIBRARY``, next to the installed
   package, or on the system path (see ``dpsm._lib``); ``dpsm.LIBRARY`` is the
   one loaded.
