@@ -20,13 +20,22 @@
 !> reads back this rank's block of a distributed grid from the file path that
 !> this rank wrote with dpsm_save (collective over comm, on as many ranks as
 !> saved it; trailing blanks of path are dropped).
+!>
+!>     call dpsm_create_graph_mpi(g, comm, global_id, owner, cell_xy, cell_area, face_cells, face_xy, face_length[, ierr])
+!>     call dpsm_create_mesh_mpi(g, comm, node_xy, cell_start, cell_nodes, global_id, owner[, ierr])
+!>
+!> this rank's part of a distributed mesh: its owned and ghost cells as the
+!> host holds them, with the arrays of dpsm_create_graph and dpsm_create_mesh
+!> (indices from 1, 0 for the domain edge in face_cells), global ids from 1
+!> and owners as ranks of comm (from 0, as MPI counts); the counts are the
+!> arrays' sizes. Messages name cells and global ids from 1. Collective over comm.
 module dpsm_mpi
   use, intrinsic :: iso_c_binding, only: c_ptr, c_int, c_int32_t, c_int64_t, c_double, c_char, c_null_char
   use dpsm, only: dpsm_grid, dpsm_adopt_handle, dpsm_status_string, dpsm_last_error, DPSM_OK
   implicit none
   private
 
-  public :: dpsm_create_2d_mpi, dpsm_load_mpi
+  public :: dpsm_create_2d_mpi, dpsm_load_mpi, dpsm_create_graph_mpi, dpsm_create_mesh_mpi
 
   interface dpsm_create_2d_mpi
     module procedure create_2d_mpi_i64, create_2d_mpi_i32
@@ -43,6 +52,30 @@ module dpsm_mpi
       type(c_ptr), intent(out) :: out
       integer(c_int) :: status
     end function c_dpsm_create_2d_mpi_f
+
+    function c_dpsm_create_graph_mpi_f(comm, ncells, global_id, owner, cell_xy, cell_area, nfaces, face_cells, &
+                                       face_xy, face_length, out) bind(C, name='dpsm_create_graph_mpi_f') result(status)
+      import :: c_int, c_int64_t, c_double, c_ptr
+      integer(c_int), value :: comm
+      integer(c_int64_t), value :: ncells, nfaces
+      integer(c_int64_t), intent(in) :: global_id(*), face_cells(*)
+      integer(c_int), intent(in) :: owner(*)
+      real(c_double), intent(in) :: cell_xy(*), cell_area(*), face_xy(*), face_length(*)
+      type(c_ptr), intent(out) :: out
+      integer(c_int) :: status
+    end function c_dpsm_create_graph_mpi_f
+
+    function c_dpsm_create_mesh_mpi_f(comm, nnodes, node_xy, ncells, cell_start, cell_nodes, global_id, owner, out) &
+        bind(C, name='dpsm_create_mesh_mpi_f') result(status)
+      import :: c_int, c_int64_t, c_double, c_ptr
+      integer(c_int), value :: comm
+      integer(c_int64_t), value :: nnodes, ncells
+      real(c_double), intent(in) :: node_xy(*)
+      integer(c_int64_t), intent(in) :: cell_start(*), cell_nodes(*), global_id(*)
+      integer(c_int), intent(in) :: owner(*)
+      type(c_ptr), intent(out) :: out
+      integer(c_int) :: status
+    end function c_dpsm_create_mesh_mpi_f
 
     function c_dpsm_load_mpi_f(comm, path, out) bind(C, name='dpsm_load_mpi_f') result(status)
       import :: c_int, c_char, c_ptr
@@ -104,5 +137,59 @@ contains
       error stop 'dpsm_load_mpi failed: '//dpsm_status_string(status)//': '//dpsm_last_error()
     end if
   end subroutine dpsm_load_mpi
+
+  !> dpsm_create_graph_mpi(g, comm, global_id, owner, cell_xy, cell_area, face_cells, face_xy, face_length[, ierr]):
+  !> this rank's part of a mesh given as a finite-volume graph: ncells =
+  !> size(global_id) local cells (cell_xy(2, ncells), cell_area(ncells)),
+  !> nfaces = size(face_length) faces (face_cells(2, nfaces) from 1, 0 for the
+  !> domain edge; face_xy(2, nfaces)). Collective over comm.
+  subroutine dpsm_create_graph_mpi(g, comm, global_id, owner, cell_xy, cell_area, face_cells, face_xy, face_length, &
+                                   ierr)
+    type(dpsm_grid), intent(out) :: g
+    integer, intent(in) :: comm
+    integer(c_int64_t), intent(in), contiguous :: global_id(:), face_cells(:, :)
+    integer, intent(in), contiguous :: owner(:)
+    real(c_double), intent(in), contiguous :: cell_xy(:, :), cell_area(:), face_xy(:, :), face_length(:)
+    integer, intent(out), optional :: ierr
+    type(c_ptr) :: ptr
+    integer(c_int) :: status
+    status = c_dpsm_create_graph_mpi_f(int(comm, c_int), size(global_id, kind=c_int64_t), global_id, int(owner, c_int), &
+                                       cell_xy, cell_area, size(face_length, kind=c_int64_t), face_cells, face_xy, &
+                                       face_length, ptr)
+    call adopt(g, ptr, status, 'dpsm_create_graph_mpi', ierr)
+  end subroutine dpsm_create_graph_mpi
+
+  !> dpsm_create_mesh_mpi(g, comm, node_xy, cell_start, cell_nodes, global_id, owner[, ierr]):
+  !> this rank's part of a mesh given as polygons: node_xy(2, nnodes),
+  !> cell_start(ncells + 1) from 1, cell_nodes from 1, global_id(ncells) from
+  !> 1, owner(ncells). Collective over comm.
+  subroutine dpsm_create_mesh_mpi(g, comm, node_xy, cell_start, cell_nodes, global_id, owner, ierr)
+    type(dpsm_grid), intent(out) :: g
+    integer, intent(in) :: comm
+    real(c_double), intent(in), contiguous :: node_xy(:, :)
+    integer(c_int64_t), intent(in), contiguous :: cell_start(:), cell_nodes(:), global_id(:)
+    integer, intent(in), contiguous :: owner(:)
+    integer, intent(out), optional :: ierr
+    type(c_ptr) :: ptr
+    integer(c_int) :: status
+    status = c_dpsm_create_mesh_mpi_f(int(comm, c_int), size(node_xy, 2, kind=c_int64_t), node_xy, &
+                                      size(global_id, kind=c_int64_t), cell_start, cell_nodes, global_id, &
+                                      int(owner, c_int), ptr)
+    call adopt(g, ptr, status, 'dpsm_create_mesh_mpi', ierr)
+  end subroutine dpsm_create_mesh_mpi
+
+  subroutine adopt(g, ptr, status, name, ierr)
+    type(dpsm_grid), intent(inout) :: g
+    type(c_ptr), intent(in) :: ptr
+    integer(c_int), intent(in) :: status
+    character(len=*), intent(in) :: name
+    integer, intent(out), optional :: ierr
+    call dpsm_adopt_handle(g, ptr, status)
+    if (present(ierr)) then
+      ierr = int(status)
+    else if (status /= DPSM_OK) then
+      error stop name//' failed: '//dpsm_status_string(status)//': '//dpsm_last_error()
+    end if
+  end subroutine adopt
 
 end module dpsm_mpi

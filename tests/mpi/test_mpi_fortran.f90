@@ -4,7 +4,10 @@
 ! scene, and the global mass must match; a grid saved with dpsm_save and read
 ! back with dpsm_load_mpi must continue bit for bit, and a rank given another
 ! rank's file must fail on every rank; a decomposition with a gap must fail
-! on every rank with a message that says so.
+! on every rank with a message that says so. A mesh of quads handed over by
+! dpsm_create_mesh_mpi (strips of columns, one layer of ghosts, indices and
+! global ids from 1) must equal the serial mesh bit for bit, and a global id
+! out of range must fail on every rank naming it from 1.
 program test_mpi_fortran
   use, intrinsic :: iso_c_binding, only: c_double, c_int64_t
   use mpi
@@ -114,8 +117,99 @@ program test_mpi_fortran
     print '(2a)', 'refused on every rank: ', message
   end if
 
+  call mesh_parts()
+
   call MPI_Allreduce(failures, total, 1, MPI_INTEGER, MPI_SUM, MPI_COMM_WORLD, ierr)
   if (rank == 0) print '(a,i0,a,i0)', 'test_mpi_fortran on ', ranks, ' ranks: failures ', total
   call MPI_Finalize(ierr)
   if (total /= 0) error stop 1
+contains
+
+  ! An m x m lattice of unit quads; rank r owns columns [c0, c0 + nc) and holds
+  ! the columns beside them as ghosts; cells numbered row by row from 1.
+  subroutine mesh_parts()
+    integer, parameter :: m = 16
+    real(c_double) :: node_xy(2, (m + 1)*(m + 1)), hs(m*m), x, y
+    integer(c_int64_t) :: cell_start(m*m + 1), cell_nodes(4*m*m)
+    integer(c_int64_t), allocatable :: part_start(:), part_nodes(:), global_id(:)
+    integer, allocatable :: owner(:)
+    real(c_double), allocatable :: hp(:)
+    type(dpsm_grid) :: part, whole
+    integer :: c0, nc, k, n, cell, column, row, local, s
+    do row = 0, m
+      do column = 0, m
+        node_xy(:, 1 + column + (m + 1)*row) = [real(column, c_double), real(row, c_double) + 0.1_c_double*column]
+      end do
+    end do
+    do row = 0, m - 1
+      do column = 0, m - 1
+        cell = 1 + column + m*row
+        cell_start(cell) = 4*(cell - 1) + 1
+        k = 1 + column + (m + 1)*row
+        cell_nodes(4*(cell - 1) + 1:4*cell) = int([k, k + 1, k + m + 2, k + m + 1], c_int64_t)
+        x = column + 0.5_c_double - m/2.0_c_double
+        y = row + 0.5_c_double - m/2.0_c_double
+        hs(cell) = 0.0_c_double
+        if (x*x + y*y < 16.0_c_double) hs(cell) = 6.0_c_double
+      end do
+    end do
+    cell_start(m*m + 1) = 4*m*m + 1
+    c0 = rank*(m/ranks) + min(rank, mod(m, ranks))
+    nc = m/ranks
+    if (rank < mod(m, ranks)) nc = nc + 1
+    n = 0
+    do row = 0, m - 1
+      do column = max(0, c0 - 1), min(m - 1, c0 + nc)
+        n = n + 1
+      end do
+    end do
+    allocate (part_start(n + 1), part_nodes(4*n), global_id(n), owner(n), hp(n))
+    local = 0
+    do row = 0, m - 1
+      do column = max(0, c0 - 1), min(m - 1, c0 + nc)
+        local = local + 1
+        cell = 1 + column + m*row
+        global_id(local) = cell
+        owner(local) = rank
+        if (column < c0) owner(local) = rank - 1
+        if (column >= c0 + nc) owner(local) = rank + 1
+        part_start(local) = 4*(local - 1) + 1
+        part_nodes(4*(local - 1) + 1:4*local) = cell_nodes(4*(cell - 1) + 1:4*cell)
+        hp(local) = hs(cell)
+        if (owner(local) /= rank) hp(local) = -3.0_c_double  ! a ghost's value is replaced by its owner's
+      end do
+    end do
+    part_start(n + 1) = 4*n + 1
+    call dpsm_create_mesh_mpi(part, MPI_COMM_WORLD, node_xy, part_start, part_nodes, global_id, owner)
+    call dpsm_create_mesh(whole, int((m + 1)*(m + 1), c_int64_t), node_xy, int(m*m, c_int64_t), cell_start, cell_nodes)
+    call dpsm_set_boundary(part, DPSM_MESH_EDGE, DPSM_OPEN)
+    call dpsm_set_boundary(whole, DPSM_MESH_EDGE, DPSM_OPEN)
+    call dpsm_set_heights(part, hp)
+    call dpsm_set_heights(whole, hs)
+    do s = 1, 4
+      call dpsm_step(part, 0.5_c_double)
+      call dpsm_step(whole, 0.5_c_double)
+      call dpsm_get_heights(part, hp)
+      call dpsm_get_heights(whole, hs)
+      if (any(hp /= hs(global_id))) then
+        failures = failures + 1
+        print '(a,i0,a,i0,a,i0)', 'FAIL: rank ', rank, ' mesh step ', s, ': cells differing from serial: ', &
+          count(hp /= hs(global_id))
+      end if
+    end do
+    call dpsm_destroy(part)
+    call dpsm_destroy(whole)
+    ! A global id beyond the mesh's m*m cells, named as Fortran counts.
+    if (rank == 0) global_id(1) = m*m + 1
+    call dpsm_create_mesh_mpi(part, MPI_COMM_WORLD, node_xy, part_start, part_nodes, global_id, owner, ierr)
+    message = dpsm_last_error()
+    if (ierr == DPSM_OK .or. index(message, 'numbered from 1 without gaps') == 0 .or. dpsm_associated(part)) then
+      failures = failures + 1
+      print '(a,i0,a,i0,2a)', 'FAIL: rank ', rank, ' a global id out of range gave status ', ierr, ' and message: ', &
+        message
+    else if (rank == 0) then
+      print '(2a)', 'refused on every rank: ', message
+    end if
+  end subroutine mesh_parts
+
 end program test_mpi_fortran
