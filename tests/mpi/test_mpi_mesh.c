@@ -544,11 +544,35 @@ static void run_scene(const mesh_t *m, int scene, int kind, int graph) {
     set_scene(m, scene, &part);
     double *hs = xcalloc((size_t)m->ncells, sizeof(double)), *hp = xcalloc((size_t)p.ncells, sizeof(double));
     const double dts[] = {0.02, 0.05, 0.05, 0.1, 0.003};
+    /* Saved after the second step, read back, and the two then stepped alike. */
+    dpsm_grid *loaded = NULL;
+    char path[64];
+    snprintf(path, sizeof path, "test_mpi_mesh.%d.dpsm", rank_);
     for (int step = 0; step < 5; ++step) {
         char at[300];
         snprintf(at, sizeof at, "%s, step %d", where, step + 1);
+        if (step == 2 && kind != PART_RANDOM) {
+            OK(part.g, dpsm_save(part.g, path));
+            OK(NULL, dpsm_load_mpi(MPI_COMM_WORLD, path, &loaded));
+            remove(path);
+        }
         OK(serial.g, dpsm_step(serial.g, dts[step]));
         OK(part.g, dpsm_step(part.g, dts[step]));
+        if (loaded) {
+            double *hl = xcalloc((size_t)p.ncells, sizeof(double));
+            OK(loaded, dpsm_step(loaded, dts[step]));
+            OK(loaded, dpsm_get_heights(loaded, hl));
+            long differ = 0;
+            OK(serial.g, dpsm_get_heights(serial.g, hs));
+            for (int64_t k = 0; k < p.ncells; ++k) differ += memcmp(&hl[k], &hs[p.global[k]], sizeof(double)) != 0;
+            require(differ == 0, "%s: the part read back from its restart file: %ld cells differ from the serial mesh",
+                    at, differ);
+            double a = 0.0, b = 0.0;
+            OK(part.g, dpsm_get_mass(part.g, DPSM_MASS_OUTFLOW, &a));
+            OK(loaded, dpsm_get_mass(loaded, DPSM_MASS_OUTFLOW, &b));
+            require(a == b, "%s: the part read back has outflow %.17g, the part %.17g", at, b, a);
+            free(hl);
+        }
         OK(serial.g, dpsm_get_heights(serial.g, hs));
         OK(part.g, dpsm_get_heights(part.g, hp));
         long differ = 0;
@@ -585,6 +609,7 @@ static void run_scene(const mesh_t *m, int scene, int kind, int graph) {
         if (scene != SCENE_TO_REST) compare_faces(&serial, &part, serial_cells, part_cells, at);
     }
     free(hs), free(hp), free(part_cells);
+    dpsm_destroy(loaded);
 done:
     dpsm_destroy(serial.g);
     dpsm_destroy(part.g);
@@ -654,6 +679,25 @@ static void inconsistent_partitions(void) {
     status = create_part(&p, &g);
     require_failed_alike(NULL, status, "without gaps", "a global id out of range");
     if (changed >= 0) p.global_id[changed] = p.global[changed];
+
+    /* Restart files: each rank loads another rank's file: refused on every rank. */
+    status = create_part(&p, &g);
+    require(status == DPSM_OK, "the partition: %s", dpsm_last_error(NULL));
+    char mine[64], other[64];
+    snprintf(mine, sizeof mine, "test_mpi_mesh_other.%d.dpsm", rank_);
+    snprintf(other, sizeof other, "test_mpi_mesh_other.%d.dpsm", (rank_ + 1) % size_);
+    OK(g, dpsm_save(g, mine));
+    dpsm_destroy(g);
+    g = NULL;
+    MPI_Barrier(MPI_COMM_WORLD);
+    status = dpsm_load_mpi(MPI_COMM_WORLD, other, &g);
+    require_failed_alike(NULL, status, "rank", "a rank loading another rank's file");
+    require(g == NULL, "a refused load left a grid");
+    status = dpsm_load(mine, &g);
+    require(status == DPSM_ERR_NOT_APPLICABLE && g == NULL && strstr(dpsm_last_error(NULL), "dpsm_load_mpi"),
+            "dpsm_load of a part of a distributed mesh: %s: %s", dpsm_status_string(status), dpsm_last_error(NULL));
+    MPI_Barrier(MPI_COMM_WORLD);
+    remove(mine);
 
     /* A NULL array on one rank. */
     status = dpsm_create_mesh_mpi(MPI_COMM_WORLD, p.nnodes, p.node_xy, p.ncells, p.cell_start, p.cell_nodes,
