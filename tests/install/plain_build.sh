@@ -128,6 +128,27 @@ expect_refusal() {
     fi
 }
 expect_refusal DPSM_BUILD_TESTS libcmocka-dev
+
+# pkg-config present (a copy outside /usr/bin) but no cmocka.pc it can see:
+# AUTO says CMocka is missing, ON fails naming libcmocka-dev.
+if pkg_config=$(command -v pkg-config); then
+    mkdir -p "$work/pkg-config-bin" "$work/no-pc-files"
+    cp -L "$pkg_config" "$work/pkg-config-bin/pkg-config"
+    export PKG_CONFIG_LIBDIR=$work/no-pc-files PKG_CONFIG_PATH=
+    pc_option=-DPKG_CONFIG_EXECUTABLE=$work/pkg-config-bin/pkg-config
+    hidden cmake -S "$src" -B "$work/pc-auto" "$pc_option" >"$work/pc-auto.log" 2>&1 ||
+        fail "configuring with pkg-config but without CMocka: $(grep -A4 'CMake Error' "$work/pc-auto.log")"
+    grep -qE '^-- dpsm: the tests not built: CMocka was not found.*libcmocka-dev' "$work/pc-auto.log" ||
+        fail "with pkg-config but without CMocka the line does not say CMocka is missing"
+    if hidden cmake -S "$src" -B "$work/pc-on" "$pc_option" -DDPSM_BUILD_TESTS=ON \
+        >"$work/pc-on.log" 2>&1; then
+        fail "-DDPSM_BUILD_TESTS=ON configured with pkg-config but without CMocka"
+    elif ! grep -q 'CMocka was not found' "$work/pc-on.log" || ! grep -q libcmocka-dev "$work/pc-on.log"; then
+        fail "-DDPSM_BUILD_TESTS=ON without CMocka did not name libcmocka-dev: $(grep -A4 'CMake Error' "$work/pc-on.log")"
+    else
+        echo "== -DDPSM_BUILD_TESTS=ON with pkg-config but no CMocka: refused, naming libcmocka-dev"
+    fi
+fi
 expect_refusal DPSM_BUILD_DOCS doxygen
 expect_refusal DPSM_BUILD_FORTRAN gfortran
 
