@@ -725,7 +725,7 @@ std::shared_ptr<const Mesh> mesh_from_input(const MeshInput &input, const char *
     fail(DPSM_ERR_BAD_FILE, function, "unknown mesh kind ", static_cast<unsigned>(input.kind));
 }
 
-std::string host_position(const char *name, std::int64_t k, int base, int rows) {
+std::string host_position(const char *name, std::int64_t k, int base, std::int64_t rows) {
     if (base == 0) return std::string(name) + "[" + std::to_string(k) + "]";
     if (rows <= 1) return std::string(name) + "(" + std::to_string(k + base) + ")";
     return std::string(name) + "(" + std::to_string(k % rows + base) + ", " + std::to_string(k / rows + base) + ")";

@@ -157,8 +157,8 @@ std::shared_ptr<const Mesh> mesh_from_input(const MeshInput &input, const char *
 // Position k of the host's array `name`, as a host that counts from `base`
 // writes it: C's name[k] (base 0), Fortran's name(k+1) (base 1). With `rows`
 // > 1 the array holds tuples of that many values (node_xy, face_cells,
-// triangle_nodes), which Fortran holds as the columns of name(rows, n):
-// name(k % rows + 1, k / rows + 1).
-std::string host_position(const char *name, std::int64_t k, int base, int rows = 1);
+// triangle_nodes; a 2D grid's rows of nx cells), which Fortran holds as the
+// columns of name(rows, n): name(k % rows + 1, k / rows + 1).
+std::string host_position(const char *name, std::int64_t k, int base, std::int64_t rows = 1);
 
 }  // namespace dpsm

@@ -4,10 +4,12 @@ The library is looked for, in this order:
 
 1. the file named by the environment variable ``DPSM_LIBRARY`` (and nowhere
    else when it is set);
-2. next to this package: ``_libpath.py``, written by ``cmake --install``,
+2. inside this package: ``pip install .`` puts the library it built into the
+   package directory (``libdpsm.so.<major>``), so the package carries its own;
+3. next to this package: ``_libpath.py``, written by ``cmake --install``,
    holds the path of the installed library relative to this directory, so an
    installed tree may be moved;
-3. the system's search path (``ctypes.util.find_library("dpsm")``, then
+4. the system's search path (``ctypes.util.find_library("dpsm")``, then
    ``libdpsm.so.<major>``).
 """
 
@@ -73,6 +75,7 @@ SIGNATURES = {
     "dpsm_set_max_substeps": (_int, [GridPtr, _i64]),
     "dpsm_set_threads": (_int, [GridPtr, _int]),
     "dpsm_get_threads": (_int, [GridPtr, _P(_int)]),
+    "dpsm_set_index_base": (_int, [GridPtr, _int]),
     "dpsm_set_bedrock": (_int, [GridPtr, _P(_dbl)]),
     "dpsm_set_repose_angle_field": (_int, [GridPtr, _P(_dbl)]),
     "dpsm_set_flux_exponent": (_int, [GridPtr, _dbl]),
@@ -100,12 +103,16 @@ def _candidates():
     if env:
         return [(env, "DPSM_LIBRARY")]
     found = []
+    here = os.path.dirname(os.path.abspath(__file__))
+    for name in _system_names():
+        inside = os.path.join(here, name)
+        if os.path.exists(inside):
+            found.append((inside, "inside the package"))
     try:
         from . import _libpath  # written by cmake --install
     except ImportError:
         _libpath = None
     if _libpath is not None:
-        here = os.path.dirname(os.path.abspath(__file__))
         found.append((os.path.normpath(os.path.join(here, _libpath.LIBRARY)), "next to the package"))
     name = ctypes.util.find_library("dpsm")
     if name:
@@ -127,8 +134,8 @@ def _load():
     raise ImportError(
         "dpsm: cannot load the dpsm C library; tried:\n  "
         + "\n  ".join(tried)
-        + "\nSet DPSM_LIBRARY to the path of libdpsm.so, or install dpsm with cmake --install "
-        "(the package then finds the library next to itself)."
+        + "\nSet DPSM_LIBRARY to the path of libdpsm.so, or install dpsm with pip install . (the package "
+        "then carries its own library) or cmake --install (the package then finds the library next to itself)."
     )
 
 
