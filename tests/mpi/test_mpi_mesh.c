@@ -305,7 +305,7 @@ static int64_t *face_nodes(int64_t ncells, const int64_t *cell_start, const int6
 /* ---- scenes -------------------------------------------------------------- */
 
 enum { SCENE_COLLAPSE, SCENE_SOURCES, SCENE_PHYSICS, SCENE_TO_REST, N_SCENES };
-static const char *const scene_names[] = {"column collapse, open edge", "sources, walls, open cells, edge kinds",
+static const char *const scene_names[] = {"column collapse, open edge", "sources, walls, open cells, edge kinds, flux exponent",
                                           "bed, erosion, angle field, static angle, edge levels",
                                           "relaxation to rest"};
 
@@ -372,6 +372,7 @@ static void set_scene(const mesh_t *m, int scene, run_t *r) {
     OK(r->g, dpsm_set_source(r->g, scene == SCENE_SOURCES || scene == SCENE_PHYSICS ? v : NULL));
 #undef FILL
     if (scene == SCENE_COLLAPSE || scene == SCENE_TO_REST) OK(r->g, dpsm_set_boundary(r->g, DPSM_MESH_EDGE, DPSM_OPEN));
+    if (scene == SCENE_SOURCES) OK(r->g, dpsm_set_flux_exponent(r->g, 1.5));
     if (scene == SCENE_SOURCES || scene == SCENE_PHYSICS) {
         /* per face: open on the left half of the domain edge, levels by x */
         uint8_t *edge = xcalloc((size_t)r->nfaces, 1);
