@@ -4,11 +4,16 @@
  *                          keys) to its end time, shows progress, writes
  *                          snapshots and the ledger to output.file every
  *                          output.every seconds, prints the mass balance
+ *   dpsm plot OUT.nc [-o FILE] [--show]
+ *                          draws that output: hands over to the Python
+ *                          package (dpsm/plot.py), which needs matplotlib
  *   dpsm --version
  *
  * Exit status: 0 done, 1 the run failed (the reason on stderr), 2 a usage error. */
 #define _POSIX_C_SOURCE 200809L
 #include <math.h>
+#include <errno.h>
+#include <limits.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -23,6 +28,9 @@ static const int kLedgerQuantities[OUTPUT_LEDGER_FIGURES] = {DPSM_MASS_TOTAL, DP
 
 static void usage(FILE *to) {
     fprintf(to, "usage: dpsm run CONFIG.yaml    run a configuration to its end time (docs/guide_bmi.md)\n"
+                "       dpsm plot OUT.nc [-o FILE] [--show]\n"
+                "                              draw the last snapshot and the ledger of a run's output to\n"
+                "                              OUT.png (or FILE); runs python3 -m dpsm plot, or $DPSM_PYTHON\n"
                 "       dpsm --version\n");
 }
 
@@ -152,6 +160,75 @@ static int run(const char *path) {
     return failed;
 }
 
+/* What `python3 -m dpsm plot ARGS` runs, with one message instead of Python's
+ * "No module named dpsm" when the package cannot be imported. */
+static const char kPlotBootstrap[] =
+    "import sys\n"
+    "try:\n"
+    "    from dpsm.__main__ import main\n"
+    "except ImportError as e:\n"
+    "    sys.exit('dpsm plot: the Python package dpsm cannot be imported by %s (%s); put the folder that holds '\n"
+    "             'dpsm/ on PYTHONPATH, install dpsm (cmake --install, pip install .) or set DPSM_PYTHON to a '\n"
+    "             'python3 that has it' % (sys.executable, e))\n"
+    "sys.exit(main(['plot'] + sys.argv[1:]))\n";
+
+/* The installed program finds the Python package installed with it
+ * (DPSM_CLI_PYTHONDIR, relative to bin/), which a python3 does not look in
+ * for every prefix; it goes ahead of PYTHONPATH, so the package matches the
+ * program. */
+static void find_installed_package(void) {
+#if defined(DPSM_CLI_PYTHONDIR) && defined(__linux__)
+    char self[PATH_MAX], package[PATH_MAX + 64];
+    ssize_t length = readlink("/proc/self/exe", self, sizeof self - 1);
+    if (length <= 0) return;
+    self[length] = '\0';
+    char *slash = strrchr(self, '/');
+    if (!slash) return;
+    *slash = '\0';
+    snprintf(package, sizeof package, "%s/%s/dpsm/__init__.py", self, DPSM_CLI_PYTHONDIR);
+    if (access(package, R_OK) != 0) return;
+    *strrchr(package, '/') = '\0';
+    *strrchr(package, '/') = '\0';
+    const char *before = getenv("PYTHONPATH");
+    if (before && *before) {
+        size_t size = strlen(package) + strlen(before) + 2;
+        char *joined = malloc(size);
+        if (!joined) return;
+        snprintf(joined, size, "%s:%s", package, before);
+        setenv("PYTHONPATH", joined, 1);
+        free(joined);
+    } else {
+        setenv("PYTHONPATH", package, 1);
+    }
+#endif
+}
+
+/* `dpsm plot ARGS`: the drawing is Python's (matplotlib); this process
+ * becomes the interpreter, so its exit status is the plot's. */
+static int plot(int argc, char **argv) {
+    const char *python = getenv("DPSM_PYTHON");
+    if (!python || !*python) python = "python3";
+    char **args = calloc((size_t)argc + 4, sizeof *args);
+    if (!args) {
+        fprintf(stderr, "dpsm plot: out of memory\n");
+        return 1;
+    }
+    args[0] = (char *)python;
+    args[1] = "-c";
+    args[2] = (char *)kPlotBootstrap;
+    for (int k = 0; k < argc; ++k) args[3 + k] = argv[k];
+    find_installed_package();
+    fflush(stdout);
+    execvp(python, args);
+    fprintf(stderr,
+            "dpsm plot: cannot run the Python interpreter \"%s\" (%s); dpsm plot needs python3 with matplotlib, "
+            "numpy and netCDF4 (Debian: apt-get install python3 python3-matplotlib python3-numpy python3-netcdf4) "
+            "and the dpsm package on PYTHONPATH; DPSM_PYTHON names another interpreter\n",
+            python, strerror(errno));
+    free(args);
+    return 1;
+}
+
 int main(int argc, char **argv) {
     if (argc == 2 && (strcmp(argv[1], "--version") == 0 || strcmp(argv[1], "-V") == 0)) {
         printf("dpsm %s\n", dpsm_version_string());
@@ -162,10 +239,13 @@ int main(int argc, char **argv) {
         return 0;
     }
     if (argc == 3 && strcmp(argv[1], "run") == 0) return run(argv[2]);
-    if (argc >= 2 && strcmp(argv[1], "run") != 0)
-        fprintf(stderr, "dpsm: unknown command \"%s\"\n", argv[1]);
-    else if (argc >= 2)
+    if (argc >= 3 && strcmp(argv[1], "plot") == 0) return plot(argc - 2, argv + 2);
+    if (argc >= 2 && strcmp(argv[1], "run") == 0)
         fprintf(stderr, "dpsm run: expected one configuration file\n");
+    else if (argc >= 2 && strcmp(argv[1], "plot") == 0)
+        fprintf(stderr, "dpsm plot: expected the netCDF file written by dpsm run\n");
+    else if (argc >= 2)
+        fprintf(stderr, "dpsm: unknown command \"%s\"\n", argv[1]);
     usage(stderr);
     return 2;
 }

@@ -31,7 +31,7 @@ def _need(module, package):
     try:
         return __import__(module, fromlist=["_"])
     except ImportError:
-        raise PlotError("dpsm plot needs the Python package %s (Debian: apt-get install %s); "
+        raise PlotError("the Python package %s is missing (Debian: apt-get install %s); "
                         "this Python is %s" % (module.split(".")[0], package, sys.executable))
 
 
