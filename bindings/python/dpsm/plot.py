@@ -36,15 +36,10 @@ def _need(module, package):
 
 
 class Run:
-    """What the plot needs of a ``dpsm run`` output, read and checked.
-
-    ``kind`` is ``"2d"``, ``"1d"`` or ``"mesh"``; ``time`` the snapshot times;
-    ``h_last`` (and ``h_first``) the heights; ``x``, ``y`` the cell centres
-    (grids) or the node coordinates (meshes); ``polygons`` the node indices of
-    each cell (meshes); ``x_name`` "x" or "r"; ``ledger`` a list of (name,
-    units, values)."""
+    """What the plot needs of a ``dpsm run`` output, read and checked."""
 
     def __init__(self, path):
+        """Reads ``path``; raises PlotError naming what is missing."""
         if not os.path.exists(path):
             raise PlotError("%s: no such file" % path)
         np = _need("numpy", "python3-numpy")
@@ -69,14 +64,25 @@ class Run:
         if not h.dimensions or h.dimensions[0] != "time" or len(h.dimensions) not in (2, 3):
             raise missing("its h has dimensions (%s), expected (time, y, x), (time, x) or (time, cell)"
                           % ", ".join(h.dimensions))
+        ## The snapshot times, s.
         self.time = np.asarray(variables["time"][:], dtype=float)
         if len(self.time) == 0 or h.shape[0] == 0:
             raise missing("it holds no snapshot")
         last = min(len(self.time), h.shape[0]) - 1
+        ## The time of the last snapshot, s.
         self.t_last = float(self.time[last])
+        ## The heights of the last snapshot, m: (ny, nx) on 2d grids, (nx,) on 1d ones, (cells,) on meshes.
         self.h_last = np.asarray(h[last], dtype=float)
+        ## The heights of the first snapshot, m.
         self.h_first = np.asarray(h[0], dtype=float)
+        ## Meshes: the node indices (from 0) of each cell; None on grids.
         self.polygons = None
+        ## "2d", "1d" (1d and axisymmetric grids) or "mesh".
+        self.kind = None
+        ## The cell centres along x (grids) or the nodes' x (meshes), m.
+        self.x = None
+        ## The cell centres along y (2d grids) or the nodes' y (meshes), m.
+        self.y = None
         if "mesh" in h.ncattrs():
             self._read_mesh(data, h, np, missing)
         elif len(h.dimensions) == 3:
@@ -86,9 +92,11 @@ class Run:
         else:
             self.kind = "1d"
             self.x = self._coordinate(data, h.dimensions[1], np, missing)
+        ## What x is: "x", or "r" on axisymmetric grids.
         self.x_name = "x"
         if self.kind == "1d" and "radius" in getattr(variables[h.dimensions[1]], "long_name", ""):
             self.x_name = "r"
+        ## The ledger: (name, units, values) of every variable of dimension time alone.
         self.ledger = [(name, getattr(v, "units", ""), np.asarray(v[:], dtype=float))
                        for name, v in variables.items() if v.dimensions == ("time",) and name != "time"]
         if not self.ledger:
