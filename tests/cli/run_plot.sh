@@ -11,8 +11,8 @@
 #     exists, has the PNG signature, is larger than 10 kB and its surface
 #     panel is drawn on (check_png.py); python -m dpsm plot does the same
 #  2. refusals, each with exit status 1 and a message: a netCDF file without
-#     h, a file that is not there, a file that is not netCDF, numpy missing;
-#     no file named: exit 2
+#     h, a file that is not there, a mesh whose cells name nodes that are not
+#     there, a file that is not netCDF, numpy missing; no file named: exit 2
 #  3. the C program's own failures: an interpreter that cannot be run, a
 #     Python that cannot import the package
 set -euo pipefail
@@ -84,11 +84,16 @@ CDL
 ncgen -o "$work/no_h.nc" "$work/no_h.cdl"
 refuses 1 "no_h.nc is not an output of dpsm run: it has no variable h (the heights)" "$dpsm" plot "$work/no_h.nc"
 refuses 1 "absent.nc: no such file" "$dpsm" plot "$work/absent.nc"
+cp "$work/examples/mesh_out.nc" "$work/bad_mesh.nc"
+"$python" -c 'import sys, netCDF4
+with netCDF4.Dataset(sys.argv[1], "a") as f: f.variables["mesh_face_nodes"][0, 0] = 999' "$work/bad_mesh.nc"
+refuses 1 "bad_mesh.nc is not an output of dpsm run: its mesh_face_nodes names nodes that are not there" \
+    "$dpsm" plot "$work/bad_mesh.nc"
 refuses 1 "column.yaml: not a netCDF file" "$dpsm" plot "$work/examples/column.yaml"
 refuses 1 "dpsm plot: the Python package numpy is missing (Debian: apt-get install python3-numpy)" \
     "$python" "$src/tests/python/block_imports.py" numpy "$src/bindings/python/dpsm/__main__.py" plot "$work/examples/column_out.nc"
 refuses 2 "dpsm plot: expected the netCDF file written by dpsm run" "$dpsm" plot
-[[ ! -e $work/no_h.png && ! -e $work/absent.png ]] || fail "a refused file left a PNG"
+[[ ! -e $work/no_h.png && ! -e $work/absent.png && ! -e $work/bad_mesh.png ]] || fail "a refused file left a PNG"
 
 echo "== 3. no Python to hand over to"
 refuses 1 'cannot run the Python interpreter "/nonexistent/python3"' \

@@ -104,9 +104,10 @@ class Run:
 
     @staticmethod
     def _coordinate(data, dimension, np, missing):
-        if dimension not in data.variables:
-            raise missing("it has no coordinate variable %s for the dimension of h" % dimension)
-        return np.asarray(data.variables[dimension][:], dtype=float)
+        variable = data.variables.get(dimension)
+        if variable is None or variable.dimensions != (dimension,):
+            raise missing("it has no coordinate variable %s(%s) for the dimension of h" % (dimension, dimension))
+        return np.asarray(variable[:], dtype=float)
 
     def _read_mesh(self, data, h, np, missing):
         """The UGRID topology h names: node coordinates, face_node_connectivity."""
@@ -134,6 +135,9 @@ class Run:
         if table.ndim != 2 or table.shape[0] != self.h_last.shape[0]:
             raise missing("its %s does not list one row of nodes per cell of h" % names[2])
         self.polygons = [row[row != fill] - start for row in table]
+        nodes = min(len(self.x), len(self.y))
+        if any(len(p) < 3 or p.min() < 0 or p.max() >= nodes for p in self.polygons):
+            raise missing("its %s names nodes that are not there, or a cell of fewer than 3 nodes" % names[2])
 
 
 def _draw_surface(run, figure, axes, np):
