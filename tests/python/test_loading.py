@@ -40,6 +40,20 @@ class TestLoading(unittest.TestCase):
         self.assertEqual(r.returncode, 0, r.stderr)
         self.assertEqual(r.stdout.split(), ["False", "list"])
 
+    def test_dpsm_never_imports_mpi4py(self):
+        # As on a machine without mpi4py: import dpsm works; import dpsm.mpi says what to install.
+        r = python("import sys; sys.modules['mpi4py'] = None; import dpsm; g = dpsm.Grid.create_1d(3, 1.0); "
+                   "g.step(0.1); print(dpsm.version_string())\n"
+                   "try:\n    import dpsm.mpi\nexcept ImportError as e:\n    print('ImportError:', e)")
+        self.assertEqual(r.returncode, 0, r.stderr)
+        lines = r.stdout.splitlines()
+        self.assertEqual(lines[0], dpsm.version_string())
+        self.assertIn("ImportError: dpsm.mpi needs mpi4py", lines[1])
+        self.assertIn("install python3-mpi4py", lines[1])
+        # Where mpi4py is installed, import dpsm still leaves it alone (importing it initializes MPI).
+        r = python("import sys, dpsm; print('mpi4py' in sys.modules)")
+        self.assertEqual((r.returncode, r.stdout.strip()), (0, "False"), r.stderr)
+
 
 if __name__ == "__main__":
     unittest.main()
