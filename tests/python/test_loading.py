@@ -1,5 +1,6 @@
 """How the package finds the C library and numpy, checked in fresh interpreters."""
 
+import importlib.util
 import os
 import subprocess
 import sys
@@ -53,6 +54,15 @@ class TestLoading(unittest.TestCase):
         # Where mpi4py is installed, import dpsm still leaves it alone (importing it initializes MPI).
         r = python("import sys, dpsm; print('mpi4py' in sys.modules)")
         self.assertEqual((r.returncode, r.stdout.strip()), (0, "False"), r.stderr)
+
+    @unittest.skipUnless(importlib.util.find_spec("mpi4py"), "mpi4py is not importable")
+    def test_a_wrong_dpsm_mpi_library_is_an_import_error(self):
+        r = python("import dpsm.mpi", DPSM_MPI_LIBRARY="/nonexistent/libdpsm_mpi.so.0",
+                   OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
+        self.assertNotEqual(r.returncode, 0)
+        self.assertIn("ImportError: dpsm: cannot load the dpsm_mpi C library", r.stderr)
+        self.assertIn("/nonexistent/libdpsm_mpi.so.0 (DPSM_MPI_LIBRARY)", r.stderr)
+        self.assertIn("Set DPSM_MPI_LIBRARY", r.stderr)
 
 
 if __name__ == "__main__":
