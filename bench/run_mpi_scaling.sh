@@ -2,7 +2,11 @@
 # Regenerates the figures of docs/guide_mpi.md (scaling): builds dpsm-bench-mpi
 # and runs strong and weak scaling on 1 .. MAX_RANKS ranks (default: the
 # cores of this machine), and the communication alone, into
-# docs/data/mpi_scaling.csv (a log in docs/data/mpi_scaling.log).
+# docs/data/mpi_scaling.csv (a log in docs/data/mpi_scaling.log); then the
+# distributed triangle mesh of MESH_N (default 708: 1,002,528 cells) on 1, 2
+# and 4 ranks (oversubscribed past the cores) into
+# docs/data/mpi_mesh_scaling.csv, and its cost model extrapolated to 1,024
+# ranks into docs/data/mpi_mesh_model.txt. MESH_ONLY=1 runs the mesh alone.
 #
 #   bash bench/run_mpi_scaling.sh      # about a minute on 2 cores
 #
@@ -17,12 +21,30 @@ export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMP_NUM_THREADS
 
 cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=Release -DDPSM_BUILD_BENCH=ON \
       -DDPSM_BUILD_TESTS=OFF -DDPSM_BUILD_DOCS=OFF -DDPSM_BUILD_EXAMPLES=OFF >/dev/null
-cmake --build "$build" --target dpsm-bench-mpi
+cmake --build "$build" --target dpsm-bench-mpi dpsm-bench-mpi-mesh
 bench=$build/bench/dpsm-bench-mpi
+mesh_bench=$build/bench/dpsm-bench-mpi-mesh
 [[ -x $bench ]] || { echo "no $bench: was MPI found?" >&2; exit 1; }
 mkdir -p "$data"
 
 run() { mpiexec -n "$1" --bind-to core "$bench" "${@:2}" | tail -n 1; }
+
+mesh_n=${MESH_N:-708}
+{
+  head=1
+  for p in 1 2 4; do
+    bind=core
+    [[ $p -gt $(nproc) ]] && bind=none
+    mpiexec -n "$p" --oversubscribe --bind-to "$bind" "$mesh_bench" "$mesh_n" 5 | if [[ $head == 1 ]]; then cat; else tail -n 1; fi
+    head=0
+  done
+} >"$data/mpi_mesh_scaling.csv"
+{
+  echo "generated: $(date -u +%Y-%m-%dT%H:%M:%SZ) by bench/run_mpi_scaling.sh, source tree $(git -C "$root" describe --always --dirty 2>/dev/null || echo unknown)"
+  echo "machine: $(uname -m), $(nproc --all) cores, $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2- | sed 's/^ //'); load average after the runs: $(cut -d' ' -f1-3 /proc/loadavg)"
+  python3 "$root/bench/mpi_mesh_model.py" "$data/mpi_mesh_scaling.csv"
+} | tee "$data/mpi_mesh_model.txt"
+if [[ ${MESH_ONLY:-0} == 1 ]]; then exit 0; fi
 {
   echo "generated: $(date -u +%Y-%m-%dT%H:%M:%SZ) by bench/run_mpi_scaling.sh"
   echo "source tree $(git -C "$root" describe --always --dirty 2>/dev/null || echo unknown)"

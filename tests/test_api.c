@@ -963,6 +963,103 @@ static void test_step_beyond_supported_range(void **state) {
         }
 }
 
+/* dpsm_set_index_base: with 1 the messages name cells and positions as a
+ * Fortran host holding h(nx, ny) writes them; with 0 (the default) as C does;
+ * a mesh keeps the start index of its constructor; results do not change. */
+static void expect_message(dpsm_grid *g, int status, int code, const char *want) {
+    REQUIRE(status == code, "returned %s, expected %s (%s)", dpsm_status_string(status), dpsm_status_string(code),
+            dpsm_last_error(g));
+    REQUIRE(strstr(dpsm_last_error(g), want) != NULL, "message \"%s\" lacks \"%s\"", dpsm_last_error(g), want);
+}
+
+static void test_index_base(void **state) {
+    (void)state;
+    enum { NX = 5, NY = 4 };
+    dpsm_grid *c = NULL, *f = NULL;
+    CHECK_OK(NULL, dpsm_create_2d(NX, NY, 0.1, 0.1, &c));
+    CHECK_OK(NULL, dpsm_create_2d(NX, NY, 0.1, 0.1, &f));
+    CHECK_OK(f, dpsm_set_index_base(f, 1));
+    CHECK_OK(c, dpsm_set_index_base(c, 0));
+    uint8_t kinds[NX * NY] = {0};
+    kinds[2 + NX * 2] = 9;
+    expect_message(c, dpsm_set_cell_kinds(c, kinds), DPSM_ERR_UNKNOWN_ENUM, "kinds[12] (cell i = 2, j = 2) = 9");
+    expect_message(f, dpsm_set_cell_kinds(f, kinds), DPSM_ERR_UNKNOWN_ENUM, "kinds(3, 3) (cell i = 3, j = 3) = 9");
+    double h[NX * NY] = {0};
+    h[1 + NX * 3] = NAN;
+    expect_message(c, dpsm_set_heights(c, h), DPSM_ERR_INVALID_VALUE, "h[16] (cell i = 1, j = 3) is NaN");
+    expect_message(f, dpsm_set_heights(f, h), DPSM_ERR_INVALID_VALUE, "h(2, 4) (cell i = 2, j = 4) is NaN");
+    /* A block's positions count within the block; its offsets stay the host's. */
+    double block[6] = {0, 0, 0, 0, INFINITY, 0}; /* 3 by 2 from (1, 1): the cell (2, 2) */
+    expect_message(c, dpsm_set_heights_region(c, 1, 1, 3, 2, block), DPSM_ERR_INVALID_VALUE,
+                   "h[4] (cell i = 2, j = 2) is +Inf");
+    expect_message(f, dpsm_set_heights_region(f, 1, 1, 3, 2, block), DPSM_ERR_INVALID_VALUE,
+                   "h(2, 2) (cell i = 3, j = 3) is +Inf");
+    block[4] = 2e50;
+    expect_message(f, dpsm_add_heights_region(f, 1, 1, 3, 2, block), DPSM_ERR_INVALID_VALUE,
+                   "dh(2, 2) (cell i = 3, j = 3) = ");
+    block[4] = 0.0;
+    block[1] = 1e50;
+    CHECK_OK(f, dpsm_set_heights_region(f, 0, 0, 3, 2, block));
+    expect_message(f, dpsm_add_heights_region(f, 0, 0, 3, 2, block), DPSM_ERR_INVALID_VALUE, "dh(2, 1) = ");
+    expect_message(f, dpsm_add_heights_region(f, 0, 0, 3, 2, block), DPSM_ERR_INVALID_VALUE,
+                   " added to cell i = 2, j = 1 of height");
+    double levels[NY] = {0, 0, NAN, 0};
+    CHECK_OK(f, dpsm_set_boundary(f, DPSM_XMAX, DPSM_OPEN));
+    expect_message(f, dpsm_set_side_levels(f, DPSM_XMAX, levels), DPSM_ERR_INVALID_VALUE,
+                   "levels(3) (the face of cell j = 3 on side DPSM_XMAX) is NaN");
+    /* dpsm_step names the cell its source would carry out of range. */
+    double q[NX * NY] = {0};
+    q[3 + NX * 1] = 1e49;
+    CHECK_OK(f, dpsm_set_heights(f, q)); /* zeros but for that cell: 1e49 */
+    CHECK_OK(f, dpsm_set_source(f, q));
+    expect_message(f, dpsm_step(f, 1e3), DPSM_ERR_INVALID_VALUE, "would carry cell i = 4, j = 2 from");
+    CHECK_OK(c, dpsm_set_heights(c, q));
+    CHECK_OK(c, dpsm_set_source(c, q));
+    expect_message(c, dpsm_step(c, 1e3), DPSM_ERR_INVALID_VALUE, "would carry cell i = 3, j = 1 from");
+    /* Back to 0: C's messages again. */
+    CHECK_OK(f, dpsm_set_index_base(f, 0));
+    expect_message(f, dpsm_set_cell_kinds(f, kinds), DPSM_ERR_UNKNOWN_ENUM, "kinds[12] (cell i = 2, j = 2) = 9");
+    /* The same scene steps to the same heights under either base. */
+    double pile[NX * NY] = {0}, hc[NX * NY], hf[NX * NY];
+    pile[2 + NX * 2] = 1.0;
+    CHECK_OK(f, dpsm_set_index_base(f, 1));
+    dpsm_grid *both[2] = {c, f};
+    for (int k = 0; k < 2; ++k) {
+        CHECK_OK(both[k], dpsm_set_source(both[k], NULL));
+        CHECK_OK(both[k], dpsm_set_heights(both[k], pile));
+        CHECK_OK(both[k], dpsm_step(both[k], 0.05));
+    }
+    CHECK_OK(c, dpsm_get_heights(c, hc));
+    CHECK_OK(f, dpsm_get_heights(f, hf));
+    REQUIRE(memcmp(hc, hf, sizeof hc) == 0, "the index base changed the heights");
+    dpsm_destroy(c);
+    dpsm_destroy(f);
+
+    /* A line names h(k); an axisymmetric grid too. */
+    dpsm_grid *line = NULL;
+    CHECK_OK(NULL, dpsm_create_1d(6, 0.1, &line));
+    CHECK_OK(line, dpsm_set_index_base(line, 1));
+    double hl[6] = {0, 0, 0, -INFINITY, 0, 0};
+    expect_message(line, dpsm_set_heights(line, hl), DPSM_ERR_INVALID_VALUE, "h(4) (cell i = 4, j = 1) is -Inf");
+    dpsm_destroy(line);
+    CHECK_OK(NULL, dpsm_create_axisymmetric(6, 0.1, &line));
+    CHECK_OK(line, dpsm_set_index_base(line, 1));
+    expect_message(line, dpsm_set_repose_angle_field(line, hl), DPSM_ERR_INVALID_VALUE, "theta_radians(1) (cell i = 1");
+    dpsm_destroy(line);
+
+    /* A mesh counts from its constructor's start index and refuses the other. */
+    const double node_xy[] = {0, 0, 1, 0, 2, 0, 0, 1, 1, 1, 2, 1};
+    const int64_t cell_start[] = {0, 4, 8}, cell_nodes[] = {0, 1, 4, 3, 1, 2, 5, 4};
+    dpsm_grid *mesh = NULL;
+    CHECK_OK(NULL, dpsm_create_mesh(6, node_xy, 2, cell_start, cell_nodes, &mesh));
+    CHECK_OK(mesh, dpsm_set_index_base(mesh, 0));
+    expect_message(mesh, dpsm_set_index_base(mesh, 1), DPSM_ERR_NOT_APPLICABLE, "start_index = 1");
+    expect_message(mesh, dpsm_set_index_base(mesh, 1), DPSM_ERR_NOT_APPLICABLE, "dpsm_set_index_base: base = 1");
+    double hm[2] = {0, NAN};
+    expect_message(mesh, dpsm_set_heights(mesh, hm), DPSM_ERR_INVALID_VALUE, "h[1] (cell 1) is NaN");
+    dpsm_destroy(mesh);
+}
+
 static void test_threads(void **state) {
     (void)state;
     enum { NX = 64, NY = 48, N = NX * NY };
@@ -2157,6 +2254,8 @@ static void test_null_grid_every_function(void **state) {
     int threads = 0;
     EXPECT_NULL_GRID(dpsm_get_threads(NULL, &threads), "dpsm_get_threads");
     EXPECT_NULL_GRID(dpsm_get_threads(NULL, NULL), "dpsm_get_threads");
+    EXPECT_NULL_GRID(dpsm_set_index_base(NULL, 1), "dpsm_set_index_base");
+    EXPECT_NULL_GRID(dpsm_set_index_base(NULL, 7), "dpsm_set_index_base");
     EXPECT_NULL_GRID(dpsm_set_side_levels(NULL, DPSM_XMAX, h), "dpsm_set_side_levels");
     EXPECT_NULL_GRID(dpsm_set_side_levels(NULL, 99, NULL), "dpsm_set_side_levels");
     EXPECT_NULL_GRID(dpsm_get_side_outflow(NULL, DPSM_XMAX, &v), "dpsm_get_side_outflow");
@@ -2470,6 +2569,13 @@ static void test_bad_threads(void **state) {
     EXPECT_FAIL(fx, dpsm_get_threads(fx->g, NULL), DPSM_ERR_NULL_POINTER, "dpsm_get_threads", "n");
 }
 
+static void test_bad_index_base(void **state) {
+    fixture_t *fx = *state;
+    const int bad[] = {-1, 2, 10, INT_MIN, INT_MAX};
+    for (size_t k = 0; k < sizeof bad / sizeof *bad; ++k)
+        EXPECT_FAIL(fx, dpsm_set_index_base(fx->g, bad[k]), DPSM_ERR_INVALID_VALUE, "dpsm_set_index_base", "base");
+}
+
 static void test_bad_max_substeps(void **state) {
     fixture_t *fx = *state;
     const int64_t bad[] = {0, -1, -1000, INT64_MIN};
@@ -2628,6 +2734,7 @@ int main(int argc, char **argv) {
         cmocka_unit_test(test_set_repose_angle_edges),
         cmocka_unit_test(test_scheme),
         cmocka_unit_test(test_threads),
+        cmocka_unit_test(test_index_base),
         cmocka_unit_test(test_step_beyond_supported_range),
         cmocka_unit_test(test_heights_round_trip),
         cmocka_unit_test(test_get_heights_writes_nx_ny_values),
@@ -2665,7 +2772,8 @@ int main(int argc, char **argv) {
         cmocka_unit_test(test_bad_stable_dt), cmocka_unit_test(test_bad_step), cmocka_unit_test(test_bad_get_mass), \
         cmocka_unit_test(test_bad_get_step_info), cmocka_unit_test(test_bad_get_shape),                       \
         cmocka_unit_test(test_bad_rest_tolerance), cmocka_unit_test(test_bad_max_substeps),                   \
-        cmocka_unit_test(test_bad_threads), cmocka_unit_test(test_bad_bedrock),                               \
+        cmocka_unit_test(test_bad_threads), cmocka_unit_test(test_bad_index_base),                            \
+        cmocka_unit_test(test_bad_bedrock),                                                                   \
         cmocka_unit_test(test_bad_repose_angle_field), cmocka_unit_test(test_bad_flux_exponent),              \
         cmocka_unit_test(test_bad_static_angle), cmocka_unit_test(test_bad_side_levels),                      \
         cmocka_unit_test(test_bad_side_outflow), cmocka_unit_test(test_bad_face_flux_recording),              \

@@ -552,10 +552,10 @@ static void test_values_are_checked_behind_the_checksum(void **state) {
     REQUIRE(get_u32(good + kOffsetVersion) == 1, "the small file is of version %u, not 1",
             get_u32(good + kOffsetVersion));
     memcpy(bytes, good, size);
-    put_u32(bytes + kOffsetVersion, 7);
+    put_u32(bytes + kOffsetVersion, 8);
     reseal(bytes, size);
     write_file(bad, bytes, size);
-    require_refused(bad, "written by a newer dpsm, version 7", "version 7");
+    require_refused(bad, "written by a newer dpsm, version 8", "version 8");
 
     /* The relaxations' flags: DPSM_RELAX_AUTO's needs version 3, and a file
      * cannot ask for both. */
@@ -571,6 +571,11 @@ static void test_values_are_checked_behind_the_checksum(void **state) {
     require_refused(bad, "need version 6", "the flag of a mesh from 1 in version 5");
     write_with_header(bad, bytes, good, size, 6, 1u << 15);
     require_refused(bad, "holds no mesh", "the flag of a mesh from 1 on a grid");
+    /* Version 7's flag, a part of a distributed mesh, needs version 7 and a mesh. */
+    write_with_header(bad, bytes, good, size, 6, 1u << 16);
+    require_refused(bad, "need version 7", "the flag of a mesh's part in version 6");
+    write_with_header(bad, bytes, good, size, 7, 1u << 16);
+    require_refused(bad, "holds no mesh", "the flag of a mesh's part on a grid");
 
     require_refused_with_f64(bad, bytes, good, size, kOffsetRepose, 2.0, "angle of repose 2 radians",
                              "a repose angle of 2");

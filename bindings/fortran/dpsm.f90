@@ -17,6 +17,9 @@
 !>  - Sizes are integer(c_int64_t) as in C; every routine taking sizes also
 !>    accepts integer(c_int32_t) (default integers). Block offsets i0, j0 are
 !>    0-based, as in C.
+!>  - The library's messages count from 1 on every grid this module creates
+!>    or loads (dpsm_set_index_base): `kinds(3, 3) (cell i = 3, j = 3) = 9`,
+!>    where a C host reads `kinds[12] (cell i = 2, j = 2) = 9`.
 !>  - Arrays are assumed-shape: heights h(nx, ny) (or h(nx*ny); h(nx) on 1D and
 !>    axisymmetric grids), real(c_double); cell kinds integer(c_int8_t). Their
 !>    shape is checked against the grid (dpsm_get_shape) before C is called; a
@@ -178,6 +181,7 @@ module dpsm
   public :: dpsm_set_heights_region, dpsm_add_heights_region, dpsm_get_heights_region
   public :: dpsm_set_source, dpsm_stable_dt, dpsm_step, dpsm_get_mass, dpsm_get_step_info
   public :: dpsm_get_shape, dpsm_set_rest_tolerance, dpsm_set_max_substeps, dpsm_set_threads, dpsm_get_threads
+  public :: dpsm_set_index_base
   public :: dpsm_set_bedrock, dpsm_set_repose_angle_field, dpsm_set_flux_exponent, dpsm_set_static_angle
   public :: dpsm_set_side_levels, dpsm_get_side_outflow, dpsm_set_face_flux_recording, dpsm_get_face_fluxes
   public :: dpsm_save, dpsm_load
@@ -506,6 +510,12 @@ module dpsm
       integer(c_int), intent(out) :: n
     end function c_dpsm_get_threads
 
+    integer(c_int) function c_dpsm_set_index_base(g, base) bind(C, name='dpsm_set_index_base')
+      import :: c_int, c_ptr
+      type(c_ptr), value :: g
+      integer(c_int), value :: base
+    end function c_dpsm_set_index_base
+
     integer(c_int) function c_dpsm_set_bedrock(g, zb) bind(C, name='dpsm_set_bedrock')
       import :: c_int, c_double, c_ptr
       type(c_ptr), value :: g
@@ -779,12 +789,26 @@ contains
     end if
   end subroutine adopt
 
+  !> Makes the library's messages on a new grid count cells and array
+  !> positions from 1, as the Fortran host does. A mesh keeps the start index
+  !> it was made with (a restart file of a C host's mesh counts from 0); the
+  !> call with 0 then succeeds and leaves no message behind.
+  subroutine count_from_one(ptr, status)
+    type(c_ptr), intent(in) :: ptr
+    integer(c_int), intent(in) :: status
+    integer(c_int) :: ignored
+    if (status /= DPSM_OK) return
+    if (c_dpsm_set_index_base(ptr, 1_c_int) /= DPSM_OK) ignored = c_dpsm_set_index_base(ptr, 0_c_int)
+  end subroutine count_from_one
+
   !> dpsm_adopt_handle(g, ptr, status): g takes the handle ptr that a C
-  !> constructor returned with status (none unless status is DPSM_OK).
+  !> constructor returned with status (none unless status is DPSM_OK); the
+  !> library's messages on it count from 1, as on the module's own grids.
   subroutine dpsm_adopt_handle(g, ptr, status)
     type(dpsm_grid), intent(out) :: g
     type(c_ptr), intent(in) :: ptr
     integer(c_int), intent(in) :: status
+    call count_from_one(ptr, status)
     call adopt(g, ptr, status)
   end subroutine dpsm_adopt_handle
 
@@ -797,6 +821,7 @@ contains
     type(c_ptr) :: ptr
     integer(c_int) :: status
     status = c_dpsm_create_1d(nx, dx, ptr)
+    call count_from_one(ptr, status)
     call adopt(g, ptr, status)
     call finish(status, ierr, 'dpsm_create_1d')
   end subroutine create_1d_i64
@@ -818,6 +843,7 @@ contains
     type(c_ptr) :: ptr
     integer(c_int) :: status
     status = c_dpsm_create_2d(nx, ny, dx, dy, ptr)
+    call count_from_one(ptr, status)
     call adopt(g, ptr, status)
     call finish(status, ierr, 'dpsm_create_2d')
   end subroutine create_2d_i64
@@ -839,6 +865,7 @@ contains
     type(c_ptr) :: ptr
     integer(c_int) :: status
     status = c_dpsm_create_axisymmetric(nr, dr, ptr)
+    call count_from_one(ptr, status)
     call adopt(g, ptr, status)
     call finish(status, ierr, 'dpsm_create_axisymmetric')
   end subroutine create_axisymmetric_i64
@@ -1415,6 +1442,17 @@ contains
     call set_max_substeps_i64(g, i64(n), ierr)
   end subroutine set_max_substeps_i32
 
+  !> dpsm_set_index_base(g, base[, ierr]): 0 or 1, where the library's
+  !> messages on g count cells and array positions from. The grids this module
+  !> creates or loads count from 1 already; 0 gives C's messages.
+  subroutine dpsm_set_index_base(g, base, ierr)
+    type(dpsm_grid), intent(in) :: g
+    integer(c_int), intent(in) :: base
+    integer, intent(out), optional :: ierr
+    call clear_message(g)
+    call finish(c_dpsm_set_index_base(g%ptr, base), ierr, 'dpsm_set_index_base', g)
+  end subroutine dpsm_set_index_base
+
   !> dpsm_set_threads(g, n[, ierr]): 0 means OpenMP's default.
   subroutine dpsm_set_threads(g, n, ierr)
     type(dpsm_grid), intent(in) :: g
@@ -1988,6 +2026,7 @@ contains
     type(c_ptr) :: ptr
     integer(c_int) :: status
     status = c_dpsm_load(c_path(path), ptr)
+    call count_from_one(ptr, status)
     call adopt(g, ptr, status)
     call finish(status, ierr, 'dpsm_load')
   end subroutine dpsm_load

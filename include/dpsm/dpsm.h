@@ -931,6 +931,31 @@ DPSM_API int dpsm_set_threads(dpsm_grid *g, int n);
  */
 DPSM_API int dpsm_get_threads(const dpsm_grid *g, int *n);
 
+/**
+ * @brief Where this grid's messages count cells and array positions from: 0
+ *        as C does (the default), or 1 as Fortran does.
+ *
+ * With base 1 every message of dpsm_last_error() that names a cell, a face
+ * or a position in an array names it as a Fortran host holding `h(nx, ny)`
+ * writes it: `kinds(3, 3) (cell i = 3, j = 3) = 9` where base 0 reads
+ * `kinds[14] (cell i = 2, j = 2) = 9`; `h(4)` on a 1D or axisymmetric grid.
+ * Positions in a block of dpsm_set_heights_region() and the others count
+ * within the block (`dh(1, 2)`); the offsets `i0`, `j0` themselves stay as
+ * the host passed them. Nothing else changes: arrays keep x fastest from
+ * index 0 in memory, and results are the same. The Fortran module sets 1 on
+ * every grid it creates or loads. Not kept in restart files.
+ *
+ * A mesh counts from the start index its constructor was given
+ * (dpsm_create_mesh_indexed() and the others); on a mesh `base` must equal it.
+ *
+ * @param g     the grid.
+ * @param base  0 or 1.
+ * @return ::DPSM_OK, ::DPSM_ERR_NULL_POINTER, ::DPSM_ERR_INVALID_VALUE (base
+ *         other than 0 and 1) or ::DPSM_ERR_NOT_APPLICABLE (a mesh counting
+ *         from the other base).
+ */
+DPSM_API int dpsm_set_index_base(dpsm_grid *g, int base);
+
 /** @name Physics for real scenes
  *  A bed that cannot erode, angles that vary, other flow laws and
  *  hysteresis. Each costs nothing when a scene does not use it; a scene that

@@ -87,32 +87,42 @@ void require_positive(double value, const char *function, const char *name) {
 const char *describe(double value) { return std::isnan(value) ? "NaN" : value > 0 ? "+Inf" : "-Inf"; }
 
 // Names the first value that is not finite or lies beyond the supported
-// range by its position (as a host counting from `base` writes it,
-// dpsm::host_position) and `where(k)`, the place it stands for.
+// range by its position (as a host counting from `base` writes it, an array of
+// `rows` rows: dpsm::host_position) and `where(k)`, the place it stands for.
 template <class Where>
 void require_in_range(const double *values, std::int64_t n, const char *function, const char *name, Where &&where,
-                      int base = 0) {
+                      int base = 0, std::int64_t rows = 1) {
     for (std::int64_t k = 0; k < n; ++k) {
         if (std::isfinite(values[k]) && std::fabs(values[k]) <= kMaxMagnitude) continue;
         if (!std::isfinite(values[k]))
-            fail(DPSM_ERR_INVALID_VALUE, function, dpsm::host_position(name, k, base), " (", where(k), ") is ",
+            fail(DPSM_ERR_INVALID_VALUE, function, dpsm::host_position(name, k, base, rows), " (", where(k), ") is ",
                  describe(values[k]));
-        fail(DPSM_ERR_INVALID_VALUE, function, dpsm::host_position(name, k, base), " (", where(k), ") = ", values[k],
-             " is outside the supported range [-1e50, 1e50]");
+        fail(DPSM_ERR_INVALID_VALUE, function, dpsm::host_position(name, k, base, rows), " (", where(k), ") = ",
+             values[k], " is outside the supported range [-1e50, 1e50]");
     }
 }
 
-std::string cell_name(std::int64_t i, std::int64_t j) {
-    return "cell i = " + std::to_string(i) + ", j = " + std::to_string(j);
+// Cell (i, j) of a grid as a host counting from `base` names it.
+std::string cell_name(std::int64_t i, std::int64_t j, int base) {
+    return "cell i = " + std::to_string(i + base) + ", j = " + std::to_string(j + base);
 }
 
 const dpsm::Mesh *mesh_of(const dpsm_grid *g) { return g->core.geometry().mesh.get(); }
 
-// Where the host's numbers of cells and faces begin: a mesh's start index
-// (0 or 1, as its constructor was given), 0 on a grid.
+// Where the host's numbers of cells, faces and array positions begin: a
+// mesh's start index (0 or 1, as its constructor was given), a grid's index
+// base (0 unless dpsm_set_index_base said 1).
 int host_base(const dpsm_grid *g) {
     const dpsm::Mesh *mesh = mesh_of(g);
-    return mesh ? mesh->input.start_index : 0;
+    return mesh ? mesh->input.start_index : g->core.index_base();
+}
+
+// The rows of a per-cell array as a host counting from 1 shapes it: h(nx, ny)
+// on a 2D grid; one row (h(nx), h(ncells)) on a line, an axisymmetric grid or
+// a mesh.
+std::int64_t cell_rows(const dpsm_grid *g) {
+    const dpsm::Geometry &geo = g->core.geometry();
+    return geo.dim == 2 && !geo.is_mesh() ? geo.nx : 1;
 }
 
 // A cell as the host numbers it: (i, j) on a grid, its index on a mesh
@@ -120,11 +130,16 @@ int host_base(const dpsm_grid *g) {
 std::string host_cell_name(const dpsm_grid *g, std::int64_t c) {
     const dpsm::Geometry &geo = g->core.geometry();
     if (geo.is_mesh()) return "cell " + std::to_string(c + host_base(g));
-    return cell_name(c % geo.nx, c / geo.nx);
+    return cell_name(c % geo.nx, c / geo.nx, host_base(g));
 }
 
-// Array `name`'s position k (a cell's or a face's) as the host writes it.
+// Per-cell array `name`'s position k as the host writes it.
 std::string host_position(const dpsm_grid *g, const char *name, std::int64_t k) {
+    return dpsm::host_position(name, k, host_base(g), cell_rows(g));
+}
+
+// A mesh's per-face array `name`'s position k as the host writes it.
+std::string host_face_position(const dpsm_grid *g, const char *name, std::int64_t k) {
     return dpsm::host_position(name, k, host_base(g));
 }
 
@@ -132,7 +147,7 @@ std::string host_position(const dpsm_grid *g, const char *name, std::int64_t k) 
 void require_finite_array(const dpsm_grid *g, const double *values, const char *function, const char *name) {
     require_pointer(values, function, name);
     require_in_range(values, g->core.geometry().cells(), function, name,
-                     [&](std::int64_t c) { return host_cell_name(g, c); }, host_base(g));
+                     [&](std::int64_t c) { return host_cell_name(g, c); }, host_base(g), cell_rows(g));
 }
 
 // On a mesh the library keeps its cells in an order of its own
@@ -190,10 +205,18 @@ dpsm::Grid::Block require_block(const dpsm_grid *g, std::int64_t i0, std::int64_
 }
 
 // Names the first non-finite value of a block by its index and cell.
-void require_finite_block(const double *values, const dpsm::Grid::Block &b, const char *function, const char *name) {
+void require_finite_block(const dpsm_grid *g, const double *values, const dpsm::Grid::Block &b, const char *function,
+                          const char *name) {
     require_pointer(values, function, name);
-    require_in_range(values, b.ni * b.nj, function, name,
-                     [&](std::int64_t k) { return cell_name(b.i0 + k % b.ni, b.j0 + k / b.ni); });
+    const int base = host_base(g);
+    require_in_range(
+        values, b.ni * b.nj, function, name,
+        [&](std::int64_t k) { return cell_name(b.i0 + k % b.ni, b.j0 + k / b.ni, base); }, base, b.ni);
+}
+
+// Position k of a block's array (ni by nj values) as the host writes it.
+std::string block_position(const dpsm_grid *g, const dpsm::Grid::Block &b, const char *name, std::int64_t k) {
+    return dpsm::host_position(name, k, host_base(g), b.ni);
 }
 
 void require_scale(double value, const char *function, const char *name) {
@@ -216,7 +239,8 @@ void require_above_bed(const dpsm_grid *g, const dpsm::Grid::Block &b, const dou
         if (next < zb[c]) {
             const dpsm::Mesh *mesh = mesh_of(g);
             const std::int64_t host = mesh ? mesh->host_cell[c] : k;
-            fail(DPSM_ERR_INVALID_VALUE, function, host_position(g, name, host), " puts ",
+            fail(DPSM_ERR_INVALID_VALUE, function,
+                 mesh ? host_position(g, name, host) : block_position(g, b, name, k), " puts ",
                  host_cell_name(g, mesh ? host : c), " at ", next, ", below its bed zb = ", zb[c],
                  " (see dpsm_set_bedrock)");
         }
@@ -448,7 +472,7 @@ int dpsm_set_edge_kinds(dpsm_grid *g, const uint8_t *kinds) {
         }
         for (std::int64_t k = 0; k < m.faces; ++k)
             if (m.face_b[m.face_of_host[k]] < 0 && kinds[k] != DPSM_OPEN && kinds[k] != DPSM_WALL)
-                fail(DPSM_ERR_UNKNOWN_ENUM, fn, host_position(g, "kinds", k), " (face ", k + host_base(g),
+                fail(DPSM_ERR_UNKNOWN_ENUM, fn, host_face_position(g, "kinds", k), " (face ", k + host_base(g),
                      ", on the domain edge) = ", static_cast<int>(kinds[k]), " is not DPSM_OPEN or DPSM_WALL");
         std::vector<std::uint8_t> open = faces_in_library_order(m, kinds);
         for (std::uint8_t &o : open) o = o == DPSM_OPEN;
@@ -546,7 +570,7 @@ int dpsm_set_heights_region(dpsm_grid *g, int64_t i0, int64_t j0, int64_t ni, in
         require_grid(g, fn);
         require_grid_not_mesh(g, fn);
         const dpsm::Grid::Block block = require_block(g, i0, j0, ni, nj, fn);
-        require_finite_block(h, block, fn, "h");
+        require_finite_block(g, h, block, fn, "h");
         require_above_bed(g, block, h, false, fn, "h");
         g->core.write_heights(block, h, false);
     });
@@ -558,14 +582,14 @@ int dpsm_add_heights_region(dpsm_grid *g, int64_t i0, int64_t j0, int64_t ni, in
         require_grid(g, fn);
         require_grid_not_mesh(g, fn);
         const dpsm::Grid::Block block = require_block(g, i0, j0, ni, nj, fn);
-        require_finite_block(dh, block, fn, "dh");
+        require_finite_block(g, dh, block, fn, "dh");
         const std::vector<double> &h = g->core.heights();
         const std::int64_t nx = g->core.geometry().nx;
         for (std::int64_t k = 0; k < ni * nj; ++k) {
             const std::int64_t c = (i0 + k % ni) + nx * (j0 + k / ni);
             if (!(std::fabs(h[c] + dh[k]) <= kMaxMagnitude))
-                fail(DPSM_ERR_INVALID_VALUE, fn, "dh[", k, "] = ", dh[k], " added to cell i = ", c % nx, ", j = ", c / nx,
-                     " of height ", h[c], " leaves the supported range [-1e50, 1e50]");
+                fail(DPSM_ERR_INVALID_VALUE, fn, block_position(g, block, "dh", k), " = ", dh[k], " added to ",
+                     host_cell_name(g, c), " of height ", h[c], " leaves the supported range [-1e50, 1e50]");
         }
         require_above_bed(g, block, dh, true, fn, "dh");
         g->core.write_heights(block, dh, true);
@@ -736,6 +760,23 @@ int dpsm_get_threads(const dpsm_grid *g, int *n) {
     });
 }
 
+int dpsm_set_index_base(dpsm_grid *g, int base) {
+    const char *fn = "dpsm_set_index_base";
+    return guarded(g, fn, [&] {
+        require_grid(g, fn);
+        if (base != 0 && base != 1)
+            fail(DPSM_ERR_INVALID_VALUE, fn, "base = ", base, " is neither 0 (as C counts) nor 1 (as Fortran counts)");
+        if (const dpsm::Mesh *mesh = mesh_of(g)) {
+            if (base != mesh->input.start_index)
+                fail(DPSM_ERR_NOT_APPLICABLE, fn, "base = ", base, ": a mesh counts from the start index its "
+                     "constructor was given (", mesh->input.start_index, "); create it with start_index = ", base,
+                     " (dpsm_create_mesh_indexed and the others) instead");
+            return;
+        }
+        g->core.set_index_base(base);
+    });
+}
+
 int dpsm_set_bedrock(dpsm_grid *g, const double *zb) {
     const char *fn = "dpsm_set_bedrock";
     return guarded(g, fn, [&] {
@@ -803,10 +844,14 @@ int dpsm_set_side_levels(dpsm_grid *g, int side, const double *levels) {
         if (levels) {
             const dpsm::Geometry &geo = g->core.geometry();
             const bool x_side = side <= DPSM_XMAX;
-            require_in_range(levels, x_side ? geo.ny : geo.nx, fn, "levels", [&](std::int64_t k) {
-                return std::string("the face of cell ") + (x_side ? "j = " : "i = ") + std::to_string(k) + " on side " +
-                       side_name(side);
-            });
+            const int base = host_base(g);
+            require_in_range(
+                levels, x_side ? geo.ny : geo.nx, fn, "levels",
+                [&](std::int64_t k) {
+                    return std::string("the face of cell ") + (x_side ? "j = " : "i = ") + std::to_string(k + base) +
+                           " on side " + side_name(side);
+                },
+                base);
         }
         g->core.set_side_levels(side, levels);
     });

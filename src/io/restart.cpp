@@ -71,15 +71,21 @@ constexpr std::uint32_t kHasEdgeKinds = 1u << 14;
 // start_index 1, and its messages and dpsm_get_mesh_faces count from 1); no
 // data of its own. Without it they count from 0, as in every version 5 file.
 constexpr std::uint32_t kMeshFromOne = 1u << 15;
+// Version 7: a rank's part of a distributed mesh (with kIsMesh and kIsBlock:
+// the block record, then the mesh record of the rank's local cells, then per
+// local cell its global id, i64, and its owner's rank, i32). The block record
+// holds the global mesh's cells as global_nx (global_ny = 1, i0 = j0 = 0).
+constexpr std::uint32_t kMeshPart = 1u << 16;
 constexpr std::uint32_t kKnownFlags = kHasSource | kHasBed | kHasAngleField | kHasMoving | kIsBlock | kRelaxToRest |
                                       kRelaxAuto | kHasSideOutflows | kHasSideLevels | kRecordsFluxes | kIsMesh |
-                                      kHasEdgeKinds | kMeshFromOne;
+                                      kHasEdgeKinds | kMeshFromOne | kMeshPart;
 // The flags a file of version 1 cannot hold, those version 2 cannot, and so on.
 constexpr std::uint32_t kVersion2Flags = kIsBlock | kRelaxToRest;
 constexpr std::uint32_t kVersion3Flags = kRelaxAuto;
 constexpr std::uint32_t kVersion4Flags = kHasSideOutflows | kHasSideLevels | kRecordsFluxes;
 constexpr std::uint32_t kVersion5Flags = kIsMesh | kHasEdgeKinds;
 constexpr std::uint32_t kVersion6Flags = kMeshFromOne;
+constexpr std::uint32_t kVersion7Flags = kMeshPart;
 // The fixed part of the mesh record: kind, a reserved word, and four counts.
 constexpr std::size_t kMeshRecordBytes = 40;
 
@@ -87,6 +93,7 @@ constexpr std::uint32_t side_levels_flag(int side) { return kHasSideLevelsOfXMin
 
 // The oldest version that holds a file with these flags.
 std::uint32_t version_for(std::uint32_t flags) {
+    if (flags & kVersion7Flags) return 7;
     if (flags & kVersion6Flags) return 6;
     if (flags & kVersion5Flags) return 5;
     if (flags & kVersion4Flags) return 4;
@@ -229,6 +236,7 @@ std::uint32_t flags_of(const Grid &g) {
     if (g.records_face_fluxes()) flags |= kRecordsFluxes;
     if (g.geometry().is_mesh()) flags |= kIsMesh;
     if (g.geometry().is_mesh() && g.geometry().mesh->input.start_index == 1) flags |= kMeshFromOne;
+    if (g.geometry().is_mesh() && !g.geometry().mesh->input.owner.empty()) flags |= kMeshPart;
     if (!g.edge_open_flags().empty()) flags |= kHasEdgeKinds;
     return flags;
 }
@@ -302,6 +310,12 @@ void write_mesh(Writer &w, const Grid &g) {
     w.array(in.node_xy, &Writer::f64);
     w.array(in.cell_start, &Writer::i64);  // empty for the dual
     w.array(in.cell_nodes, &Writer::i64);
+}
+
+void write_part(Writer &w, const Grid &g) {
+    if (!g.geometry().is_mesh() || g.geometry().mesh->input.owner.empty()) return;
+    w.array(g.geometry().mesh->input.global_id, &Writer::i64);
+    w.array(g.geometry().mesh->input.owner, &Writer::i32);
 }
 
 void write_body(Writer &w, const Grid &g) {
@@ -541,7 +555,8 @@ void check_layout(const Header &h, const std::string &path, const char *fn) {
         bad("nx * ny = ", h.nx, " * ", h.ny, " cells is more than this library can address (", kMaxCells, ")");
     if (h.flags & ~kKnownFlags) bad("unknown array flags ", hex32(h.flags & ~kKnownFlags));
     const std::pair<std::uint32_t, std::uint32_t> needs[] = {
-        {kVersion2Flags, 2}, {kVersion3Flags, 3}, {kVersion4Flags, 4}, {kVersion5Flags, 5}, {kVersion6Flags, 6}};
+        {kVersion2Flags, 2}, {kVersion3Flags, 3}, {kVersion4Flags, 4}, {kVersion5Flags, 5}, {kVersion6Flags, 6},
+        {kVersion7Flags, 7}};
     for (const auto &[flags, version] : needs)
         if ((h.flags & flags) && h.version < version)
             bad("the flags ", hex32(h.flags & flags), " are set in a file of version ", h.version, " (they need version ",
@@ -550,10 +565,12 @@ void check_layout(const Header &h, const std::string &path, const char *fn) {
     if ((h.flags & kRelaxToRest) && h.dim != 2) bad("a grid of dim = ", h.dim, " cannot relax to rest");
     if ((h.flags & kIsBlock) && h.dim != 2) bad("a block of a distributed grid must have dim = 2, not ", h.dim);
     if ((h.flags & kHasEdgeKinds) && !(h.flags & kIsMesh)) bad("edge kinds are set but the file holds no mesh");
+    if ((h.flags & kMeshPart) && !(h.flags & kIsMesh)) bad("a part of a distributed mesh is set but the file holds no mesh");
     if ((h.flags & kMeshFromOne) && !(h.flags & kIsMesh))
         bad("the mesh's indices are said to count from 1 but the file holds no mesh");
     if (h.flags & kIsMesh) {
-        if (h.dim != 2 || h.ny != 1 || (h.flags & kIsBlock)) bad("a mesh has dim = 2, ny = 1 and no block record");
+        if (h.dim != 2 || h.ny != 1 || ((h.flags & kIsBlock) != 0) != ((h.flags & kMeshPart) != 0))
+            bad("a mesh has dim = 2, ny = 1 and a block record only when it is a part of a distributed mesh");
         if (h.flags & (kHasSideLevels & ~side_levels_flag(kXMin))) bad("a mesh has levels beyond its edge only");
     }
     for (int side = 0; side < 4; ++side)
@@ -677,6 +694,7 @@ void save_restart(const Grid &grid, const char *path, const char *function, cons
         fail(DPSM_ERR_INTERNAL, function, "the header takes ", w.buffered(), " bytes, not ", kHeaderBytes);
     write_block(w, block);
     write_mesh(w, grid);
+    write_part(w, grid);
     write_body(w, grid);
     // On disk before it replaces the old file: a crash leaves one or the other.
     if (std::fflush(tmp.file) != 0) fail(DPSM_ERR_IO, function, "cannot write ", target, ": ", system_reason(errno));
@@ -757,11 +775,12 @@ void load_restart(const char *path, Geometry &geometry, GridState &state, Restar
     // A mesh's counts next: they size the rest. Trusted only as far as they
     // are plausible; the file's checksum covers them.
     std::size_t mesh_bytes = 0;
+    const std::size_t block_bytes = (header.flags & kIsBlock) ? kBlockBytes : 0;
     if (header.flags & kIsMesh) {
-        read_more(in.file, bytes, kMeshRecordBytes, source, fn);
-        if (bytes.size() < kHeaderBytes + kMeshRecordBytes)
+        read_more(in.file, bytes, block_bytes + kMeshRecordBytes, source, fn);
+        if (bytes.size() < kHeaderBytes + block_bytes + kMeshRecordBytes)
             bad(" is truncated: its mesh record is cut short at ", bytes.size(), " bytes");
-        Reader counts(bytes, kHeaderBytes, source, fn);
+        Reader counts(bytes, kHeaderBytes + block_bytes, source, fn);
         read_mesh_counts(counts, header);
         const MeshRecord &m = header.mesh;
         const bool graph = m.kind == MeshInput::kGraph;
@@ -773,11 +792,11 @@ void load_restart(const char *path, Geometry &geometry, GridState &state, Restar
             bad(" is corrupted: its mesh record's counts (", m.nnodes, " nodes, ", m.ncells, " cells, ", m.nindices,
                 " node indices, ", m.nfaces, " faces) do not describe a mesh of ", header.nx, " cells");
         mesh_bytes = kMeshRecordBytes + m.array_bytes();
+        if (header.flags & kMeshPart) mesh_bytes += static_cast<std::size_t>(header.nx) * (8 + 4);
     }
     // Then exactly as many bytes as the header implies, read as they come (a
     // short file allocates no more than it holds).
     const std::size_t n = static_cast<std::size_t>(header.nx) * static_cast<std::size_t>(header.ny);
-    const std::size_t block_bytes = (header.flags & kIsBlock) ? kBlockBytes : 0;
     const std::size_t expected = kHeaderBytes + block_bytes + mesh_bytes + n * bytes_per_cell(header.flags) +
                                  coupling_bytes(header.flags, header.nx, header.ny, header.mesh.nfaces) + kChecksumBytes;
     constexpr std::size_t kChunk = std::size_t{1} << 22;
@@ -810,6 +829,10 @@ void load_restart(const char *path, Geometry &geometry, GridState &state, Restar
         read_mesh_counts(body, header);
         read_mesh(body, header, mesh_input);
         mesh_input.start_index = (header.flags & kMeshFromOne) ? 1 : 0;
+        if (header.flags & kMeshPart) {
+            body.array(mesh_input.global_id, static_cast<std::size_t>(header.nx), &Reader::i64);
+            body.array(mesh_input.owner, static_cast<std::size_t>(header.nx), &Reader::i32);
+        }
     }
     read_body(body, header, n, state);
     if (body.at() != expected - kChecksumBytes)
@@ -826,8 +849,18 @@ void load_restart(const char *path, Geometry &geometry, GridState &state, Restar
     geometry = Geometry{static_cast<int>(header.dim), header.axisymmetric != 0, header.nx, header.ny, header.dx, header.dy, nullptr};
     if (header.flags & kIsMesh) {
         // The same checks as the constructors; what they refuse, the file got wrong.
+        for (std::size_t c = 0; c < mesh_input.owner.size(); ++c)
+            if (mesh_input.global_id[c] < 0 || mesh_input.global_id[c] >= block.global_nx ||
+                mesh_input.owner[c] < 0 || mesh_input.owner[c] >= block.ranks)
+                bad(" is corrupted: local cell ", c, " has global id ", mesh_input.global_id[c], " and owner ",
+                    mesh_input.owner[c], " in a mesh of ", block.global_nx, " cells on ", block.ranks, " ranks");
         try {
-            geometry.mesh = mesh_from_input(mesh_input, fn);
+            if (header.flags & kMeshPart) {
+                block.part = part_from_input(mesh_input, block.rank, fn);
+                geometry.mesh = block.part;
+            } else {
+                geometry.mesh = mesh_from_input(mesh_input, fn);
+            }
         } catch (const Error &e) {
             bad(" holds a mesh its constructor refuses: ", e.what());
         }

@@ -20,8 +20,9 @@ namespace dpsm {
 // Version 5 holds unstructured meshes (the mesh as its constructor got it),
 // version 6 meshes whose indices count from 1 (a flag: the mesh record's
 // arrays are as a start_index = 1 constructor got them); a mesh from 0 is
-// still written as version 5.
-constexpr std::uint32_t kRestartVersion = 6;
+// still written as version 5. Version 7 holds a rank's part of a
+// distributed mesh (its local cells' global ids and owners).
+constexpr std::uint32_t kRestartVersion = 7;
 
 // Where a block file's grid lies in its distributed grid (version 2): its
 // place, which of how many ranks saved it, and the mark that all the files
@@ -31,6 +32,10 @@ struct RestartBlock {
     std::uint64_t save_mark = 0;
     std::int64_t global_nx = 0, global_ny = 0, i0 = 0, j0 = 0;
     std::int32_t rank = 0, ranks = 0;
+    // A part of a distributed mesh, as load_restart rebuilt it from the file,
+    // not finished (mesh/mesh.hpp, finish_part): the MPI component finishes
+    // it with the other ranks. Null otherwise.
+    std::shared_ptr<Mesh> part;
 };
 
 // Writes the grid to `path` through `path + ".tmp"`, renamed over `path` only

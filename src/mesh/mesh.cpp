@@ -571,6 +571,33 @@ std::shared_ptr<Mesh> part_from_graph(std::int64_t ncells, const double *cell_xy
     return assemble_graph(ncells, cell_xy, cell_area, nfaces, face_cells, face_xy, face_length, &part, function, base);
 }
 
+std::shared_ptr<Mesh> part_from_input(const MeshInput &input, int rank, const char *function) {
+    const std::size_t n = input.global_id.size();
+    std::vector<std::uint8_t> ghost(n);
+    for (std::size_t c = 0; c < n; ++c) ghost[c] = input.owner[c] != rank;
+    const PartOfMesh part{input.global_id.data(), ghost.data()};
+    std::shared_ptr<Mesh> mesh;
+    const int base = input.start_index;
+    if (input.kind == MeshInput::kPolygons) {
+        const std::int64_t ncells = static_cast<std::int64_t>(input.cell_start.size()) - 1;
+        if (ncells != static_cast<std::int64_t>(n) ||
+            input.cell_start.back() - base != static_cast<std::int64_t>(input.cell_nodes.size()))
+            fail(DPSM_ERR_BAD_FILE, function, "the mesh's cells do not match their node list");
+        mesh = assemble_polygons(static_cast<std::int64_t>(input.node_xy.size() / 2), input.node_xy.data(), ncells,
+                                 input.cell_start.data(), input.cell_nodes.data(), &part, function, base);
+    } else if (input.kind == MeshInput::kGraph && input.ncells == static_cast<std::int64_t>(n)) {
+        mesh = assemble_graph(input.ncells, input.cell_xy.data(), input.cell_area.data(),
+                              static_cast<std::int64_t>(input.face_length.size()), input.face_cells.data(),
+                              input.face_xy.data(), input.face_length.data(), &part, function, base);
+    } else {
+        fail(DPSM_ERR_BAD_FILE, function, "a part of a distributed mesh of kind ", static_cast<unsigned>(input.kind),
+             " with ", n, " cells");
+    }
+    mesh->input.global_id = input.global_id;
+    mesh->input.owner = input.owner;
+    return mesh;
+}
+
 bool gradients_over_two_rings(std::int64_t cell_faces, std::int64_t cells) {
     // Edges count: an upper figure of the neighbours.
     return static_cast<double>(cell_faces) / static_cast<double>(cells) < 4.0;
@@ -698,7 +725,7 @@ std::shared_ptr<const Mesh> mesh_from_input(const MeshInput &input, const char *
     fail(DPSM_ERR_BAD_FILE, function, "unknown mesh kind ", static_cast<unsigned>(input.kind));
 }
 
-std::string host_position(const char *name, std::int64_t k, int base, int rows) {
+std::string host_position(const char *name, std::int64_t k, int base, std::int64_t rows) {
     if (base == 0) return std::string(name) + "[" + std::to_string(k) + "]";
     if (rows <= 1) return std::string(name) + "(" + std::to_string(k + base) + ")";
     return std::string(name) + "(" + std::to_string(k % rows + base) + ", " + std::to_string(k / rows + base) + ")";

@@ -33,6 +33,10 @@ struct MeshInput {
     std::int64_t ncells = 0;
     std::vector<double> cell_xy, cell_area, face_xy, face_length;
     std::vector<std::int64_t> face_cells;
+    // A rank's part of a distributed mesh: per host cell, its global id (from
+    // 0) and its owner's rank; empty on a serial mesh.
+    std::vector<std::int64_t> global_id;
+    std::vector<std::int32_t> owner;
 };
 
 struct Mesh {
@@ -133,6 +137,8 @@ std::shared_ptr<Mesh> part_from_graph(std::int64_t ncells, const double *cell_xy
                                       std::int64_t nfaces, const std::int64_t *face_cells, const double *face_xy,
                                       const double *face_length, const PartOfMesh &part, const char *function,
                                       int base);
+// The same part again from what a restart file kept, for the rank `rank`.
+std::shared_ptr<Mesh> part_from_input(const MeshInput &input, int rank, const char *function);
 // Whether the least-squares gradients use two rings of neighbours: where
 // cells have fewer than 4 faces on average over the whole mesh.
 bool gradients_over_two_rings(std::int64_t cell_faces, std::int64_t cells);
@@ -151,8 +157,8 @@ std::shared_ptr<const Mesh> mesh_from_input(const MeshInput &input, const char *
 // Position k of the host's array `name`, as a host that counts from `base`
 // writes it: C's name[k] (base 0), Fortran's name(k+1) (base 1). With `rows`
 // > 1 the array holds tuples of that many values (node_xy, face_cells,
-// triangle_nodes), which Fortran holds as the columns of name(rows, n):
-// name(k % rows + 1, k / rows + 1).
-std::string host_position(const char *name, std::int64_t k, int base, int rows = 1);
+// triangle_nodes; a 2D grid's rows of nx cells), which Fortran holds as the
+// columns of name(rows, n): name(k % rows + 1, k / rows + 1).
+std::string host_position(const char *name, std::int64_t k, int base, std::int64_t rows = 1);
 
 }  // namespace dpsm

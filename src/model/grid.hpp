@@ -136,6 +136,11 @@ public:
     // The threads a step runs on (model/threads.hpp).
     int step_threads() const { return thread_count(threads_, decomposition_ != nullptr); }
     void set_threads(int n) { threads_ = n; }
+    // Where the host counts cells and array positions from in messages on a
+    // grid: 0 as C writes them, 1 as Fortran does (a mesh has its own start
+    // index, mesh/mesh.hpp). It changes no result.
+    int index_base() const { return index_base_; }
+    void set_index_base(int base) { index_base_ = base; }
     Scheme scheme() const { return scheme_; }
     void set_scheme(Scheme scheme) {
         scheme_ = scheme;
@@ -391,6 +396,7 @@ private:
     Scheme scheme_;
     Relaxation relaxation_ = kAutoRelaxation;
     int threads_ = 0;
+    int index_base_ = 0;
     std::int64_t wall_cells_ = 0;
     std::int64_t open_cells_ = 0;
     double open_level_min_ = 0.0, open_level_max_ = 0.0;

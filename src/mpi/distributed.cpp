@@ -42,6 +42,7 @@
 #include "structured/active_set.hpp"
 #include "mpi/collective.hpp"
 #include "mpi/decomposition.hpp"
+#include "mpi/distributed_mesh.hpp"
 #include "dpsm/dpsm.h"
 #include "dpsm/dpsm_mpi.h"
 #include "model/error.hpp"
@@ -521,6 +522,11 @@ int load_distributed(MPI_Comm comm, const char *path, dpsm_grid **out, const cha
                 fail(DPSM_ERR_BAD_FILE, fn, "the files are not the blocks of one save: rank 0's file was written by the "
                      "save marked ", hex64(marks[0]), ", rank ", r, "'s by the save marked ",
                      hex64(marks[static_cast<std::size_t>(r)]), " (each rank must load the file of the same save)");
+        if (block.part) {
+            // A part of a distributed mesh: the ranks finish it together.
+            *out = part_grid(comm, block.part, fn, &state);
+            return;
+        }
         const Arguments mine{block.global_nx, block.global_ny, block.i0, block.j0, geometry.nx, geometry.ny, 0,
                              geometry.dx, geometry.dy};
         const std::vector<Rect> blocks = agreed_blocks(comm, size, mine, fn);

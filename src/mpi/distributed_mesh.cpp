@@ -41,6 +41,7 @@
 #include "model/grid.hpp"
 #include "mpi/collective.hpp"
 #include "mpi/decomposition.hpp"
+#include "mpi/distributed_mesh.hpp"
 
 namespace dpsm {
 namespace {
@@ -328,7 +329,11 @@ public:
     // `comm` is this part's own duplicate; `neighbours` its distributed-graph
     // communicator over the ranks in `links` (both freed with it).
     MeshPartDecomposition(MPI_Comm comm, MPI_Comm neighbours, PartLinks links)
-        : CollectiveDecomposition(comm), neighbours_(neighbours), links_(std::move(links)) {}
+        : CollectiveDecomposition(comm), neighbours_(neighbours), links_(std::move(links)) {
+        // What dpsm_save records of the part's place (io/restart.cpp: kMeshPart).
+        halo_.global_nx = links_.global_cells;
+        halo_.global_ny = 1;
+    }
 
     ~MeshPartDecomposition() override {
         int finalized = 0;
@@ -508,14 +513,19 @@ private:
     std::uint64_t exchanged_heights_ = std::numeric_limits<std::uint64_t>::max();  // none yet
 };
 
+}  // namespace
+
 // The part's grid, tied to a duplicate of `comm` and a distributed graph over
-// its neighbours. Collective.
-dpsm_grid *part_grid(MPI_Comm comm, std::shared_ptr<Mesh> mesh, const std::vector<int> &owner_of_cell, const char *fn) {
+// its neighbours; with `state`, as a restart file saved it. Collective.
+dpsm_grid *part_grid(MPI_Comm comm, std::shared_ptr<Mesh> mesh, const char *fn, GridState *state) {
+    std::vector<int> owner_of_cell(static_cast<std::size_t>(mesh->cells));
+    for (std::int64_t c = 0; c < mesh->cells; ++c) owner_of_cell[c] = mesh->input.owner[mesh->host_cell[c]];
     PartLinks links = link_parts(comm, *mesh, owner_of_cell, fn);
     std::unique_ptr<dpsm_grid> made;
     on_every_rank(comm, fn, [&] {
         std::shared_ptr<const Mesh> done = mesh;
         made = std::make_unique<dpsm_grid>(Geometry{2, false, done->cells, 1, done->min_distance, done->min_distance, done});
+        if (state) made->core.restore(std::move(*state));
     });
     MPI_Comm own = MPI_COMM_NULL, neighbours = MPI_COMM_NULL;
     check_mpi(MPI_Comm_dup(comm, &own), "MPI_Comm_dup");
@@ -570,6 +580,8 @@ std::vector<std::uint8_t> ghosts_of_rank(MPI_Comm comm, std::int64_t ncells, con
     return ghost;
 }
 
+namespace {
+
 template <class Build>
 int create_part(MPI_Comm comm, int start_index, std::int64_t ncells, const std::int64_t *global_id, const int *owner,
                 dpsm_grid **out, const char *fn, Build &&build) noexcept {
@@ -578,17 +590,16 @@ int create_part(MPI_Comm comm, int start_index, std::int64_t ncells, const std::
         int rank = 0, size = 0;
         check_communicator(comm, fn, rank, size);
         std::shared_ptr<Mesh> mesh;
-        std::vector<int> owner_of_cell;
         on_every_rank(comm, fn, [&] {
             const std::vector<std::uint8_t> ghost = ghosts_of_rank(comm, ncells, global_id, owner, out, start_index, fn);
             // From here on global ids count from 0 (the messages add start_index again).
             std::vector<std::int64_t> ids(global_id, global_id + ncells);
             for (std::int64_t &id : ids) id -= start_index;
             mesh = build(PartOfMesh{ids.data(), ghost.data()});
-            owner_of_cell.resize(static_cast<std::size_t>(mesh->cells));
-            for (std::int64_t c = 0; c < mesh->cells; ++c) owner_of_cell[c] = owner[mesh->host_cell[c]];
+            mesh->input.global_id = std::move(ids);
+            mesh->input.owner.assign(owner, owner + ncells);
         });
-        *out = part_grid(comm, std::move(mesh), owner_of_cell, fn);
+        *out = part_grid(comm, std::move(mesh), fn, nullptr);
     });
 }
 

@@ -45,13 +45,14 @@ bool can_flow_forever(const StepAgreement &state, bool driven) {
     return lowest != highest;
 }
 
-// A cell as the host numbers it, for messages: (i, j) on a grid, its index
-// from the mesh's start index on a mesh.
+// A cell as the host numbers it, for messages: (i, j) from the grid's index
+// base on a grid, its index from the mesh's start index on a mesh.
 std::string host_cell_name(const Grid &grid, std::int64_t c) {
     const Geometry &geo = grid.geometry();
     if (const Mesh *mesh = geo.mesh.get())
         return "cell " + std::to_string(mesh->host_cell[static_cast<std::size_t>(c)] + mesh->input.start_index);
-    return "cell i = " + std::to_string(c % geo.nx) + ", j = " + std::to_string(c / geo.nx);
+    const int base = grid.index_base();
+    return "cell i = " + std::to_string(c % geo.nx + base) + ", j = " + std::to_string(c / geo.nx + base);
 }
 
 // A source that would carry a sand cell beyond the supported range within

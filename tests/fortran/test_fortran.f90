@@ -5,7 +5,7 @@
 program test_fortran
   use, intrinsic :: iso_c_binding, only: c_double, c_int, c_int8_t, c_int32_t, c_int64_t
   use, intrinsic :: iso_fortran_env, only: error_unit
-  use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
+  use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan, ieee_positive_inf
   use dpsm
   implicit none
 
@@ -24,6 +24,7 @@ program test_fortran
   call test_coupling()
   call test_restart()
   call test_meshes()
+  call test_messages_count_from_one()
   call test_destroyed()
 
   if (failures > 0) then
@@ -480,7 +481,8 @@ contains
     zb(2, 3) = 1.0e60_c_double
     call dpsm_set_bedrock(g, zb, ierr)
     call expect(ierr == DPSM_ERR_INVALID_VALUE, 'dpsm_set_bedrock outside the supported range fails with INVALID_VALUE')
-    call expect(index(dpsm_last_error(g), 'zb[') > 0, 'the message names the cell: '//dpsm_last_error(g))
+    call expect(index(dpsm_last_error(g), 'zb(2, 3) (cell i = 2, j = 3) = ') > 0, &
+                'the message names the cell from 1: '//dpsm_last_error(g))
     wrong = 0
     call dpsm_set_bedrock(g, wrong, ierr)
     call expect(ierr == DPSM_ERR_INVALID_SIZE, 'dpsm_set_bedrock(zb(ny, nx)) fails with INVALID_SIZE')
@@ -587,7 +589,8 @@ contains
     levels(3) = ieee_value(levels(3), ieee_quiet_nan)
     call dpsm_set_side_levels(g, DPSM_XMAX, levels, ierr)
     call expect(ierr == DPSM_ERR_INVALID_VALUE, 'dpsm_set_side_levels with a NaN fails with INVALID_VALUE')
-    call expect(index(dpsm_last_error(g), 'levels[2]') > 0, 'the message names the face: '//dpsm_last_error(g))
+    call expect(index(dpsm_last_error(g), 'levels(3) (the face of cell j = 3 on side DPSM_XMAX) is NaN') > 0, &
+                'the message names the face from 1: '//dpsm_last_error(g))
     call dpsm_set_side_levels(g, DPSM_XMIN, ierr=ierr)
     call expect(ierr == DPSM_OK, 'dpsm_set_side_levels without levels returns the side to 0')
     call dpsm_set_face_flux_recording(g, 0_c_int)
@@ -678,6 +681,70 @@ contains
     close (unit, status='delete')
     call dpsm_destroy(g)
   end subroutine test_restart
+
+  !> The library's messages name cells and array positions as this program
+  !> writes them, from 1, on every grid the module creates or loads;
+  !> dpsm_set_index_base(g, 0) gives C's.
+  subroutine test_messages_count_from_one()
+    integer, parameter :: nx = 3, ny = 3
+    type(dpsm_grid) :: g, line, loaded
+    integer(c_int8_t) :: kinds(nx, ny)
+    real(c_double) :: h(nx, ny), block(2, 2), hl(5)
+    integer :: ierr
+    call dpsm_create_2d(g, nx, ny, 0.1_c_double, 0.1_c_double)
+    kinds = DPSM_CELL_SAND
+    kinds(3, 3) = 9
+    call dpsm_set_cell_kinds(g, kinds, ierr)
+    call expect(ierr == DPSM_ERR_UNKNOWN_ENUM, 'dpsm_set_cell_kinds with kinds(3,3) = 9 fails with UNKNOWN_ENUM')
+    call expect(index(dpsm_last_error(g), 'kinds(3, 3) (cell i = 3, j = 3) = 9') > 0, &
+                'the message names kinds(3, 3) and cell i = 3, j = 3: '//dpsm_last_error(g))
+    h = 0
+    h(1, 2) = ieee_value(h(1, 2), ieee_quiet_nan)
+    call dpsm_set_heights(g, h, ierr)
+    call expect(index(dpsm_last_error(g), 'h(1, 2) (cell i = 1, j = 2) is NaN') > 0, &
+                'dpsm_set_heights names h(1, 2): '//dpsm_last_error(g))
+    ! A block's positions count within the block, its cells on the grid.
+    block = 0
+    block(2, 1) = ieee_value(block(2, 1), ieee_positive_inf)
+    call dpsm_set_heights_region(g, 1, 1, 2, 2, block, ierr)
+    call expect(index(dpsm_last_error(g), 'h(2, 1) (cell i = 3, j = 2) is +Inf') > 0, &
+                'dpsm_set_heights_region names the block position and the cell: '//dpsm_last_error(g))
+    call dpsm_set_index_base(g, 2_c_int, ierr)
+    call expect(ierr == DPSM_ERR_INVALID_VALUE, 'dpsm_set_index_base(2) fails with INVALID_VALUE')
+    call dpsm_set_index_base(g, 0_c_int, ierr)
+    call expect(ierr == DPSM_OK, 'dpsm_set_index_base(0)')
+    call dpsm_set_cell_kinds(g, kinds, ierr)
+    call expect(index(dpsm_last_error(g), 'kinds[8] (cell i = 2, j = 2) = 9') > 0, &
+                'with base 0 the message is C''s: '//dpsm_last_error(g))
+    call dpsm_set_index_base(g, 1_c_int, ierr)
+    call expect(ierr == DPSM_OK, 'dpsm_set_index_base(1)')
+
+    ! A grid loaded from a restart file counts from 1 too.
+    h = 1
+    call dpsm_set_heights(g, h)
+    call dpsm_save(g, 'test_fortran_index_base.dpsm', ierr)
+    call expect(ierr == DPSM_OK, 'dpsm_save: '//dpsm_last_error(g))
+    call dpsm_load(loaded, 'test_fortran_index_base.dpsm', ierr)
+    call expect(ierr == DPSM_OK, 'dpsm_load: '//dpsm_last_error())
+    call dpsm_set_cell_kinds(loaded, kinds, ierr)
+    call expect(index(dpsm_last_error(loaded), 'kinds(3, 3) (cell i = 3, j = 3) = 9') > 0, &
+                'a loaded grid counts from 1: '//dpsm_last_error(loaded))
+    call dpsm_destroy(loaded)
+    call dpsm_destroy(g)
+
+    call dpsm_create_1d(line, 5, 0.1_c_double)
+    hl = 0
+    hl(4) = -1.0e60_c_double
+    call dpsm_set_heights(line, hl, ierr)
+    call expect(index(dpsm_last_error(line), 'h(4) (cell i = 4, j = 1) = ') > 0, &
+                'a line names h(4): '//dpsm_last_error(line))
+    call dpsm_destroy(line)
+    call dpsm_create_axisymmetric(line, 5, 0.1_c_double)
+    call dpsm_set_heights(line, hl, ierr)
+    call expect(index(dpsm_last_error(line), 'h(4) (cell i = 4, j = 1)') > 0, &
+                'an axisymmetric grid names h(4): '//dpsm_last_error(line))
+    call dpsm_destroy(line)
+  end subroutine test_messages_count_from_one
 
   !> Meshes: the three constructors with 1-based indices (good and bad, C's
   !> messages counting from 1 as the host does), their faces 1-based,

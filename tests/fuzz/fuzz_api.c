@@ -665,8 +665,16 @@ static void op_parameter(reader_t *r, unsigned which) {
         default: {
             g_op = "dpsm_set_threads";
             static const int values[] = {0, 1, 2, 3, 1, 2, -1, INT32_MIN};
-            const int v = values[u8(r) % COUNT(values)];
+            const unsigned pick_byte = u8(r);
+            const int v = values[pick_byte % COUNT(values)];
             ON_BOTH(s, v >= 0 ? DPSM_OK : DPSM_ERR_INVALID_VALUE, g_op, dpsm_set_threads(g_, v));
+            /* The index base from the same byte (no byte of its own, so the
+             * corpus keeps its meaning): it changes messages only. */
+            static const int bases[] = {0, 1, 1, 0, 2, -1, 0, INT32_MAX};
+            const int base = bases[(pick_byte / COUNT(values)) % COUNT(bases)];
+            g_op = "dpsm_set_index_base";
+            ON_BOTH(s, base == 0 || base == 1 ? DPSM_OK : DPSM_ERR_INVALID_VALUE, g_op, dpsm_set_index_base(g_, base));
+            if (dpsm_set_index_base(NULL, base) != DPSM_ERR_NULL_POINTER) die("dpsm_set_index_base accepted a NULL grid");
             /* What a step will use: 1 on a line's serial sweep, else what was asked, else OpenMP's default. */
             int n = 0;
             g_op = "dpsm_get_threads";

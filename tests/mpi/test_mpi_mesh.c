@@ -32,30 +32,7 @@
 #include <metis.h>
 #endif
 
-static int rank_, size_;
-static long failures_, checks_;
-
-#if defined(__GNUC__)
-__attribute__((format(printf, 2, 3)))
-#endif
-static void require(int cond, const char *fmt, ...) {
-    ++checks_;
-    if (cond) return;
-    ++failures_;
-    va_list ap;
-    va_start(ap, fmt);
-    fprintf(stderr, "FAIL (rank %d of %d): ", rank_, size_);
-    vfprintf(stderr, fmt, ap);
-    fputc('\n', stderr);
-    va_end(ap);
-}
-
-#define OK(g, call)                                                                                       \
-    do {                                                                                                  \
-        int status_ = (call);                                                                             \
-        require(status_ == DPSM_OK, "%s:%d: %s returned %s: %s", __FILE__, __LINE__, #call,               \
-                dpsm_status_string(status_), dpsm_last_error(g));                                         \
-    } while (0)
+#include "mpi_check.h"
 
 static void *xcalloc(size_t n, size_t size) {
     void *p = calloc(n ? n : 1, size);
@@ -165,6 +142,21 @@ static void centre(const mesh_t *m, int64_t c, double *x, double *y) {
     const int64_t k0 = m->cell_start[c], k1 = m->cell_start[c + 1];
     for (int64_t k = k0; k < k1; ++k) *x += m->node_xy[2 * m->cell_nodes[k]], *y += m->node_xy[2 * m->cell_nodes[k] + 1];
     *x /= (double)(k1 - k0), *y /= (double)(k1 - k0);
+}
+
+/* A cell's centroid and area, as a finite-volume host computes them. */
+static void centroid(const mesh_t *m, int64_t c, double *xy, double *area) {
+    double twice = 0.0, mx = 0.0, my = 0.0;
+    const int64_t k0 = m->cell_start[c], n = m->cell_start[c + 1] - k0;
+    const double ox = m->node_xy[2 * m->cell_nodes[k0]], oy = m->node_xy[2 * m->cell_nodes[k0] + 1];
+    for (int64_t j = 0; j < n; ++j) {
+        const int64_t u = m->cell_nodes[k0 + j], w = m->cell_nodes[k0 + (j + 1) % n];
+        const double px = m->node_xy[2 * u] - ox, py = m->node_xy[2 * u + 1] - oy;
+        const double qx = m->node_xy[2 * w] - ox, qy = m->node_xy[2 * w + 1] - oy;
+        const double cr = px * qy - py * qx;
+        twice += cr, mx += cr * (px + qx) / 3.0, my += cr * (py + qy) / 3.0;
+    }
+    xy[0] = ox + mx / twice, xy[1] = oy + my / twice, *area = 0.5 * fabs(twice);
 }
 
 /* ---- partitions ---------------------------------------------------------- */
@@ -456,20 +448,7 @@ static void run_scene(const mesh_t *m, int scene, int kind, int graph) {
          * with a local cell on both sides (or the domain edge), from the
          * serial mesh's geometry as a host's finite-volume code holds it. */
         double *cell_xy = xcalloc((size_t)(2 * p.ncells), sizeof(double)), *area = xcalloc((size_t)p.ncells, sizeof(double));
-        for (int64_t k = 0; k < p.ncells; ++k) {
-            const int64_t c = p.global[k];
-            double twice = 0.0, mx = 0.0, my = 0.0;
-            const int64_t k0 = m->cell_start[c], n = m->cell_start[c + 1] - k0;
-            const double ox = m->node_xy[2 * m->cell_nodes[k0]], oy = m->node_xy[2 * m->cell_nodes[k0] + 1];
-            for (int64_t j = 0; j < n; ++j) {
-                const int64_t u = m->cell_nodes[k0 + j], w = m->cell_nodes[k0 + (j + 1) % n];
-                const double px = m->node_xy[2 * u] - ox, py = m->node_xy[2 * u + 1] - oy;
-                const double qx = m->node_xy[2 * w] - ox, qy = m->node_xy[2 * w + 1] - oy;
-                const double cr = px * qy - py * qx;
-                twice += cr, mx += cr * (px + qx) / 3.0, my += cr * (py + qy) / 3.0;
-            }
-            cell_xy[2 * k] = ox + mx / twice, cell_xy[2 * k + 1] = oy + my / twice, area[k] = 0.5 * fabs(twice);
-        }
+        for (int64_t k = 0; k < p.ncells; ++k) centroid(m, p.global[k], &cell_xy[2 * k], &area[k]);
         int64_t nfaces = 0;
         int64_t *fc = xcalloc((size_t)(2 * serial.nfaces), sizeof(int64_t));
         double *fxy = xcalloc((size_t)(2 * serial.nfaces), sizeof(double)), *flen = xcalloc((size_t)serial.nfaces, sizeof(double));
@@ -494,19 +473,7 @@ static void run_scene(const mesh_t *m, int scene, int kind, int graph) {
         {
             double *gxy = xcalloc((size_t)(2 * m->ncells), sizeof(double)), *garea = xcalloc((size_t)m->ncells, sizeof(double));
             double *sfxy = xcalloc((size_t)(2 * serial.nfaces), sizeof(double)), *sflen = xcalloc((size_t)serial.nfaces, sizeof(double));
-            for (int64_t c = 0; c < m->ncells; ++c) {
-                double twice = 0.0, mx = 0.0, my = 0.0;
-                const int64_t k0 = m->cell_start[c], n = m->cell_start[c + 1] - k0;
-                const double ox = m->node_xy[2 * m->cell_nodes[k0]], oy = m->node_xy[2 * m->cell_nodes[k0] + 1];
-                for (int64_t j = 0; j < n; ++j) {
-                    const int64_t u = m->cell_nodes[k0 + j], w = m->cell_nodes[k0 + (j + 1) % n];
-                    const double px = m->node_xy[2 * u] - ox, py = m->node_xy[2 * u + 1] - oy;
-                    const double qx = m->node_xy[2 * w] - ox, qy = m->node_xy[2 * w + 1] - oy;
-                    const double cr = px * qy - py * qx;
-                    twice += cr, mx += cr * (px + qx) / 3.0, my += cr * (py + qy) / 3.0;
-                }
-                gxy[2 * c] = ox + mx / twice, gxy[2 * c + 1] = oy + my / twice, garea[c] = 0.5 * fabs(twice);
-            }
+            for (int64_t c = 0; c < m->ncells; ++c) centroid(m, c, &gxy[2 * c], &garea[c]);
             for (int64_t s = 0; s < serial.nfaces; ++s) {
                 const int64_t u = serial.face_nodes[2 * s], w = serial.face_nodes[2 * s + 1];
                 sfxy[2 * s] = 0.5 * (m->node_xy[2 * u] + m->node_xy[2 * w]);
@@ -544,11 +511,35 @@ static void run_scene(const mesh_t *m, int scene, int kind, int graph) {
     set_scene(m, scene, &part);
     double *hs = xcalloc((size_t)m->ncells, sizeof(double)), *hp = xcalloc((size_t)p.ncells, sizeof(double));
     const double dts[] = {0.02, 0.05, 0.05, 0.1, 0.003};
+    /* Saved after the second step, read back, and the two then stepped alike. */
+    dpsm_grid *loaded = NULL;
+    char path[64];
+    snprintf(path, sizeof path, "test_mpi_mesh.%d.dpsm", rank_);
     for (int step = 0; step < 5; ++step) {
         char at[300];
         snprintf(at, sizeof at, "%s, step %d", where, step + 1);
+        if (step == 2 && kind != PART_RANDOM) {
+            OK(part.g, dpsm_save(part.g, path));
+            OK(NULL, dpsm_load_mpi(MPI_COMM_WORLD, path, &loaded));
+            remove(path);
+        }
         OK(serial.g, dpsm_step(serial.g, dts[step]));
         OK(part.g, dpsm_step(part.g, dts[step]));
+        if (loaded) {
+            double *hl = xcalloc((size_t)p.ncells, sizeof(double));
+            OK(loaded, dpsm_step(loaded, dts[step]));
+            OK(loaded, dpsm_get_heights(loaded, hl));
+            long differ = 0;
+            OK(serial.g, dpsm_get_heights(serial.g, hs));
+            for (int64_t k = 0; k < p.ncells; ++k) differ += memcmp(&hl[k], &hs[p.global[k]], sizeof(double)) != 0;
+            require(differ == 0, "%s: the part read back from its restart file: %ld cells differ from the serial mesh",
+                    at, differ);
+            double a = 0.0, b = 0.0;
+            OK(part.g, dpsm_get_mass(part.g, DPSM_MASS_OUTFLOW, &a));
+            OK(loaded, dpsm_get_mass(loaded, DPSM_MASS_OUTFLOW, &b));
+            require(a == b, "%s: the part read back has outflow %.17g, the part %.17g", at, b, a);
+            free(hl);
+        }
         OK(serial.g, dpsm_get_heights(serial.g, hs));
         OK(part.g, dpsm_get_heights(part.g, hp));
         long differ = 0;
@@ -585,6 +576,7 @@ static void run_scene(const mesh_t *m, int scene, int kind, int graph) {
         if (scene != SCENE_TO_REST) compare_faces(&serial, &part, serial_cells, part_cells, at);
     }
     free(hs), free(hp), free(part_cells);
+    dpsm_destroy(loaded);
 done:
     dpsm_destroy(serial.g);
     dpsm_destroy(part.g);
@@ -654,6 +646,25 @@ static void inconsistent_partitions(void) {
     status = create_part(&p, &g);
     require_failed_alike(NULL, status, "without gaps", "a global id out of range");
     if (changed >= 0) p.global_id[changed] = p.global[changed];
+
+    /* Restart files: each rank loads another rank's file: refused on every rank. */
+    status = create_part(&p, &g);
+    require(status == DPSM_OK, "the partition: %s", dpsm_last_error(NULL));
+    char mine[64], other[64];
+    snprintf(mine, sizeof mine, "test_mpi_mesh_other.%d.dpsm", rank_);
+    snprintf(other, sizeof other, "test_mpi_mesh_other.%d.dpsm", (rank_ + 1) % size_);
+    OK(g, dpsm_save(g, mine));
+    dpsm_destroy(g);
+    g = NULL;
+    MPI_Barrier(MPI_COMM_WORLD);
+    status = dpsm_load_mpi(MPI_COMM_WORLD, other, &g);
+    require_failed_alike(NULL, status, "rank", "a rank loading another rank's file");
+    require(g == NULL, "a refused load left a grid");
+    status = dpsm_load(mine, &g);
+    require(status == DPSM_ERR_NOT_APPLICABLE && g == NULL && strstr(dpsm_last_error(NULL), "dpsm_load_mpi"),
+            "dpsm_load of a part of a distributed mesh: %s: %s", dpsm_status_string(status), dpsm_last_error(NULL));
+    MPI_Barrier(MPI_COMM_WORLD);
+    remove(mine);
 
     /* A NULL array on one rank. */
     status = dpsm_create_mesh_mpi(MPI_COMM_WORLD, p.nnodes, p.node_xy, p.ncells, p.cell_start, p.cell_nodes,

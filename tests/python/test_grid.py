@@ -121,8 +121,34 @@ class Test2D(LedgerMixin, unittest.TestCase):
         self.assertEqual(g.get_threads(), 2)
         g.set_threads(0)
         self.assertGreaterEqual(g.get_threads(), 1)
+        self.assertFails(dpsm.ERR_INVALID_VALUE, g.set_index_base, 2)
+        g.set_index_base(0)
         expected = 1 / (2 * 2.0 * math.cos(0.6) * (1 / self.dx**2 + 1 / self.dy**2))
         self.assertAlmostEqual(g.stable_dt(), expected, delta=1e-12 * expected)
+
+    def test_index_base(self):
+        """index_base=1 (or set_index_base(1)): messages count from 1, as Fortran writes them."""
+        kinds = [[0] * 5 for _ in range(4)]
+        kinds[2][2] = 9  # (ny, nx) order: the cell i = 2, j = 2 from 0
+        c = dpsm.Grid.create_2d(5, 4, 0.1, 0.1)
+        e = self.assertFails(dpsm.ERR_UNKNOWN_ENUM, c.set_cell_kinds, kinds)
+        self.assertIn("kinds[12] (cell i = 2, j = 2) = 9", e.message)
+        f = dpsm.Grid.create_2d(5, 4, 0.1, 0.1, index_base=1)
+        e = self.assertFails(dpsm.ERR_UNKNOWN_ENUM, f.set_cell_kinds, kinds)
+        self.assertIn("kinds(3, 3) (cell i = 3, j = 3) = 9", e.message)
+        f.set_index_base(0)
+        e = self.assertFails(dpsm.ERR_UNKNOWN_ENUM, f.set_cell_kinds, kinds)
+        self.assertIn("kinds[12]", e.message)
+        line = dpsm.Grid.create_1d(4, 0.1, index_base=1)
+        e = self.assertFails(dpsm.ERR_INVALID_VALUE, line.set_heights, [0.0, 0.0, float("nan"), 0.0])
+        self.assertIn("h(3) (cell i = 3, j = 1) is NaN", e.message)
+        ring = dpsm.Grid.create_axisymmetric(4, 0.1, index_base=1)
+        e = self.assertFails(dpsm.ERR_INVALID_VALUE, ring.set_heights, [0.0, float("inf"), 0.0, 0.0])
+        self.assertIn("h(2)", e.message)
+        for bad in (2, -1):
+            self.assertFails(dpsm.ERR_INVALID_VALUE, dpsm.Grid.create_2d, 5, 4, 0.1, 0.1, index_base=bad)
+        with self.assertRaises(TypeError):
+            dpsm.Grid.create_1d(4, 0.1, index_base=1.0)
 
     def test_heights(self):
         g = self.g

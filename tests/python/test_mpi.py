@@ -13,7 +13,8 @@ also runs the whole scene on a serial grid of libdpsm in the same process:
   cells and two layers of ghosts in a shuffled order (create_mesh and
   create_graph, indices from 0 and from 1) against the serial mesh: owned and
   ghost heights bit for bit, the faces' fluxes of the graph bit for bit;
-- a restart: save on every rank, load, and the run continues bit for bit;
+- restarts of a 2D grid and of a mesh: save on every rank, load, and the run
+  continues bit for bit;
 - a rank refusing its arguments, in Python or in C, fails the call on every
   rank, with dpsm.Error naming the problem; inconsistent partitions too;
 - a distributed grid calls only libdpsm_mpi: with libdpsm's functions made
@@ -375,6 +376,31 @@ class TestDistributedMesh(MpiTestCase):
                             self.assertEqual(flat(g.get_mesh_faces()),
                                              [v + start_index for pair in part.face_cells for v in pair])
 
+    def test_restart_continues_bit_for_bit(self):
+        directory = comm.bcast(tempfile.mkdtemp(prefix="dpsm-pympi-") if RANK == 0 else None)
+        try:
+            part = Part()
+            path = os.path.join(directory, "part.%04d.dpsm" % RANK)
+            with part.create("graph") as g:
+                setup_mesh(g, part)
+                g.step(0.02)
+                g.save(path)
+                g.step(0.02)
+                g.step(0.02)
+                continued, mass = g.get_heights(), g.get_mass(dpsm.MASS_TOTAL)
+            with dpsm.mpi.load(comm, path) as g:
+                g.step(0.02)
+                g.step(0.02)
+                loaded_mass = g.get_mass(dpsm.MASS_TOTAL)
+                with self.subTest(check="the loaded part continues bit for bit"):
+                    self.assertEqual((g.kind, g.shape), ("mesh", (len(part.cells),)))
+                    self.assertEqual(as_list(g.get_heights()), as_list(continued))
+                    self.assertEqual(loaded_mass, mass)
+        finally:
+            comm.Barrier()
+            if RANK == 0:
+                shutil.rmtree(directory)
+
     def test_too_few_ghosts_fail_on_every_rank(self):
         if SIZE == 1:
             self.skipTest("one rank has no ghosts")
@@ -509,6 +535,7 @@ class TestOneLibraryPerGrid(MpiTestCase):
             g.set_rest_tolerance(1e-9)
             g.set_max_substeps(10000)
             g.set_threads(1)
+            g.set_index_base(0)
             self.assertEqual(g.get_threads(), 1)
             g.set_bedrock([[0.0] * ni for _ in range(nj)])
             g.set_repose_angle_field([[THETA] * ni for _ in range(nj)])

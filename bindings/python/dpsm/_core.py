@@ -462,29 +462,41 @@ class Grid:
     # ---- creating and releasing --------------------------------------------
 
     @classmethod
-    def _create(cls, function, kind, *args):
+    def _create(cls, function, kind, *args, index_base=0):
+        # The base is checked before the grid exists, so a bad one leaves nothing behind.
+        base = _c_int(index_base, "index_base", function, C.DPSM_ERR_INVALID_VALUE)
+        if base not in (0, 1):
+            raise Error(C.DPSM_ERR_INVALID_VALUE,
+                        "index_base = %d is neither 0 (as C and Python count) nor 1 (as Fortran counts)" % base,
+                        function)
         handle = GridPtr()
         _check(getattr(lib, function)(*args, ctypes.byref(handle)), function, created=True)
-        return cls(_handle=handle, _kind=kind)
+        grid = cls(_handle=handle, _kind=kind)
+        if base:
+            grid.set_index_base(base)
+        return grid
+
+    # ``index_base=1`` makes the library's messages name cells and array
+    # positions from 1, as Fortran writes them (``dpsm_set_index_base``).
 
     @classmethod
-    def create_1d(cls, nx, dx):
+    def create_1d(cls, nx, dx, index_base=0):
         """``dpsm_create_1d``: ``nx`` cells of width ``dx``."""
         f = "dpsm_create_1d"
-        return cls._create(f, "1d", _c_int64(nx, "nx", f), _c_double(dx, "dx", f))
+        return cls._create(f, "1d", _c_int64(nx, "nx", f), _c_double(dx, "dx", f), index_base=index_base)
 
     @classmethod
-    def create_2d(cls, nx, ny, dx, dy):
+    def create_2d(cls, nx, ny, dx, dy, index_base=0):
         """``dpsm_create_2d``: ``nx`` by ``ny`` cells of size ``dx`` by ``dy``."""
         f = "dpsm_create_2d"
         return cls._create(f, "2d", _c_int64(nx, "nx", f), _c_int64(ny, "ny", f), _c_double(dx, "dx", f),
-                           _c_double(dy, "dy", f))
+                           _c_double(dy, "dy", f), index_base=index_base)
 
     @classmethod
-    def create_axisymmetric(cls, nr, dr):
+    def create_axisymmetric(cls, nr, dr, index_base=0):
         """``dpsm_create_axisymmetric``: ``nr`` rings of width ``dr``."""
         f = "dpsm_create_axisymmetric"
-        return cls._create(f, "axisymmetric", _c_int64(nr, "nr", f), _c_double(dr, "dr", f))
+        return cls._create(f, "axisymmetric", _c_int64(nr, "nr", f), _c_double(dr, "dr", f), index_base=index_base)
 
     # ---- meshes ----------------------------------------------------------------
     # Indices are 0-based, as in C, unless ``start_index=1`` says they count
@@ -849,6 +861,13 @@ class Grid:
         value = ctypes.c_int()
         self._call("dpsm_get_threads", ctypes.byref(value))
         return value.value
+
+    def set_index_base(self, base):
+        """``dpsm_set_index_base``: 0 (the default) or 1, where the library's messages count cells and
+        array positions from (1: as Fortran writes them, ``kinds(3, 3) (cell i = 3, j = 3)``). A mesh
+        keeps the start index it was created with."""
+        f = "dpsm_set_index_base"
+        self._call(f, _c_int(base, "base", f, C.DPSM_ERR_INVALID_VALUE))
 
     def set_flux_exponent(self, p):
         """``dpsm_set_flux_exponent``: within [1, ``MAX_FLUX_EXPONENT``]; 1 is the paper's law."""

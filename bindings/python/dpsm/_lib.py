@@ -4,10 +4,12 @@ The library is looked for, in this order:
 
 1. the file named by the environment variable ``DPSM_LIBRARY`` (and nowhere
    else when it is set);
-2. next to this package: ``_libpath.py``, written by ``cmake --install``,
+2. inside this package: ``pip install .`` puts the library it built into the
+   package directory (``libdpsm.so.<major>``), so the package carries its own;
+3. next to this package: ``_libpath.py``, written by ``cmake --install``,
    holds the path of the installed library relative to this directory, so an
    installed tree may be moved;
-3. the system's search path (``ctypes.util.find_library("dpsm")``, then
+4. the system's search path (``ctypes.util.find_library("dpsm")``, then
    ``libdpsm.so.<major>``).
 """
 
@@ -73,6 +75,7 @@ SIGNATURES = {
     "dpsm_set_max_substeps": (_int, [GridPtr, _i64]),
     "dpsm_set_threads": (_int, [GridPtr, _int]),
     "dpsm_get_threads": (_int, [GridPtr, _P(_int)]),
+    "dpsm_set_index_base": (_int, [GridPtr, _int]),
     "dpsm_set_bedrock": (_int, [GridPtr, _P(_dbl)]),
     "dpsm_set_repose_angle_field": (_int, [GridPtr, _P(_dbl)]),
     "dpsm_set_flux_exponent": (_int, [GridPtr, _dbl]),
@@ -97,7 +100,7 @@ def _system_names(base="dpsm"):
 def _next_to_package(base, libpath_name):
     """The library ``_libpath.py`` names (its ``libpath_name``), or, when it
     names only libdpsm, ``lib<base>`` in the same directory; None without
-    ``_libpath.py`` (a source tree)."""
+    ``_libpath.py`` (a source tree, or a package pip installed)."""
     try:
         from . import _libpath  # written by cmake --install
     except ImportError:
@@ -115,6 +118,11 @@ def _candidates(base="dpsm", env="DPSM_LIBRARY", libpath_name="LIBRARY"):
     if chosen:
         return [(chosen, env)]
     found = []
+    here = os.path.dirname(os.path.abspath(__file__))
+    for name in _system_names(base):
+        inside = os.path.join(here, name)
+        if os.path.exists(inside):
+            found.append((inside, "inside the package"))
     installed = _next_to_package(base, libpath_name)
     if installed is not None:
         found.append((installed, "next to the package"))
@@ -141,8 +149,9 @@ def load_library(base="dpsm", env="DPSM_LIBRARY", libpath_name="LIBRARY"):
     raise ImportError(
         "dpsm: cannot load the %s C library; tried:\n  " % base
         + "\n  ".join(tried)
-        + "\nSet %s to the path of lib%s.so, or install dpsm with cmake --install "
-        "(the package then finds the library next to itself)." % (env, base)
+        + "\nSet %s to the path of lib%s.so, or install dpsm with " % (env, base)
+        + ("pip install . (the package then carries its own library) or " if base == "dpsm" else "")
+        + "cmake --install (the package then finds the library next to itself)."
     )
 
 
