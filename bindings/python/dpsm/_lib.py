@@ -11,6 +11,9 @@ The library is looked for, in this order:
    installed tree may be moved;
 4. the system's search path (``ctypes.util.find_library("dpsm")``, then
    ``libdpsm.so.<major>``).
+
+``dpsm.mpi`` finds libdpsm_mpi the same ways (``load_library``), through
+``DPSM_MPI_LIBRARY`` and ``_libpath.py``'s ``MPI_LIBRARY``.
 """
 
 import ctypes

@@ -40,8 +40,9 @@ communicator (an ``mpi4py.MPI.Intracomm``, e.g. ``MPI.COMM_WORLD``)::
   (on Debian: python3-mpi4py and libopenmpi-dev).
 
 Importing this module imports ``mpi4py.MPI`` (which initializes MPI) and
-loads libdpsm_mpi, found through ``DPSM_MPI_LIBRARY``, next to the installed
-package (``_libpath.py``), or on the system path (``libdpsm_mpi.so.<major>``).
+loads libdpsm_mpi, found as ``dpsm._lib`` finds libdpsm: through
+``DPSM_MPI_LIBRARY``, inside or next to the installed package (``_libpath.py``),
+or on the system path (``libdpsm_mpi.so.<major>``).
 ``import dpsm`` alone never imports mpi4py.
 """
 
