@@ -20,6 +20,7 @@ DPSM_APT_PACKAGES=(
     python3-matplotlib # the Python example's plot
     python3-yaml       # dpsm.config: the YAML configuration of the Python BMI component and its tests
     python3-netcdf4    # dpsm.config: netCDF fields and UGRID meshes; tests/python/test_bmi.py's mesh
+    python3-mpi4py     # dpsm.mpi (the Python binding of libdpsm_mpi) and its tests, tests/python/test_mpi.py
     python3-venv       # the install_pip test: pip install . into a venv (ensurepip)
     python3-setuptools # the install_pip test: pip install --no-build-isolation uses the system's setuptools
     python3-wheel      # the install_pip test: setuptools builds a wheel for pip

@@ -38,6 +38,9 @@ A ctypes binding of the C library (no compiled extension)::
   and other BMI hosts), configured by a YAML file that ``dpsm.config``
   reads (docs: The BMI component in Python); import them as
   ``from dpsm.bmi import BmiDpsm``.
+- ``dpsm.mpi`` (``import dpsm.mpi``, which needs mpi4py) makes grids and
+  meshes distributed over MPI, in libdpsm_mpi (docs: Distributed grids over
+  MPI, "Python hosts"); ``import dpsm`` alone never imports mpi4py.
 - The C library is found through ``DPSM_LIBRARY``, next to the installed
   package, or on the system path (see ``dpsm._lib``); ``dpsm.LIBRARY`` is the
   one loaded.

@@ -124,9 +124,12 @@ def _restart_kind(raw_path, ny):
     return "axisymmetric" if axisymmetric else "1d"
 
 
-def _check(status, function, handle=None, created=False):
+def _check(status, function, handle=None, created=False, library=None):
+    """Raises Error with the message ``library`` (libdpsm by default) keeps for
+    ``handle`` (for this thread when ``created``: a constructor failed) unless
+    ``status`` is DPSM_OK."""
     if status != C.DPSM_OK:
-        message = _text(lib.dpsm_last_error(None if created else handle))
+        message = _text((library or lib).dpsm_last_error(None if created else handle))
         raise Error(status, message, function)
 
 
@@ -438,16 +441,21 @@ class Grid:
     ``TypeError`` naming the function and the argument, before C is called.
     """
 
-    def __init__(self, _handle=None, _kind=None):
-        """Not for hosts: a Grid is made by one of the ``create_*`` class methods."""
+    def __init__(self, _handle=None, _kind=None, _lib=None):
+        """Not for hosts: a Grid is made by one of the ``create_*`` class methods (or by ``dpsm.mpi``,
+        which passes ``_lib``, the library that made the handle: only its functions may take it)."""
         if not isinstance(_handle, GridPtr) or not _handle:
             raise TypeError("make a Grid with Grid.create_1d, Grid.create_2d, Grid.create_axisymmetric, "
                             "Grid.create_mesh, Grid.create_graph, Grid.create_dual_mesh or Grid.from_meshio")
+        # libdpsm, or libdpsm_mpi for a distributed grid: two copies of the
+        # library may live in the process, each knowing only its own grids.
+        self._lib = _lib or lib
         self._handle = _handle
         ## What the grid is: "1d", "2d", "axisymmetric" or "mesh".
         self.kind = _kind
         nx, ny = ctypes.c_int64(), ctypes.c_int64()
-        _check(lib.dpsm_get_shape(_handle, ctypes.byref(nx), ctypes.byref(ny)), "dpsm_get_shape", _handle)
+        _check(self._lib.dpsm_get_shape(_handle, ctypes.byref(nx), ctypes.byref(ny)), "dpsm_get_shape", _handle,
+               library=self._lib)
         # C's sizes (dpsm_get_shape), read through the properties nx and ny.
         self._nx, self._ny = nx.value, ny.value
 
@@ -691,16 +699,21 @@ class Grid:
         raw = _c_path(path, f)
         handle = GridPtr()
         _check(lib.dpsm_load(raw, ctypes.byref(handle)), f, created=True)
+        return cls._loaded(handle, raw, lib)
+
+    @classmethod
+    def _loaded(cls, handle, raw_path, library):
+        """The Grid of a ``handle`` that ``library`` loaded from ``raw_path``, of the kind the file holds."""
         # A mesh knows its faces; a grid refuses (and the next call, which
         # succeeds, clears that message).
         nfaces = ctypes.c_int64()
-        mesh = lib.dpsm_get_face_count(handle, ctypes.byref(nfaces)) == C.DPSM_OK
+        mesh = library.dpsm_get_face_count(handle, ctypes.byref(nfaces)) == C.DPSM_OK
         nx, ny = ctypes.c_int64(), ctypes.c_int64()
-        status = lib.dpsm_get_shape(handle, ctypes.byref(nx), ctypes.byref(ny))
+        status = library.dpsm_get_shape(handle, ctypes.byref(nx), ctypes.byref(ny))
         if status != C.DPSM_OK:  # cannot happen with a loaded grid; do not leak it
-            lib.dpsm_destroy(handle)
-            _check(status, "dpsm_get_shape")
-        return cls(_handle=handle, _kind="mesh" if mesh else _restart_kind(raw, ny.value))
+            library.dpsm_destroy(handle)
+            _check(status, "dpsm_get_shape", library=library)
+        return cls(_handle=handle, _kind="mesh" if mesh else _restart_kind(raw_path, ny.value), _lib=library)
 
     def save(self, path):
         """``dpsm_save``: writes everything needed to continue the run bit for
@@ -713,7 +726,7 @@ class Grid:
         ``DPSM_ERR_NULL_POINTER``. Closing twice is allowed."""
         handle, self._handle = self._handle, None
         if handle:
-            lib.dpsm_destroy(handle)
+            self._lib.dpsm_destroy(handle)
 
     ## The C name of close.
     destroy = close
@@ -770,7 +783,7 @@ class Grid:
         return (ny, nx) if self.kind == "2d" else (nx,)
 
     def _call(self, function, *args):
-        _check(getattr(lib, function)(self._handle, *args), function, self._handle)
+        _check(getattr(self._lib, function)(self._handle, *args), function, self._handle, library=self._lib)
 
     # ---- parameters ----------------------------------------------------------
 
@@ -1178,7 +1191,7 @@ class Grid:
 
     def last_error(self):
         """``dpsm_last_error``: the message of the last failed call on this grid, ``""`` if it succeeded."""
-        return _text(lib.dpsm_last_error(self._handle))
+        return _text(self._lib.dpsm_last_error(self._handle))
 
 
 def _rows_columns(shape):

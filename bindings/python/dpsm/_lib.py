@@ -11,6 +11,9 @@ The library is looked for, in this order:
    installed tree may be moved;
 4. the system's search path (``ctypes.util.find_library("dpsm")``, then
    ``libdpsm.so.<major>``).
+
+``dpsm.mpi`` finds libdpsm_mpi the same ways (``load_library``), through
+``DPSM_MPI_LIBRARY`` and ``_libpath.py``'s ``MPI_LIBRARY``.
 """
 
 import ctypes
@@ -89,42 +92,57 @@ SIGNATURES = {
 }
 
 
-def _system_names():
+def _system_names(base="dpsm"):
     if sys.platform == "win32":
-        return ["dpsm.dll", "libdpsm.dll"]
+        return ["%s.dll" % base, "lib%s.dll" % base]
     if sys.platform == "darwin":
-        return ["libdpsm.%d.dylib" % ABI_MAJOR]
-    return ["libdpsm.so.%d" % ABI_MAJOR]
+        return ["lib%s.%d.dylib" % (base, ABI_MAJOR)]
+    return ["lib%s.so.%d" % (base, ABI_MAJOR)]
 
 
-def _candidates():
-    """(path or name, how it was found) in the order they are tried."""
-    env = os.environ.get("DPSM_LIBRARY")
-    if env:
-        return [(env, "DPSM_LIBRARY")]
-    found = []
-    here = os.path.dirname(os.path.abspath(__file__))
-    for name in _system_names():
-        inside = os.path.join(here, name)
-        if os.path.exists(inside):
-            found.append((inside, "inside the package"))
+def _next_to_package(base, libpath_name):
+    """The library ``_libpath.py`` names (its ``libpath_name``), or, when it
+    names only libdpsm, ``lib<base>`` in the same directory; None without
+    ``_libpath.py`` (a source tree, or a package pip installed)."""
     try:
         from . import _libpath  # written by cmake --install
     except ImportError:
-        _libpath = None
-    if _libpath is not None:
-        found.append((os.path.normpath(os.path.join(here, _libpath.LIBRARY)), "next to the package"))
-    name = ctypes.util.find_library("dpsm")
+        return None
+    here = os.path.dirname(os.path.abspath(__file__))
+    relative = getattr(_libpath, libpath_name, None)
+    if relative is None:
+        relative = os.path.join(os.path.dirname(_libpath.LIBRARY), _system_names(base)[0])
+    return os.path.normpath(os.path.join(here, relative))
+
+
+def _candidates(base="dpsm", env="DPSM_LIBRARY", libpath_name="LIBRARY"):
+    """(path or name, how it was found) in the order they are tried."""
+    chosen = os.environ.get(env)
+    if chosen:
+        return [(chosen, env)]
+    found = []
+    here = os.path.dirname(os.path.abspath(__file__))
+    for name in _system_names(base):
+        inside = os.path.join(here, name)
+        if os.path.exists(inside):
+            found.append((inside, "inside the package"))
+    installed = _next_to_package(base, libpath_name)
+    if installed is not None:
+        found.append((installed, "next to the package"))
+    name = ctypes.util.find_library(base)
     if name:
         found.append((name, "the system path"))
-    for name in _system_names():
+    for name in _system_names(base):
         found.append((name, "the system path"))
     return found
 
 
-def _load():
+def load_library(base="dpsm", env="DPSM_LIBRARY", libpath_name="LIBRARY"):
+    """(the ctypes.CDLL of ``lib<base>``, the path it was loaded from), found
+    through the environment variable ``env``, ``_libpath.py`` (its
+    ``libpath_name``) or the system path; ImportError naming every place tried."""
     tried = []
-    for path, how in _candidates():
+    for path, how in _candidates(base, env, libpath_name):
         try:
             lib = ctypes.CDLL(path)
         except OSError as e:
@@ -132,31 +150,35 @@ def _load():
             continue
         return lib, path
     raise ImportError(
-        "dpsm: cannot load the dpsm C library; tried:\n  "
+        "dpsm: cannot load the %s C library; tried:\n  " % base
         + "\n  ".join(tried)
-        + "\nSet DPSM_LIBRARY to the path of libdpsm.so, or install dpsm with pip install . (the package "
-        "then carries its own library) or cmake --install (the package then finds the library next to itself)."
+        + "\nSet %s to the path of lib%s.so, or install dpsm with " % (env, base)
+        + ("pip install . (the package then carries its own library) or " if base == "dpsm" else "")
+        + "cmake --install (the package then finds the library next to itself)."
     )
 
 
-def _declare(lib):
-    for name, (restype, argtypes) in SIGNATURES.items():
+def declare(lib, path, signatures):
+    """Gives every function of ``signatures`` (name -> (restype, argtypes)) of
+    ``lib``, loaded from ``path``, its ctypes types; ImportError when one is
+    missing or the library's major version is not ABI_MAJOR."""
+    for name, (restype, argtypes) in signatures.items():
         try:
             function = getattr(lib, name)
         except AttributeError:
-            raise ImportError("dpsm: %s has no function %s: the library is older than this package" % (LIBRARY, name))
+            raise ImportError("dpsm: %s has no function %s: the library is older than this package" % (path, name))
         function.restype = restype
         function.argtypes = argtypes
     major = lib.dpsm_version_number() // 10000
     if major != ABI_MAJOR:
         raise ImportError(
             "dpsm: %s is version %s, major %d; this package needs major version %d"
-            % (LIBRARY, lib.dpsm_version_string().decode(), major, ABI_MAJOR)
+            % (path, lib.dpsm_version_string().decode(), major, ABI_MAJOR)
         )
 
 
 ## The loaded C library (a ctypes.CDLL).
-lib, LIBRARY = _load()
+lib, LIBRARY = load_library()
 ## @var LIBRARY
 #  The path the C library was loaded from.
-_declare(lib)
+declare(lib, LIBRARY, SIGNATURES)
