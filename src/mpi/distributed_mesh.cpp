@@ -407,42 +407,56 @@ private:
     // negated): a source, open cells, something that may move, the lowest and
     // highest open cell, the smallest angle, the open edge faces' levels, an
     // open edge. Over its owned cells and the faces that touch them.
-    std::vector<double> local_state(const Grid &grid) const {
+    std::vector<double> local_state(const Grid &grid) {
+        const HeldLevels &held = held_levels(grid);
         const double none = -std::numeric_limits<double>::infinity();
+        return {grid.source_active() ? 1.0 : 0.0,
+                held.open ? 1.0 : 0.0,
+                grid.mesh_activity().may_move() ? 1.0 : 0.0,
+                held.open ? -held.open_lo : none,
+                held.open ? held.open_hi : none,
+                -grid.own_min_repose_angle(),
+                held.edge ? 1.0 : 0.0,
+                held.edge ? -held.edge_lo : none,
+                held.edge ? held.edge_hi : none,
+                held.edge || grid.side_open(0) ? 1.0 : 0.0};
+    }
+
+    // The levels held by the owned open cells and the open edge faces. Steps
+    // change neither (open cells are not stepped): they are found again only
+    // when a host set heights, masks, edges or levels, not at every step.
+    struct HeldLevels {
+        std::uint64_t heights = 0, masks = 0, edges = 0, levels = 0;
+        bool known = false, open = false, edge = false;
+        double open_lo = 0.0, open_hi = 0.0, edge_lo = 0.0, edge_hi = 0.0;
+    };
+    const HeldLevels &held_levels(const Grid &grid) {
+        HeldLevels &h = held_;
+        if (h.known && h.heights == grid.heights_version() && h.masks == grid.masks_version() &&
+            h.edges == grid.edges_version() && h.levels == grid.side_levels_version())
+            return h;
+        h = HeldLevels{grid.heights_version(), grid.masks_version(), grid.edges_version(), grid.side_levels_version(),
+                       true};
         const Mesh &m = *grid.geometry().mesh;
-        bool open = false;
-        double lo = 0.0, hi = 0.0;
         if (grid.has_open_cells()) {
             const std::vector<std::uint8_t> &kind = grid.kinds();
-            const std::vector<double> &h = grid.heights();
+            const std::vector<double> &height = grid.heights();
             for (std::int64_t c = 0; c < m.owned; ++c) {
                 if (kind[c] != kOpen) continue;
-                lo = open ? std::min(lo, h[c]) : h[c];
-                hi = open ? std::max(hi, h[c]) : h[c];
-                open = true;
+                h.open_lo = h.open ? std::min(h.open_lo, height[c]) : height[c];
+                h.open_hi = h.open ? std::max(h.open_hi, height[c]) : height[c];
+                h.open = true;
             }
         }
-        bool edge = false, any_open_edge = false;
-        double edge_lo = 0.0, edge_hi = 0.0;
         const std::vector<double> &levels = grid.side_levels(0);
         for (std::int64_t f = 0; f < m.live_faces; ++f) {
             if (m.face_b[f] >= 0 || !grid.edge_open(f)) continue;
-            any_open_edge = true;
             const double level = levels.empty() ? 0.0 : levels[f];
-            edge_lo = edge ? std::min(edge_lo, level) : level;
-            edge_hi = edge ? std::max(edge_hi, level) : level;
-            edge = true;
+            h.edge_lo = h.edge ? std::min(h.edge_lo, level) : level;
+            h.edge_hi = h.edge ? std::max(h.edge_hi, level) : level;
+            h.edge = true;
         }
-        return {grid.source_active() ? 1.0 : 0.0,
-                open ? 1.0 : 0.0,
-                grid.mesh_activity().may_move() ? 1.0 : 0.0,
-                open ? -lo : none,
-                open ? hi : none,
-                -grid.own_min_repose_angle(),
-                edge ? 1.0 : 0.0,
-                edge ? -edge_lo : none,
-                edge ? edge_hi : none,
-                any_open_edge || grid.side_open(0) ? 1.0 : 0.0};
+        return h;
     }
 
     // One neighbourhood all-to-all of `per_cell` values per listed cell.
@@ -511,6 +525,7 @@ private:
     std::vector<int> send_counts_, send_offsets_, receive_counts_, receive_offsets_;
     std::uint64_t exchanged_masks_ = std::numeric_limits<std::uint64_t>::max();    // none yet
     std::uint64_t exchanged_heights_ = std::numeric_limits<std::uint64_t>::max();  // none yet
+    HeldLevels held_;
 };
 
 }  // namespace
