@@ -14,9 +14,15 @@
  * serial mesh, all ranks at once: the compute without communication under the
  * same sharing of the cores; the communication's share is what the
  * distributed part takes beyond that. Machine-independent counts go beside:
- * owned and ghost cells, neighbouring ranks, messages and bytes a rank sends
- * per sub-step (its owned cells that other ranks hold as ghosts: heights, and
- * gradients for those across a face from the other rank's cells).
+ * owned and ghost cells, neighbouring ranks, and the messages and bytes a
+ * rank sent per sub-step (DPSM_INFO_MESSAGES_SENT, DPSM_INFO_BYTES_SENT).
+ *
+ *   mpiexec -n P dpsm-bench-mpi-mesh N STEPS local
+ *
+ * runs the local scene instead: a steep cone near a corner, the rest of the
+ * mesh flat and at rest, against the fully active scene in the same run; it
+ * prints per rank the cells visited and the messages sent per sub-step, and
+ * how many ranks did neither (local_run).
  */
 #include <malloc.h>
 #include <math.h>
@@ -107,10 +113,16 @@ static mesh_t triangles(int64_t n) {
     return m;
 }
 
+/* The scenes: fully active (a plane steeper than the angle of repose with
+ * ripples, the domain edge open), or local (a steep cone of radius 30 near a
+ * corner, the rest flat and at rest). */
+static int local_scene;
+
 static double height(const mesh_t *m, int64_t c) {
     double x = 0.0, y = 0.0;
     for (int k = 0; k < 3; ++k) x += m->node_xy[2 * m->cell_nodes[3 * c + k]], y += m->node_xy[2 * m->cell_nodes[3 * c + k] + 1];
     x /= 3.0, y /= 3.0;
+    if (local_scene) return fmax(0.0, 3.0 * (30.0 - hypot(x - 60.0, y - 60.0)));
     return 1.2 * x + 0.3 * sin(0.7 * y) + 0.2 * sin(1.3 * x + 0.4 * y);
 }
 
@@ -180,20 +192,33 @@ static dpsm_grid *make_grid(const mesh_t *m, const part_t *p, int distributed, i
     return g;
 }
 
-/* The slowest rank's seconds per sub-step, best of 3 runs of `steps` steps. */
-static double time_substeps(dpsm_grid *g, int steps, double *substeps_per_step, double *moving) {
+/* What this rank did per sub-step over the timed steps (dpsm_get_step_info). */
+typedef struct {
+    double cell_updates, messages, bytes;
+} traffic_t;
+
+/* The slowest rank's seconds per sub-step, best of 3 runs of `steps` steps;
+ * `did`: this rank's figures per sub-step over all runs. */
+static double time_substeps(dpsm_grid *g, int steps, double *substeps_per_step, double *moving, traffic_t *did) {
     double dt = 0.0;
     CHECK(g, dpsm_stable_dt(g, &dt));
-    double best = INFINITY;
+    double best = INFINITY, all_substeps = 0.0;
+    traffic_t sum = {0.0, 0.0, 0.0};
     for (int run = 0; run < 3; ++run) {
         double substeps = 0.0;
         MPI_Barrier(MPI_COMM_WORLD);
         const double t0 = MPI_Wtime();
         for (int s = 0; s < steps; ++s) {
             CHECK(g, dpsm_step(g, 4.0 * dt));
-            double k = 0.0, rest = 0.0;
+            double k = 0.0, rest = 0.0, v = 0.0;
             CHECK(g, dpsm_get_step_info(g, DPSM_INFO_SUBSTEPS, &k));
             CHECK(g, dpsm_get_step_info(g, DPSM_INFO_AT_REST, &rest));
+            CHECK(g, dpsm_get_step_info(g, DPSM_INFO_RANK_CELL_UPDATES, &v));
+            sum.cell_updates += v;
+            CHECK(g, dpsm_get_step_info(g, DPSM_INFO_MESSAGES_SENT, &v));
+            sum.messages += v;
+            CHECK(g, dpsm_get_step_info(g, DPSM_INFO_BYTES_SENT, &v));
+            sum.bytes += v;
             substeps += k;
             *moving = rest == 0.0;
         }
@@ -201,8 +226,49 @@ static double time_substeps(dpsm_grid *g, int steps, double *substeps_per_step, 
         MPI_Allreduce(MPI_IN_PLACE, &t, 1, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
         if (t < best) best = t;
         *substeps_per_step = substeps / steps;
+        all_substeps += substeps;
+    }
+    if (did) {
+        did->cell_updates = sum.cell_updates / all_substeps;
+        did->messages = sum.messages / all_substeps;
+        did->bytes = sum.bytes / all_substeps;
     }
     return best;
+}
+
+/* The local scene: a cone near a corner on the distributed mesh, against the
+ * fully active scene on the same parts in the same run. One CSV line: the
+ * time per sub-step of each, and per rank (largest and smallest) the cells
+ * visited, messages and bytes sent per sub-step; idle ranks visited and sent
+ * nothing over all timed steps. */
+static void local_run(const mesh_t *m, const part_t *p, int steps) {
+    double per_step = 0.0, moving = 0.0, dt = 0.0;
+    local_scene = 0;
+    dpsm_grid *g = make_grid(m, p, 1, 0);
+    CHECK(g, dpsm_stable_dt(g, &dt));
+    CHECK(g, dpsm_step(g, dt));
+    const double active = time_substeps(g, 1, &per_step, &moving, NULL);
+    dpsm_destroy(g);
+    local_scene = 1;
+    g = make_grid(m, p, 1, 0);
+    CHECK(g, dpsm_step(g, dt));  /* a new grid looks at every cell once */
+    traffic_t did;
+    const double local = time_substeps(g, steps, &per_step, &moving, &did);
+    dpsm_destroy(g);
+    double most[3] = {did.cell_updates, did.messages, did.bytes}, least[3] = {did.cell_updates, did.messages, did.bytes};
+    MPI_Allreduce(MPI_IN_PLACE, most, 3, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
+    MPI_Allreduce(MPI_IN_PLACE, least, 3, MPI_DOUBLE, MPI_MIN, MPI_COMM_WORLD);
+    int idle = did.cell_updates == 0.0 && did.messages == 0.0, idle_ranks = 0;
+    MPI_Allreduce(&idle, &idle_ranks, 1, MPI_INT, MPI_SUM, MPI_COMM_WORLD);
+    if (rank_ == 0) {
+        fprintf(stderr, "dpsm-bench-mpi-mesh local: %d ranks, %lld cells, %.0f sub-steps a step, still moving: %s\n",
+                size_, (long long)m->ncells, per_step, moving != 0.0 ? "yes" : "NO");
+        printf("ranks,cells,seconds_per_substep,active_seconds_per_substep,ratio_to_active,idle_ranks,"
+               "cell_updates_per_substep_max,cell_updates_per_substep_min,messages_per_substep_max,"
+               "messages_per_substep_min,bytes_per_substep_max\n");
+        printf("%d,%lld,%.6e,%.6e,%.4f,%d,%.0f,%.0f,%.2f,%.2f,%.0f\n", size_, (long long)m->ncells, local, active,
+               local / active, idle_ranks, most[0], least[0], most[1], least[1], most[2]);
+    }
 }
 
 int main(int argc, char **argv) {
@@ -210,7 +276,7 @@ int main(int argc, char **argv) {
     MPI_Comm_rank(MPI_COMM_WORLD, &rank_);
     MPI_Comm_size(MPI_COMM_WORLD, &size_);
     if (argc < 2) {
-        if (rank_ == 0) fprintf(stderr, "usage: mpiexec -n P dpsm-bench-mpi-mesh N [STEPS]\n");
+        if (rank_ == 0) fprintf(stderr, "usage: mpiexec -n P dpsm-bench-mpi-mesh N [STEPS [local]]\n");
         MPI_Finalize();
         return 2;
     }
@@ -237,24 +303,25 @@ int main(int argc, char **argv) {
     MPI_Bcast(owner, (int)m.ncells, MPI_INT, 0, MPI_COMM_WORLD);
     part_t p = part_of(&m, owner);
 
-    /* What a rank sends per sub-step: its owned cells that others hold as
-     * ghosts (heights), and those across a face from the others' cells
-     * (gradients): counted from the partition. */
-    int64_t sent_heights = 0, sent_gradients = 0, neighbours = 0;
+    if (argc > 3 && strcmp(argv[3], "local") == 0) {
+        local_run(&m, &p, steps);
+        free(owner), free(p.global), free(p.owner);
+        free(m.node_xy), free(m.cell_nodes), free(m.adj_start), free(m.adj);
+        MPI_Finalize();
+        return 0;
+    }
+    /* The ranks that hold this rank's cells as ghosts (from the partition). */
+    int64_t neighbours = 0;
     {
         char *to = xcalloc((size_t)size_, 1);
         for (int64_t c = 0; c < m.ncells; ++c) {
             if (owner[c] != rank_) continue;
-            /* ranks within two faces of c hold it as a ghost; within one, read its gradient */
-            char *near = xcalloc((size_t)size_, 1), *next = xcalloc((size_t)size_, 1);
             for (int64_t k = m.adj_start[c]; k < m.adj_start[c + 1]; ++k) {
                 const int64_t b = m.adj[k];
-                if (owner[b] != rank_) near[owner[b]] = 1, next[owner[b]] = 1;
+                if (owner[b] != rank_) to[owner[b]] = 1;
                 for (int64_t j = m.adj_start[b]; j < m.adj_start[b + 1]; ++j)
-                    if (owner[m.adj[j]] != rank_) next[owner[m.adj[j]]] = 1;
+                    if (owner[m.adj[j]] != rank_) to[owner[m.adj[j]]] = 1;
             }
-            for (int r = 0; r < size_; ++r) sent_heights += next[r], sent_gradients += near[r], to[r] |= next[r];
-            free(near), free(next);
         }
         for (int r = 0; r < size_; ++r) neighbours += to[r];
         free(to);
@@ -267,20 +334,20 @@ int main(int argc, char **argv) {
     CHECK(g, dpsm_step(g, dt));
     const double part_bytes = heap_bytes() - before;
     double per_step = 0.0, moving = 0.0, moving_alone = 0.0, per_step_alone = 0.0;
-    const double distributed = time_substeps(g, steps, &per_step, &moving);
+    traffic_t did;
+    const double distributed = time_substeps(g, steps, &per_step, &moving, &did);
     dpsm_destroy(g);
     const double before_alone = heap_bytes();
     dpsm_grid *alone = make_grid(&m, &p, 0, 1);
     CHECK(alone, dpsm_stable_dt(alone, &dt));
     CHECK(alone, dpsm_step(alone, dt));
     const double alone_bytes = heap_bytes() - before_alone;
-    const double compute = time_substeps(alone, steps, &per_step_alone, &moving_alone);
+    const double compute = time_substeps(alone, steps, &per_step_alone, &moving_alone, NULL);
     dpsm_destroy(alone);
 
     /* The largest figures over the ranks (the slowest rank sets the pace). */
-    double v[8] = {(double)p.owned, (double)p.ghosts, (double)neighbours, (double)(2 * neighbours),
-                   8.0 * (double)sent_heights + 16.0 * (double)sent_gradients, part_bytes / alone_bytes, moving,
-                   moving_alone};
+    double v[8] = {(double)p.owned, (double)p.ghosts, (double)neighbours, did.messages, did.bytes,
+                   part_bytes / alone_bytes, moving, moving_alone};
     MPI_Allreduce(MPI_IN_PLACE, v, 8, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
     double ratio_min = part_bytes / alone_bytes;
     MPI_Allreduce(MPI_IN_PLACE, &ratio_min, 1, MPI_DOUBLE, MPI_MIN, MPI_COMM_WORLD);
@@ -289,7 +356,7 @@ int main(int argc, char **argv) {
                 size_, (long long)m.ncells, per_step, v[6] != 0.0 && v[7] != 0.0 ? "yes" : "NO (not fully active)");
         printf("ranks,cells,owned_max,ghosts_max,neighbours_max,messages_per_substep_max,bytes_per_substep_max,"
                "seconds_per_substep,alone_seconds_per_substep,communication_share,memory_ratio_min,memory_ratio_max\n");
-        printf("%d,%lld,%.0f,%.0f,%.0f,%.0f,%.0f,%.6e,%.6e,%.3f,%.3f,%.3f\n", size_, (long long)m.ncells, v[0], v[1],
+        printf("%d,%lld,%.0f,%.0f,%.0f,%.2f,%.0f,%.6e,%.6e,%.3f,%.3f,%.3f\n", size_, (long long)m.ncells, v[0], v[1],
                v[2], v[3], v[4], distributed, compute, 1.0 - compute / distributed, ratio_min, v[5]);
     }
     free(owner), free(p.global), free(p.owner);

@@ -128,6 +128,12 @@ module dpsm
   integer(c_int), parameter, public :: DPSM_INFO_MAX_EXCESS_SLOPE = 3
   !> Step information: DPSM_INFO_CELL_UPDATES, as in dpsm.h.
   integer(c_int), parameter, public :: DPSM_INFO_CELL_UPDATES = 4
+  !> Step information: DPSM_INFO_RANK_CELL_UPDATES, as in dpsm.h.
+  integer(c_int), parameter, public :: DPSM_INFO_RANK_CELL_UPDATES = 5
+  !> Step information: DPSM_INFO_MESSAGES_SENT, as in dpsm.h.
+  integer(c_int), parameter, public :: DPSM_INFO_MESSAGES_SENT = 6
+  !> Step information: DPSM_INFO_BYTES_SENT, as in dpsm.h.
+  integer(c_int), parameter, public :: DPSM_INFO_BYTES_SENT = 7
   ! Defaults.
   !> Defaults: DPSM_DEFAULT_REPOSE_ANGLE, as in dpsm.h.
   real(c_double), parameter, public :: DPSM_DEFAULT_REPOSE_ANGLE = 0.52359877559829887_c_double

@@ -198,6 +198,18 @@ typedef struct dpsm_grid dpsm_grid;
  *  only the tiles of 64 x 64 cells near moving sand or a source are visited, so
  *  this measures what the step cost (a step at rest computes none). */
 #define DPSM_INFO_CELL_UPDATES 4
+/** This rank's part of ::DPSM_INFO_CELL_UPDATES on a distributed grid (the
+ *  other items are global): a rank whose cells are all at rest computes none.
+ *  On a serial grid the same as ::DPSM_INFO_CELL_UPDATES. */
+#define DPSM_INFO_RANK_CELL_UPDATES 5
+/** The point-to-point messages of ghost cells' values this rank sent to
+ *  other ranks in the step (dpsm_mpi.h); the all-reductions by which the
+ *  ranks agree are not counted. A rank of a distributed mesh sends only the
+ *  values that changed, so one whose cells near its neighbours are at rest
+ *  sends none. 0 on a serial grid. */
+#define DPSM_INFO_MESSAGES_SENT 6
+/** The bytes of those messages. 0 on a serial grid. */
+#define DPSM_INFO_BYTES_SENT 7
 /** @} */
 
 /** The default angle of repose: 30 degrees, in radians. */

@@ -211,12 +211,24 @@ DPSM_API int dpsm_load_mpi_f(MPI_Fint comm, const char *path, dpsm_grid **out);
  *    order of their global ids. Mass figures and step information are global,
  *    as on distributed 2D grids (their sums over ranks differ from the serial
  *    ones by round-off).
- *  - **Communication:** each sub-step exchanges the ghosts' gradients and,
- *    after the update, their heights with the neighbouring ranks only (a
- *    distributed-graph communicator and neighbourhood all-to-alls), plus one
- *    all-reduce of a few numbers.
- *  - **Collective calls** are those of distributed 2D grids; restart files
- *    (dpsm_save()) are not written for distributed meshes in this version.
+ *  - **Communication:** each sub-step sends the neighbouring ranks only the
+ *    owned cells' gradients and, after the update, heights that changed
+ *    since they were last sent (one message per neighbour that has any; a
+ *    non-blocking barrier tells every rank that all have arrived), plus one
+ *    all-reduce of a few numbers. A rank whose cells near its neighbours are
+ *    at rest sends nothing, and one whose cells are all at rest also computes
+ *    nothing (its active set is empty): ::DPSM_INFO_RANK_CELL_UPDATES,
+ *    ::DPSM_INFO_MESSAGES_SENT and ::DPSM_INFO_BYTES_SENT say what this rank
+ *    did in the last step. A new grid, and one whose heights or masks a host
+ *    set, looks at every cell once. After a host changed heights, masks,
+ *    sources, bed or angles on any rank, the next step sends every ghost's
+ *    values whole (neighbourhood all-to-alls over a distributed-graph
+ *    communicator). The ghost layer is the host's: a sub-step needs the
+ *    owners' gradients of the first layer, so it takes two exchanges; dpsm
+ *    does not yet deepen the layer to take several sub-steps per exchange.
+ *  - **Collective calls** are those of distributed 2D grids; dpsm_save()
+ *    writes one restart file per rank and dpsm_load_mpi() links the parts
+ *    again.
  * @{
  */
 

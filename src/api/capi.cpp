@@ -705,10 +705,16 @@ int dpsm_get_step_info(const dpsm_grid *g, int item, double *value) {
             case DPSM_INFO_AT_REST: *value = info.at_rest ? 1.0 : 0.0; break;
             case DPSM_INFO_MAX_EXCESS_SLOPE: *value = info.max_excess_slope; break;
             case DPSM_INFO_CELL_UPDATES: *value = info.cell_updates; break;
+            case DPSM_INFO_RANK_CELL_UPDATES:
+                *value = g->core.decomposition() ? info.rank_cell_updates : info.cell_updates;
+                break;
+            case DPSM_INFO_MESSAGES_SENT: *value = info.messages_sent; break;
+            case DPSM_INFO_BYTES_SENT: *value = info.bytes_sent; break;
             default:
                 fail(DPSM_ERR_UNKNOWN_ENUM, fn, "item = ", item,
                      " is not DPSM_INFO_SUBSTEPS, DPSM_INFO_TIME_INTEGRATED, DPSM_INFO_AT_REST,"
-                     " DPSM_INFO_MAX_EXCESS_SLOPE or DPSM_INFO_CELL_UPDATES");
+                     " DPSM_INFO_MAX_EXCESS_SLOPE, DPSM_INFO_CELL_UPDATES, DPSM_INFO_RANK_CELL_UPDATES,"
+                     " DPSM_INFO_MESSAGES_SENT or DPSM_INFO_BYTES_SENT");
         }
     });
 }

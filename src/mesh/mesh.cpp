@@ -171,7 +171,21 @@ void gradient_weights(Mesh &m, int rings, const std::vector<std::int64_t> &ghost
         m.grad_cells.insert(m.grad_cells.end(), ring.begin(), ring.end());
         m.grad_start[c + 1] = static_cast<std::int64_t>(m.grad_cells.size());
     }
-    for (std::int64_t c = m.owned; c < m.cells; ++c) m.grad_start[c + 1] = m.grad_start[c];
+    if (m.owned < m.cells) {
+        // A ghost's list: the owned cells that read it, in ascending order.
+        std::vector<std::int64_t> readers(static_cast<std::size_t>(m.cells - m.owned), 0);
+        for (std::int64_t k = 0; k < m.grad_start[m.owned]; ++k)
+            if (m.grad_cells[k] >= m.owned) ++readers[static_cast<std::size_t>(m.grad_cells[k] - m.owned)];
+        for (std::int64_t c = m.owned; c < m.cells; ++c)
+            m.grad_start[c + 1] = m.grad_start[c] + readers[static_cast<std::size_t>(c - m.owned)];
+        m.grad_cells.resize(static_cast<std::size_t>(m.grad_start[m.cells]));
+        std::vector<std::int64_t> next(m.grad_start.begin() + m.owned, m.grad_start.end() - 1);
+        for (std::int64_t c = 0; c < m.owned; ++c)
+            for (std::int64_t k = m.grad_start[c]; k < m.grad_start[c + 1]; ++k) {
+                const std::int64_t n = m.grad_cells[k];
+                if (n >= m.owned) m.grad_cells[static_cast<std::size_t>(next[static_cast<std::size_t>(n - m.owned)]++)] = c;
+            }
+    }
     m.grad_wx.assign(m.grad_cells.size(), 0.0);
     m.grad_wy.assign(m.grad_cells.size(), 0.0);
     for (std::int64_t c = 0; c < m.owned; ++c) {

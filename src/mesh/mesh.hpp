@@ -62,6 +62,9 @@ struct Mesh {
     // the plane; in the order of the host's cell numbers, as the faces. The
     // cells a change of height reaches through gradients are
     // the same list (the stencil is symmetric), which the active set wakes.
+    // A ghost of a distributed mesh's part takes its gradient from its owner:
+    // its list holds the owned cells whose gradients read it (weights 0), so
+    // that a change of its height wakes them.
     std::vector<std::int64_t> grad_start, grad_cells;
     std::vector<double> grad_wx, grad_wy;
 

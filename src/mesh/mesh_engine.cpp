@@ -40,6 +40,7 @@ struct MeshScratch final : EngineState {
     std::uint32_t stamp = 0;
     std::vector<std::int64_t> faces, gradient_cells, update_cells, source_cells;
     std::vector<std::int64_t> sink_faces;  // faces onto open edges or open cells
+    std::vector<std::int64_t> changed_ghosts;  // a part's ghosts whose owners sent new values
     std::vector<double> available;         // bed: the sand a face may take
     std::vector<std::uint8_t> changed;     // dense: per cell, a face of it carried sand
     bool flux_clean = true;
@@ -244,11 +245,14 @@ private:
     SubstepSummary substep(Grid &grid, const Mesh &m, MeshScratch &s, double dt, bool record, double &visited) const {
         MeshActivity &act = grid.mesh_activity();
         const bool physics = grid.hysteresis() || !grid.bed().empty();
-        // A part of a distributed mesh visits all its cells (its ghosts' heights
-        // and gradients arrive whole from their owners at every sub-step).
+        // A part of a distributed mesh steps its owned cells and the faces
+        // that touch them; its ghosts' heights and gradients come from their
+        // owners, only where they changed (decomposition.hpp).
         Decomposition *parts = grid.decomposition();
-        const bool dense = parts || physics || act.all_hot || visit_all_cells() ||
-                           static_cast<double>(act.hot_list.size()) > kDenseShare * static_cast<double>(m.cells);
+        const bool dense = physics || act.all_hot || visit_all_cells() ||
+                           static_cast<double>(act.hot_list.size()) > kDenseShare * static_cast<double>(m.owned);
+        std::vector<std::int64_t> &changed_ghosts = s.changed_ghosts;
+        changed_ghosts.clear();
         std::vector<double> &h = grid.heights_for_stepping();
         std::vector<float> &residual = grid.residuals_for_stepping();
         const std::vector<std::uint8_t> &kind = grid.kinds();
@@ -288,7 +292,7 @@ private:
             if (law.isotropic) {
 #pragma omp parallel for num_threads(threads) if (parallel) schedule(static)
                 for (std::int64_t c = 0; c < n; ++c) gradient_of(m, h.data(), kind.data(), c, s.gx.data(), s.gy.data());
-                if (parts) parts->exchange_ghost_gradients(grid, s.gx.data(), s.gy.data());
+                if (parts) parts->exchange_ghost_gradients(grid, s.gx.data(), s.gy.data(), nullptr, changed_ghosts);
             }
             double *flux = s.flux.data();
 #pragma omp parallel for num_threads(threads) if (parallel) schedule(static) reduction(max : max_excess) reduction(|| : moved)
@@ -325,7 +329,8 @@ private:
                 std::vector<std::uint8_t> &moving = grid.moving_for_stepping();
                 for (std::int64_t c = 0; c < n; ++c) moving[c] = kind[c] == kSand && changed[c];
             }
-            if (parts) parts->exchange_ghost_heights(grid);
+            changed_ghosts.clear();
+            if (parts) parts->exchange_ghost_heights(grid, nullptr, changed_ghosts);
             // The next sub-step looks at the cells that changed and those whose
             // gradients read them; where that is most of the mesh, at all.
             const std::size_t most = static_cast<std::size_t>(kDenseShare * static_cast<double>(n));
@@ -339,30 +344,42 @@ private:
                         if (act.hot_list.size() > most) act.wake_all();
                     }
                 for (const std::int64_t c : s.source_cells) act.wake_around(m, c);
+                for (const std::int64_t c : changed_ghosts) act.wake_around(m, c);
             }
         } else {
-            // The faces of the hot cells, the cells whose gradients they read.
+            // The faces of the hot cells, the owned cells whose gradients they
+            // read (a ghost's comes from its owner).
             std::uint32_t stamp = next_stamp(s);
             s.faces.clear();
             s.gradient_cells.clear();
-            for (const std::int64_t c : act.hot_list)
+            const auto look_at_faces_of = [&](std::int64_t c) {
                 for (std::int64_t k = m.cell_face_start[c]; k < m.cell_face_start[c + 1]; ++k) {
                     const std::int64_t f = m.cell_faces[k];
-                    if (s.face_seen[f] == stamp) continue;
+                    if (f >= m.live_faces || s.face_seen[f] == stamp) continue;
                     s.face_seen[f] = stamp;
                     s.faces.push_back(f);
                     for (const std::int64_t e : {m.face_a[f], m.face_b[f]})
-                        if (e >= 0 && s.cell_seen[e] != stamp) {
+                        if (e >= 0 && e < m.owned && s.cell_seen[e] != stamp) {
                             s.cell_seen[e] = stamp;
                             s.gradient_cells.push_back(e);
                         }
                 }
+            };
+            for (const std::int64_t c : act.hot_list) look_at_faces_of(c);
             if (!s.flux_clean) {
                 std::fill(s.flux.begin(), s.flux.end(), 0.0);
                 s.flux_clean = true;
             }
-            if (law.isotropic)
+            if (law.isotropic) {
                 for (const std::int64_t c : s.gradient_cells) gradient_of(m, h.data(), kind.data(), c, s.gx.data(), s.gy.data());
+                if (parts) {
+                    // A ghost whose gradient changed makes its faces steep or flat
+                    // whether or not anything near them here changed.
+                    parts->exchange_ghost_gradients(grid, s.gx.data(), s.gy.data(), &s.gradient_cells, changed_ghosts);
+                    for (const std::int64_t c : changed_ghosts) look_at_faces_of(c);
+                    changed_ghosts.clear();
+                }
+            }
             // The cells to update: those of faces that carried sand, and the sources.
             const std::uint32_t update_stamp = next_stamp(s);
             s.update_cells.clear();
@@ -374,7 +391,7 @@ private:
                 moved = true;
                 max_excess = std::max(max_excess, excess);
                 for (const std::int64_t e : {m.face_a[f], m.face_b[f]})
-                    if (e >= 0 && s.cell_seen[e] != update_stamp) {
+                    if (e >= 0 && e < m.owned && s.cell_seen[e] != update_stamp) {
                         s.cell_seen[e] = update_stamp;
                         s.update_cells.push_back(e);
                     }
@@ -393,8 +410,10 @@ private:
                 if (rate != 0.0) add_with_residual(h[c], residual[c], dt * rate);
             }
             visited = static_cast<double>(s.gradient_cells.size() + s.update_cells.size() - carried_cells);
+            if (parts) parts->exchange_ghost_heights(grid, &s.update_cells, changed_ghosts);
             act.cool_all();
             for (const std::int64_t c : s.update_cells) act.wake_around(m, c);
+            for (const std::int64_t c : changed_ghosts) act.wake_around(m, c);
         }
         // What went into sinks, face by face in one order whatever the threads.
         for (const std::int64_t f : s.sink_faces) {

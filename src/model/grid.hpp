@@ -78,6 +78,9 @@ struct StepInfo {
     bool at_rest = false;
     double max_excess_slope = 0.0;
     double cell_updates = 0.0;
+    // On a distributed grid, this rank's own: its cell updates, and the
+    // messages and bytes of ghost cells' values it sent (0 on a serial grid).
+    double rank_cell_updates = 0.0, messages_sent = 0.0, bytes_sent = 0.0;
 };
 
 // Everything of a grid besides its geometry that later results depend on, as

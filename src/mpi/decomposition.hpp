@@ -121,9 +121,22 @@ public:
     // A distributed mesh's hooks (mpi/distributed_mesh.cpp), collective, in
     // every sub-step: the ghosts' gradients from their owners once the owned
     // cells' are known, and the ghosts' heights (and moving flags) once the
-    // owned cells changed. Nothing on a block of a grid.
-    virtual void exchange_ghost_gradients(Grid &, double * /*gx*/, double * /*gy*/) {}
-    virtual void exchange_ghost_heights(Grid &) {}
+    // owned cells changed. Only values that changed since they were last sent
+    // travel: `computed` lists the owned cells whose values this sub-step may
+    // have changed (null: any owned cell); the ghosts whose values changed
+    // are appended to `changed_ghosts`. Nothing on a block of a grid.
+    virtual void exchange_ghost_gradients(Grid &, double * /*gx*/, double * /*gy*/,
+                                          const std::vector<std::int64_t> * /*computed*/,
+                                          std::vector<std::int64_t> & /*changed_ghosts*/) {}
+    virtual void exchange_ghost_heights(Grid &, const std::vector<std::int64_t> * /*computed*/,
+                                        std::vector<std::int64_t> & /*changed_ghosts*/) {}
+    // The point-to-point messages of ghost cells' values this rank sent, and
+    // their bytes, since the last call (collectives are not counted).
+    void take_traffic(double &messages, double &bytes) {
+        messages = messages_sent_;
+        bytes = bytes_sent_;
+        messages_sent_ = bytes_sent_ = 0.0;
+    }
     // Collective: the sum over all ranks, the same on every rank.
     virtual double sum(double local) const = 0;
     // Collective: as sum(), for a call that a rank may have refused (its
@@ -142,6 +155,7 @@ public:
 
 protected:
     HaloStore halo_;
+    double messages_sent_ = 0.0, bytes_sent_ = 0.0;
 };
 
 }  // namespace dpsm

@@ -200,6 +200,8 @@ public:
             check_mpi(MPI_Isend(out.data(), static_cast<int>(out.size()), MPI_DOUBLE, n.rank, kTagHeights, comm_,
                                 &requests_[neighbours_.size() + k]),
                       "MPI_Isend of the halo");
+            messages_sent_ += 1.0;
+            bytes_sent_ += static_cast<double>(out.size() * sizeof(double));
         }
         check_mpi(MPI_Waitall(static_cast<int>(requests_.size()), requests_.data(), MPI_STATUSES_IGNORE),
                   "MPI_Waitall of the halo");
@@ -290,6 +292,8 @@ private:
             check_mpi(MPI_Isend(out.data(), static_cast<int>(out.size()), MPI_DOUBLE, n.rank, kTagMasks, comm_,
                                 &requests_[neighbours_.size() + k]),
                       "MPI_Isend of the halo's cell kinds and sources");
+            messages_sent_ += 1.0;
+            bytes_sent_ += static_cast<double>(out.size() * sizeof(double));
         }
         check_mpi(MPI_Waitall(static_cast<int>(requests_.size()), requests_.data(), MPI_STATUSES_IGNORE),
                   "MPI_Waitall of the halo's cell kinds and sources");

@@ -13,13 +13,18 @@
 //    distance). Each cell's faces and gradient neighbours are summed in the
 //    order of their global ids, so an owned cell is computed from the same
 //    values by the same arithmetic as in the serial mesh: bit for bit;
-//  - sub-steps: two neighbourhood exchanges over a distributed-graph
-//    communicator, with the ranks that own this part's ghosts or hold its
-//    cells as ghosts only: the owned cells' gradients (for the faces between
-//    an owned cell and a ghost) and, after the update, their heights;
+//  - sub-steps: two exchanges with the ranks that own this part's ghosts or
+//    hold its cells as ghosts: the owned cells' gradients (for the faces
+//    between an owned cell and a ghost) and, after the update, their heights.
+//    Only values that changed since they were last sent travel, one
+//    synchronous message per neighbour that has any, and a non-blocking
+//    barrier tells every rank that all messages arrived; a part at rest
+//    near its neighbours sends nothing and, with the active set, computes
+//    nothing (mesh/mesh_engine.cpp);
 //  - agreement: one MAX all-reduce before a step (parameters, flags, and
 //    whether a host changed heights or masks anywhere, which then go to the
-//    ghosts), one after each sub-step, and gathers for sums.
+//    ghosts whole, by neighbourhood all-to-alls over a distributed-graph
+//    communicator), one after each sub-step, and gathers for sums.
 #include <mpi.h>
 
 #include <algorithm>
@@ -37,6 +42,7 @@
 #include "dpsm/dpsm.h"
 #include "dpsm/dpsm_mpi.h"
 #include "mesh/mesh.hpp"
+#include "mesh/mesh_engine.hpp"
 #include "model/error.hpp"
 #include "model/grid.hpp"
 #include "mpi/collective.hpp"
@@ -141,6 +147,29 @@ std::string name_cell(const Mesh &m, std::int64_t c) {
     return "cell " + std::to_string(m.host_cell[static_cast<std::size_t>(c)] + base) + " (global id " +
            std::to_string(m.global_id[static_cast<std::size_t>(c)] + base) + ")";
 }
+
+// Per owned cell, where it stands in the lists sent to the neighbours: the
+// neighbour's index and the place in that neighbour's list.
+struct SendSlots {
+    std::int64_t owned = 0;
+    std::vector<std::int32_t> start, neighbour, position;
+
+    SendSlots(const CellLists &send, std::int64_t owned_cells) : owned(owned_cells) {
+        start.assign(static_cast<std::size_t>(owned) + 1, 0);
+        for (const std::int64_t c : send.cells) ++start[static_cast<std::size_t>(c) + 1];
+        for (std::size_t c = 0; c < static_cast<std::size_t>(owned); ++c) start[c + 1] += start[c];
+        neighbour.resize(send.cells.size());
+        position.resize(send.cells.size());
+        std::vector<std::int32_t> next(start.begin(), start.end() - 1);
+        for (std::size_t r = 0; r < send.ranks.size(); ++r)
+            for (int k = 0; k < send.counts[r]; ++k) {
+                const std::int64_t c = send.cells[static_cast<std::size_t>(send.offsets[r] + k)];
+                const std::int32_t at = next[static_cast<std::size_t>(c)]++;
+                neighbour[static_cast<std::size_t>(at)] = static_cast<std::int32_t>(r);
+                position[static_cast<std::size_t>(at)] = k;
+            }
+    }
+};
 
 // What the ranks learn about a part when they make it, beyond the part itself.
 struct PartLinks {
@@ -328,8 +357,17 @@ class MeshPartDecomposition final : public CollectiveDecomposition {
 public:
     // `comm` is this part's own duplicate; `neighbours` its distributed-graph
     // communicator over the ranks in `links` (both freed with it).
-    MeshPartDecomposition(MPI_Comm comm, MPI_Comm neighbours, PartLinks links)
-        : CollectiveDecomposition(comm), neighbours_(neighbours), links_(std::move(links)) {
+    MeshPartDecomposition(MPI_Comm comm, MPI_Comm neighbours, PartLinks links, std::int64_t owned)
+        : CollectiveDecomposition(comm),
+          neighbours_(neighbours),
+          links_(std::move(links)),
+          height_slots_(links_.send_heights, owned),
+          gradient_slots_(links_.send_gradients, owned),
+          sent_h_(links_.send_heights.cells.size(), 0.0),
+          sent_moving_(links_.send_heights.cells.size(), 0.0),
+          sent_gx_(links_.send_gradients.cells.size(), 0.0),
+          sent_gy_(links_.send_gradients.cells.size(), 0.0) {
+        // Ghosts' gradients start at 0 on every rank (mesh_engine.cpp), as sent_gx_ and sent_gy_ do.
         // What dpsm_save records of the part's place (io/restart.cpp: kMeshPart).
         halo_.global_nx = links_.global_cells;
         halo_.global_ny = 1;
@@ -357,7 +395,7 @@ public:
         if (v[0] != 0.0 || v[1] != 0.0) {
             // A host changed something on some rank: the ghosts take their owners' values, then the flags again.
             if (v[0] != 0.0) exchange_masks(grid);
-            exchange_ghost_heights(grid);
+            send_all_heights(grid);
             exchanged_heights_ = grid.heights_version();
             agreed = local_state(grid);
             check_mpi(MPI_Allreduce(MPI_IN_PLACE, agreed.data(), static_cast<int>(agreed.size()), MPI_DOUBLE, MPI_MAX,
@@ -380,26 +418,44 @@ public:
 
     void before_sweep(Grid &) override {}
 
-    void exchange_ghost_gradients(Grid &, double *gx, double *gy) override {
-        exchange(links_.send_gradients, links_.receive_gradients, 2,
-                 [&](std::int64_t c, double *out) { out[0] = gx[c], out[1] = gy[c]; },
-                 [&](std::int64_t c, const double *in) { gx[c] = in[0], gy[c] = in[1]; });
+    // Point-to-point, each value only when it changed since it was last sent
+    // (the ghost's copy on the other rank is then that value): a part whose
+    // cells near its neighbours are at rest sends nothing.
+    void exchange_ghost_gradients(Grid &, double *gx, double *gy, const std::vector<std::int64_t> *computed,
+                                  std::vector<std::int64_t> &changed_ghosts) override {
+        send_changes(links_.send_gradients, gradient_slots_, computed, 2, kTagGradients,
+                     [&](std::size_t slot, std::int64_t c, double *out) {
+                         if (gx[c] == sent_gx_[slot] && gy[c] == sent_gy_[slot]) return false;
+                         out[0] = sent_gx_[slot] = gx[c];
+                         out[1] = sent_gy_[slot] = gy[c];
+                         return true;
+                     });
+        receive_changes(links_.receive_gradients, 2, kTagGradients, [&](std::int64_t c, const double *in) {
+            gx[c] = in[0];
+            gy[c] = in[1];
+            changed_ghosts.push_back(c);
+        });
     }
 
-    void exchange_ghost_heights(Grid &grid) override {
+    void exchange_ghost_heights(Grid &grid, const std::vector<std::int64_t> *computed,
+                                std::vector<std::int64_t> &changed_ghosts) override {
         std::vector<double> &h = grid.heights_for_stepping();
-        if (!grid.hysteresis()) {
-            exchange(links_.send_heights, links_.receive_heights, 1, [&](std::int64_t c, double *out) { out[0] = h[c]; },
-                     [&](std::int64_t c, const double *in) { h[c] = in[0]; });
-            return;
-        }
+        const bool hysteresis = grid.hysteresis();
         std::vector<std::uint8_t> &moving = grid.moving_for_stepping();
-        exchange(links_.send_heights, links_.receive_heights, 2,
-                 [&](std::int64_t c, double *out) { out[0] = h[c], out[1] = moving[c]; },
-                 [&](std::int64_t c, const double *in) {
-                     h[c] = in[0];
-                     moving[c] = static_cast<std::uint8_t>(in[1]);
-                 });
+        const int width = hysteresis ? 2 : 1;
+        send_changes(links_.send_heights, height_slots_, computed, width, kTagHeights,
+                     [&](std::size_t slot, std::int64_t c, double *out) {
+                         const double flag = hysteresis ? moving[c] : 0.0;
+                         if (h[c] == sent_h_[slot] && flag == sent_moving_[slot]) return false;
+                         out[0] = sent_h_[slot] = h[c];
+                         if (hysteresis) out[1] = sent_moving_[slot] = flag;
+                         return true;
+                     });
+        receive_changes(links_.receive_heights, width, kTagHeights, [&](std::int64_t c, const double *in) {
+            h[c] = in[0];
+            if (hysteresis) moving[c] = static_cast<std::uint8_t>(in[1]);
+            changed_ghosts.push_back(c);
+        });
     }
 
 private:
@@ -459,6 +515,119 @@ private:
         return h;
     }
 
+    // Every ghost's height (and moving flag) from its owner, after a host
+    // changed heights on some rank; the ghosts that changed wake the owned
+    // cells that read them, and what was sent is what the ghosts now hold.
+    void send_all_heights(Grid &grid) {
+        std::vector<double> &h = grid.heights_for_stepping();
+        std::vector<std::uint8_t> &moving = grid.moving_for_stepping();
+        const bool hysteresis = grid.hysteresis();
+        const Mesh &m = *grid.geometry().mesh;
+        MeshActivity &activity = grid.mesh_activity();
+        exchange(links_.send_heights, links_.receive_heights, 2,
+                 [&](std::int64_t c, double *out) { out[0] = h[c], out[1] = hysteresis ? moving[c] : 0.0; },
+                 [&](std::int64_t c, const double *in) {
+                     const bool changed = h[c] != in[0] || (hysteresis && moving[c] != in[1]);
+                     h[c] = in[0];
+                     if (hysteresis) moving[c] = static_cast<std::uint8_t>(in[1]);
+                     if (changed) activity.wake_around(m, c);
+                 });
+        for (std::size_t slot = 0; slot < links_.send_heights.cells.size(); ++slot) {
+            const std::int64_t c = links_.send_heights.cells[slot];
+            sent_h_[slot] = h[c];
+            sent_moving_[slot] = hysteresis ? moving[c] : 0.0;
+        }
+    }
+
+    // Packs, for each neighbour, the listed cells' values that `pack(slot, c,
+    // out)` finds changed (it writes them and returns true) as (position in
+    // the neighbour's list, values) and sends each neighbour that has any one
+    // synchronous message. `computed` (null: every listed cell) names the
+    // owned cells to look at.
+    template <class Pack>
+    void send_changes(const CellLists &send, const SendSlots &slots, const std::vector<std::int64_t> *computed,
+                      int width, int tag, Pack &&pack) {
+        const std::size_t record = 1 + static_cast<std::size_t>(width);
+        outgoing_.resize(send.ranks.size());
+        for (std::vector<double> &to : outgoing_) to.clear();
+        const auto look_at = [&](std::size_t neighbour, std::size_t position) {
+            std::vector<double> &to = outgoing_[neighbour];
+            const std::size_t slot = static_cast<std::size_t>(send.offsets[neighbour]) + position;
+            to.resize(to.size() + record);
+            double *out = &to[to.size() - record];
+            out[0] = static_cast<double>(position);
+            if (!pack(slot, send.cells[slot], out + 1)) to.resize(to.size() - record);
+        };
+        if (!computed) {
+            for (std::size_t r = 0; r < send.ranks.size(); ++r)
+                for (int k = 0; k < send.counts[r]; ++k) look_at(r, static_cast<std::size_t>(k));
+        } else {
+            for (const std::int64_t c : *computed) {
+                if (c >= slots.owned) continue;
+                for (std::int32_t k = slots.start[c]; k < slots.start[c + 1]; ++k)
+                    look_at(static_cast<std::size_t>(slots.neighbour[k]), static_cast<std::size_t>(slots.position[k]));
+            }
+        }
+        sends_.clear();
+        for (std::size_t r = 0; r < outgoing_.size(); ++r) {
+            if (outgoing_[r].empty()) continue;
+            sends_.emplace_back();
+            check_mpi(MPI_Issend(outgoing_[r].data(), static_cast<int>(outgoing_[r].size()), MPI_DOUBLE, send.ranks[r],
+                                 tag, neighbours_, &sends_.back()),
+                      "MPI_Issend of changed ghost values");
+            messages_sent_ += 1.0;
+            bytes_sent_ += static_cast<double>(outgoing_[r].size() * sizeof(double));
+        }
+    }
+
+    // Receives what the neighbours sent by send_changes, unpacking each value
+    // into its ghost, until every rank's messages have arrived: a rank
+    // enters a non-blocking barrier once its own synchronous sends have been
+    // received, so the barrier completes only when no message is still on
+    // its way (the NBX exchange of Hoefler, Siebert and Lumsdaine, 2010: no
+    // rank needs to know beforehand who sends to it).
+    template <class Unpack>
+    void receive_changes(const CellLists &receive, int width, int tag, Unpack &&unpack) {
+        const std::size_t record = 1 + static_cast<std::size_t>(width);
+        MPI_Request barrier = MPI_REQUEST_NULL;
+        bool in_barrier = false;
+        for (;;) {
+            int arrived = 0;
+            MPI_Status status;
+            check_mpi(MPI_Iprobe(MPI_ANY_SOURCE, tag, neighbours_, &arrived, &status), "MPI_Iprobe of ghost values");
+            if (arrived) {
+                int count = 0;
+                check_mpi(MPI_Get_count(&status, MPI_DOUBLE, &count), "MPI_Get_count of ghost values");
+                incoming_.resize(static_cast<std::size_t>(count));
+                check_mpi(MPI_Recv(incoming_.data(), count, MPI_DOUBLE, status.MPI_SOURCE, tag, neighbours_,
+                                   MPI_STATUS_IGNORE),
+                          "MPI_Recv of ghost values");
+                const auto from = std::lower_bound(receive.ranks.begin(), receive.ranks.end(), status.MPI_SOURCE);
+                if (from == receive.ranks.end() || *from != status.MPI_SOURCE)
+                    throw Error(DPSM_ERR_INTERNAL, "dpsm_step: ghost values from rank " +
+                                                       std::to_string(status.MPI_SOURCE) + ", which owns no ghost here");
+                const std::size_t r = static_cast<std::size_t>(from - receive.ranks.begin());
+                for (std::size_t k = 0; k + record <= incoming_.size(); k += record) {
+                    const std::size_t position = static_cast<std::size_t>(incoming_[k]);
+                    unpack(receive.cells[static_cast<std::size_t>(receive.offsets[r]) + position], &incoming_[k + 1]);
+                }
+                continue;
+            }
+            int done = 0;
+            if (!in_barrier) {
+                check_mpi(MPI_Testall(static_cast<int>(sends_.size()), sends_.data(), &done, MPI_STATUSES_IGNORE),
+                          "MPI_Testall of ghost values");
+                if (done) {
+                    check_mpi(MPI_Ibarrier(neighbours_, &barrier), "MPI_Ibarrier after ghost values");
+                    in_barrier = true;
+                }
+            } else {
+                check_mpi(MPI_Test(&barrier, &done, MPI_STATUS_IGNORE), "MPI_Test of the barrier after ghost values");
+                if (done) return;
+            }
+        }
+    }
+
     // One neighbourhood all-to-all of `per_cell` values per listed cell.
     template <class Pack, class Unpack>
     void exchange(const CellLists &send, const CellLists &receive, int per_cell, Pack &&pack, Unpack &&unpack) {
@@ -468,6 +637,8 @@ private:
         for (std::size_t k = 0; k < send.cells.size(); ++k) pack(send.cells[k], &send_buffer_[k * width]);
         scaled(send, per_cell, send_counts_, send_offsets_);
         scaled(receive, per_cell, receive_counts_, receive_offsets_);
+        for (const int count : send_counts_)
+            if (count > 0) messages_sent_ += 1.0, bytes_sent_ += static_cast<double>(count) * sizeof(double);
         check_mpi(MPI_Neighbor_alltoallv(send_buffer_.data(), send_counts_.data(), send_offsets_.data(), MPI_DOUBLE,
                                          receive_buffer_.data(), receive_counts_.data(), receive_offsets_.data(),
                                          MPI_DOUBLE, neighbours_),
@@ -519,8 +690,16 @@ private:
         exchanged_masks_ = grid.masks_version();
     }
 
+    static constexpr int kTagGradients = 1, kTagHeights = 2;
     MPI_Comm neighbours_;
     PartLinks links_;
+    // Per owned cell, the places it has in the lists sent to neighbours.
+    SendSlots height_slots_, gradient_slots_;
+    // Per place in those lists, the value last sent (the ghost's copy).
+    std::vector<double> sent_h_, sent_moving_, sent_gx_, sent_gy_;
+    std::vector<std::vector<double>> outgoing_;
+    std::vector<double> incoming_;
+    std::vector<MPI_Request> sends_;
     std::vector<double> send_buffer_, receive_buffer_;
     std::vector<int> send_counts_, send_offsets_, receive_counts_, receive_offsets_;
     std::uint64_t exchanged_masks_ = std::numeric_limits<std::uint64_t>::max();    // none yet
@@ -554,7 +733,7 @@ dpsm_grid *part_grid(MPI_Comm comm, std::shared_ptr<Mesh> mesh, const char *fn, 
         MPI_Comm_free(&own);
         check_mpi(status, "MPI_Dist_graph_create_adjacent");
     }
-    made->core.set_decomposition(std::make_unique<MeshPartDecomposition>(own, neighbours, std::move(links)));
+    made->core.set_decomposition(std::make_unique<MeshPartDecomposition>(own, neighbours, std::move(links), mesh->owned));
     return made.release();
 }
 

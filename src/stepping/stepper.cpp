@@ -139,6 +139,8 @@ void step(Grid &grid, double dt) {
 
 void step_in_time(Grid &grid, double dt, std::int64_t most) {
     const Engine &engine = engine_for(grid);
+    double messages = 0.0, bytes = 0.0;
+    if (Decomposition *decomposition = grid.decomposition()) decomposition->take_traffic(messages, bytes);  // from here
     const StepAgreement state = agree_before_step(grid, dt);  // first: it may set the smallest angle
     const double dt_max = stable_dt(grid);
     const double needed = std::ceil(dt / dt_max);
@@ -215,7 +217,11 @@ void step_in_time(Grid &grid, double dt, std::int64_t most) {
 
     // A lazy source acts over all of dt, whenever its cells took it.
     if (lazy) ledger.sourced.add(grid.source_mass_rate() * dt);
-    if (grid.decomposition()) info.cell_updates = grid.global_sum(info.cell_updates);
+    info.rank_cell_updates = info.cell_updates;
+    if (Decomposition *decomposition = grid.decomposition()) {
+        info.cell_updates = grid.global_sum(info.cell_updates);
+        decomposition->take_traffic(info.messages_sent, info.bytes_sent);
+    }
     const bool whole_dt = source_active || !(info.at_rest || !bounded);
     info.time_integrated = whole_dt ? dt : static_cast<double>(info.substeps) * sub_dt;
     grid.last_step() = info;

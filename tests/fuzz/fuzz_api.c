@@ -196,7 +196,9 @@ typedef struct {
 } slot_t;
 
 /* The step information items this header knows (a newer header may add some). */
-#ifdef DPSM_INFO_CELL_UPDATES
+#if defined(DPSM_INFO_BYTES_SENT)
+#define NINFO (DPSM_INFO_BYTES_SENT + 1)
+#elif defined(DPSM_INFO_CELL_UPDATES)
 #define NINFO (DPSM_INFO_CELL_UPDATES + 1)
 #else
 #define NINFO (DPSM_INFO_MAX_EXCESS_SLOPE + 1)
@@ -259,7 +261,7 @@ static void same_but_fluxes(const slot_t *s, const snap_t *a, const snap_t *b, i
         if (memcmp(&a->mass[q], &b->mass[q], sizeof(double)) != 0)
             die("%s: mass %s differs: %.17g vs %.17g", what, mass_names[q], a->mass[q], b->mass[q]);
     static const char *const info_names[] = {"SUBSTEPS", "TIME_INTEGRATED", "AT_REST", "MAX_EXCESS_SLOPE",
-                                             "CELL_UPDATES", "?", "?", "?"};
+                                             "CELL_UPDATES", "RANK_CELL_UPDATES", "MESSAGES_SENT", "BYTES_SENT"};
     for (int i = 0; i < NINFO; ++i)
         if (memcmp(&a->info[i], &b->info[i], sizeof(double)) != 0)
             die("%s: step info %s differs: %.17g vs %.17g", what, info_names[i], a->info[i], b->info[i]);
@@ -907,6 +909,9 @@ static void check_restart_continues(slot_t *s, dpsm_grid *copy, double dt, const
     snap(copy, s, &stepped);
 #ifdef DPSM_INFO_CELL_UPDATES
     stepped.info[DPSM_INFO_CELL_UPDATES] = after->info[DPSM_INFO_CELL_UPDATES];
+#endif
+#ifdef DPSM_INFO_RANK_CELL_UPDATES
+    stepped.info[DPSM_INFO_RANK_CELL_UPDATES] = after->info[DPSM_INFO_RANK_CELL_UPDATES];
 #endif
     same(s, after, &stepped, "a grid loaded from a restart file, after a step");
     unsnap(&stepped);

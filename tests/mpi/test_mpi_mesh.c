@@ -586,6 +586,92 @@ done:
     free(owner);
 }
 
+/* ---- a local pile: ranks at rest ------------------------------------------ */
+
+/* A small pile on a mesh in strips: at x = `at`, closed edges, stepped in
+ * short steps until it rests. Besides the heights (bit for bit with the
+ * serial mesh after every step) it checks what each rank did: the ranks'
+ * cell updates add up to the step's; a rank whose strip lies beyond
+ * `quiet_from` (where the pile never reaches) computes and sends nothing
+ * after the first step (whose first sub-step looks at every cell); and
+ * the rank holding the pile visits fewer cells than its owned cells times the
+ * sub-steps once the pile has mostly settled (the active set). Returns the
+ * messages this rank sent over all steps. */
+static double local_pile(const mesh_t *m, double at, double quiet_from, const char *where) {
+    int *owner = xcalloc((size_t)m->ncells, sizeof(int));
+    partition(m, PART_STRIPS, owner);
+    part_t p = part_of(m, owner, 2);
+    dpsm_grid *serial = NULL, *part = NULL;
+    OK(NULL, dpsm_create_mesh(m->nnodes, m->node_xy, m->ncells, m->cell_start, m->cell_nodes, &serial));
+    OK(NULL, dpsm_create_mesh_mpi(MPI_COMM_WORLD, p.nnodes, p.node_xy, p.ncells, p.cell_start, p.cell_nodes,
+                                  p.global_id, p.owner, &part));
+    double *hs = xcalloc((size_t)m->ncells, sizeof(double)), *hp = xcalloc((size_t)p.ncells, sizeof(double));
+    for (int64_t c = 0; c < m->ncells; ++c) {
+        double x, y;
+        centre(m, c, &x, &y);
+        hs[c] = fmax(0.0, 0.3 - 3.0 * hypot(x - at, y - 0.5));
+    }
+    for (int64_t k = 0; k < p.ncells; ++k) hp[k] = hs[p.global[k]];
+    OK(serial, dpsm_set_heights(serial, hs));
+    OK(part, dpsm_set_heights(part, hp));
+    double x0 = 1.0, owned = 0.0, sent = 0.0;
+    for (int64_t k = 0; k < p.ncells; ++k)
+        if (p.owner[k] == rank_) {
+            double x, y;
+            centre(m, p.global[k], &x, &y);
+            x0 = fmin(x0, x);
+            owned += 1.0;
+        }
+    int sparse_seen = 0, moving_rank = 0;
+    for (int step = 0; step < 40; ++step) {
+        char at_step[300];
+        snprintf(at_step, sizeof at_step, "%s, step %d", where, step + 1);
+        OK(serial, dpsm_step(serial, 0.01));
+        OK(part, dpsm_step(part, 0.01));
+        OK(serial, dpsm_get_heights(serial, hs));
+        OK(part, dpsm_get_heights(part, hp));
+        long differ = 0;
+        for (int64_t k = 0; k < p.ncells; ++k) differ += memcmp(&hp[k], &hs[p.global[k]], sizeof(double)) != 0;
+        require(differ == 0, "%s: %ld local cells differ from the serial mesh", at_step, differ);
+        double info[DPSM_INFO_BYTES_SENT + 1], serial_info[DPSM_INFO_CELL_UPDATES + 1];
+        for (int item = 0; item <= DPSM_INFO_BYTES_SENT; ++item) OK(part, dpsm_get_step_info(part, item, &info[item]));
+        for (int item = 0; item <= DPSM_INFO_CELL_UPDATES; ++item)
+            OK(serial, dpsm_get_step_info(serial, item, &serial_info[item]));
+        for (int item = DPSM_INFO_SUBSTEPS; item <= DPSM_INFO_MAX_EXCESS_SLOPE; ++item)
+            require(info[item] == serial_info[item], "%s: step info %d is %.17g, serial %.17g", at_step, item,
+                    info[item], serial_info[item]);
+        double all = 0.0;
+        MPI_Allreduce(&info[DPSM_INFO_RANK_CELL_UPDATES], &all, 1, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
+        require(all == info[DPSM_INFO_CELL_UPDATES], "%s: the ranks' cell updates add up to %.17g, the step's are %.17g",
+                at_step, all, info[DPSM_INFO_CELL_UPDATES]);
+        require(info[DPSM_INFO_BYTES_SENT] >= 8.0 * info[DPSM_INFO_MESSAGES_SENT],
+                "%s: %g messages of %g bytes", at_step, info[DPSM_INFO_MESSAGES_SENT], info[DPSM_INFO_BYTES_SENT]);
+        sent += info[DPSM_INFO_MESSAGES_SENT];
+        /* A new grid looks at every cell once, in the first sub-step. */
+        if (x0 >= quiet_from && step > 0) {
+            require(info[DPSM_INFO_RANK_CELL_UPDATES] == 0.0 && info[DPSM_INFO_MESSAGES_SENT] == 0.0,
+                    "%s: this rank's strip (x from %.3f) lies far from the pile, yet it visited %g cells and sent %g "
+                    "messages (%g bytes)", at_step, x0, info[DPSM_INFO_RANK_CELL_UPDATES],
+                    info[DPSM_INFO_MESSAGES_SENT], info[DPSM_INFO_BYTES_SENT]);
+        }
+        if (info[DPSM_INFO_RANK_CELL_UPDATES] > 0.0) moving_rank = 1;
+        if (info[DPSM_INFO_RANK_CELL_UPDATES] > 0.0 && info[DPSM_INFO_RANK_CELL_UPDATES] < owned * info[DPSM_INFO_SUBSTEPS])
+            sparse_seen = 1;
+        if (info[DPSM_INFO_AT_REST] == 1.0 && step > 0) break;
+    }
+    int any_sparse = 0, any_moving = 0;
+    MPI_Allreduce(&sparse_seen, &any_sparse, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
+    MPI_Allreduce(&moving_rank, &any_moving, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
+    require(any_moving, "%s: no rank visited any cell", where);
+    require(any_sparse, "%s: no rank ever visited fewer cells than all its own in every sub-step", where);
+    free(hs), free(hp);
+    dpsm_destroy(serial);
+    dpsm_destroy(part);
+    free_part(&p);
+    free(owner);
+    return sent;
+}
+
 /* ---- failures on every rank ---------------------------------------------- */
 
 /* Every rank got `status` (not DPSM_OK) and the same one; rank 0's message contains `phrase`. */
@@ -720,6 +806,23 @@ int main(int argc, char **argv) {
                                scene_names[scene], graph ? "graph" : "polygons", partition_names[kind],
                                total == 0 ? "heights bit for bit" : "FAILED", total == 0 ? "" : "see above");
                 }
+        free_mesh(&m);
+    }
+    {
+        /* 1,152 triangles in strips; the pile spreads less than 0.2 from its centre. */
+        mesh_t m = lattice(24, 1);
+        const long before = failures_;
+        const double quiet = size_ > 1 ? 1.0 - 1.0 / size_ : 2.0;
+        local_pile(&m, 0.1, quiet > 0.45 ? quiet : 2.0, "a pile at x = 0.1, strips");
+        const double crossing = local_pile(&m, size_ > 1 ? 1.0 / size_ : 0.5, 2.0, "a pile across two strips");
+        double all = 0.0;
+        MPI_Allreduce(&crossing, &all, 1, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
+        require(size_ == 1 || all > 0.0, "a pile across two strips: no rank sent a message");
+        long mine = failures_ - before, failed = 0;
+        MPI_Allreduce(&mine, &failed, 1, MPI_LONG, MPI_SUM, MPI_COMM_WORLD);
+        if (rank_ == 0)
+            printf("  triangles: local piles in strips: %s\n",
+                   failed ? "FAILED, see above" : "heights bit for bit, ranks far from the pile idle");
         free_mesh(&m);
     }
     inconsistent_partitions();

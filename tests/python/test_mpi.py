@@ -356,8 +356,14 @@ class TestDistributedMesh(MpiTestCase):
                         g.step(0.02)
                         mass = g.get_mass(dpsm.MASS_TOTAL)
                         same_on_every_rank = everywhere_equal(mass)
+                        ranks_updates = comm.allreduce(g.get_step_info(dpsm.INFO_RANK_CELL_UPDATES))
+                        ranks_messages = comm.allreduce(g.get_step_info(dpsm.INFO_MESSAGES_SENT))
                         with self.subTest(how=how, start_index=start_index, step=n):
                             self.assertEqual((g.kind, g.shape), ("mesh", (len(part.cells),)))
+                            self.assertEqual(ranks_updates, g.get_step_info(dpsm.INFO_CELL_UPDATES),
+                                             "the ranks' own cell updates do not add up to the step's")
+                            self.assertTrue(ranks_messages > 0 or SIZE == 1, "no rank sent its neighbours anything")
+                            self.assertEqual(s.get_step_info(dpsm.INFO_MESSAGES_SENT), 0.0)
                             want = [flat(s.get_heights())[c] for c in part.cells]
                             self.assertEqual(flat(g.get_heights()), want,
                                              "owned and ghost heights differ from the serial mesh")
