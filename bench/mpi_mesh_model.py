@@ -4,13 +4,16 @@ bench/mpi_mesh_scaling.c (docs/data/mpi_mesh_scaling.csv) and extrapolates
 it to 1,024 ranks holding 10^9 cells. Prints the result (docs/data/mpi_mesh_model.txt).
 
 Model: the slowest rank's seconds per fully active sub-step are
-    t = a * owned + b * ghosts + r * log2(P)
+    t = a * owned + b * ghosts + 3 r * log2(P)
   a: a cell's update, from the owned cells stepped alone (every rank at once,
      as in the distributed run, so that sharing the cores is counted);
   b: what a ghost cell costs beyond that: the exchanges (two per sub-step)
      and the ghost's part of the faces, from the distributed run less the
      alone run, per ghost of the slowest rank;
-  r: one all-reduce stage per sub-step (assumed, not measured here).
+  r: one stage of a collective; a sub-step takes three (the all-reduce by
+     which the ranks agree and the two non-blocking barriers that end the
+     exchanges), each log2(P) stages (assumed, not measured here).
+A rank at rest computes and sends nothing: its sub-step costs 3 r log2(P).
 Ghosts of a METIS part of a 2D mesh grow as the part's perimeter:
 ghosts = k * sqrt(owned), k measured on the partitions run.
 """
@@ -18,7 +21,8 @@ import csv
 import math
 import sys
 
-ALLREDUCE_STAGE_S = 1.5e-6   # assumed: one stage of an all-reduce on a cluster's InfiniBand
+ALLREDUCE_STAGE_S = 1.5e-6   # assumed: one stage of a collective on a cluster's InfiniBand
+COLLECTIVES = 3              # per sub-step: the agreement's all-reduce and two barriers
 RANKS, CELLS = 1024, 1.0e9
 
 
@@ -48,13 +52,15 @@ def main(path):
     k = max(ks)
     owned = CELLS / RANKS
     ghosts = k * math.sqrt(owned)
-    t = a * owned + b * ghosts + ALLREDUCE_STAGE_S * math.log2(RANKS)
+    collectives = COLLECTIVES * ALLREDUCE_STAGE_S * math.log2(RANKS)
+    t = a * owned + b * ghosts + collectives
     ideal = a * owned
     print("extrapolated to %d ranks on %.0e cells: owned %.0f, ghosts %.0f (k = %.2f), b = %.3e s (P <= 2)"
           % (RANKS, CELLS, owned, ghosts, k, b))
-    print("  t = %.3e s per sub-step: compute %.3e s, ghosts %.3e s, all-reduce %.3e s (assumed %.1e s a stage)"
-          % (t, ideal, b * ghosts, ALLREDUCE_STAGE_S * math.log2(RANKS), ALLREDUCE_STAGE_S))
+    print("  t = %.3e s per sub-step: compute %.3e s, ghosts %.3e s, collectives %.3e s (3 of log2 P stages, "
+          "assumed %.1e s a stage)" % (t, ideal, b * ghosts, collectives, ALLREDUCE_STAGE_S))
     print("  parallel efficiency against the same cells' compute alone: %.1f %%" % (100.0 * ideal / t))
+    print("  a rank at rest: %.3e s per sub-step (the collectives alone)" % collectives)
 
 
 if __name__ == "__main__":

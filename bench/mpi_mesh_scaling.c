@@ -17,10 +17,11 @@
  * owned and ghost cells, neighbouring ranks, and the messages and bytes a
  * rank sent per sub-step (DPSM_INFO_MESSAGES_SENT, DPSM_INFO_BYTES_SENT).
  *
- *   mpiexec -n P dpsm-bench-mpi-mesh N STEPS local
+ *   mpiexec -n P dpsm-bench-mpi-mesh N STEPS corner|centre
  *
- * runs the local scene instead: a steep cone near a corner, the rest of the
- * mesh flat and at rest, against the fully active scene in the same run; it
+ * runs the local scene instead: a steep cone near a corner or at the centre
+ * (where METIS's parts meet), the rest of the mesh flat and at rest, against
+ * the fully active scene in the same run; it
  * prints per rank the cells visited and the messages sent per sub-step, and
  * how many ranks did neither (local_run).
  */
@@ -114,15 +115,16 @@ static mesh_t triangles(int64_t n) {
 }
 
 /* The scenes: fully active (a plane steeper than the angle of repose with
- * ripples, the domain edge open), or local (a steep cone of radius 30 near a
- * corner, the rest flat and at rest). */
+ * ripples, the domain edge open), or local (a steep cone of radius 30 at
+ * (pile_x, pile_y), the rest flat and at rest). */
 static int local_scene;
+static double pile_x = 60.0, pile_y = 60.0;
 
 static double height(const mesh_t *m, int64_t c) {
     double x = 0.0, y = 0.0;
     for (int k = 0; k < 3; ++k) x += m->node_xy[2 * m->cell_nodes[3 * c + k]], y += m->node_xy[2 * m->cell_nodes[3 * c + k] + 1];
     x /= 3.0, y /= 3.0;
-    if (local_scene) return fmax(0.0, 3.0 * (30.0 - hypot(x - 60.0, y - 60.0)));
+    if (local_scene) return fmax(0.0, 3.0 * (30.0 - hypot(x - pile_x, y - pile_y)));
     return 1.2 * x + 0.3 * sin(0.7 * y) + 0.2 * sin(1.3 * x + 0.4 * y);
 }
 
@@ -236,12 +238,12 @@ static double time_substeps(dpsm_grid *g, int steps, double *substeps_per_step, 
     return best;
 }
 
-/* The local scene: a cone near a corner on the distributed mesh, against the
- * fully active scene on the same parts in the same run. One CSV line: the
- * time per sub-step of each, and per rank (largest and smallest) the cells
- * visited, messages and bytes sent per sub-step; idle ranks visited and sent
- * nothing over all timed steps. */
-static void local_run(const mesh_t *m, const part_t *p, int steps) {
+/* The local scene: a cone on the distributed mesh, against the same scene
+ * with the active set off and the fully active scene, on the same parts in
+ * the same run. One CSV line: the time per sub-step of each, and per rank
+ * (largest and smallest) the cells visited, messages and bytes sent per
+ * sub-step; idle ranks visited and sent nothing over all timed steps. */
+static void local_run(const mesh_t *m, const part_t *p, int steps, const char *where) {
     double per_step = 0.0, moving = 0.0, dt = 0.0;
     local_scene = 0;
     dpsm_grid *g = make_grid(m, p, 1, 0);
@@ -250,6 +252,14 @@ static void local_run(const mesh_t *m, const part_t *p, int steps) {
     const double active = time_substeps(g, 1, &per_step, &moving, NULL);
     dpsm_destroy(g);
     local_scene = 1;
+    /* The same scene with the active set off (every sub-step visits every
+     * owned cell, as distributed meshes did before): the same results. */
+    setenv("DPSM_VISIT_ALL_CELLS", "1", 1);
+    g = make_grid(m, p, 1, 0);
+    CHECK(g, dpsm_step(g, dt));
+    const double every_cell = time_substeps(g, steps, &per_step, &moving, NULL);
+    dpsm_destroy(g);
+    unsetenv("DPSM_VISIT_ALL_CELLS");
     g = make_grid(m, p, 1, 0);
     CHECK(g, dpsm_step(g, dt));  /* a new grid looks at every cell once */
     traffic_t did;
@@ -261,13 +271,13 @@ static void local_run(const mesh_t *m, const part_t *p, int steps) {
     int idle = did.cell_updates == 0.0 && did.messages == 0.0, idle_ranks = 0;
     MPI_Allreduce(&idle, &idle_ranks, 1, MPI_INT, MPI_SUM, MPI_COMM_WORLD);
     if (rank_ == 0) {
-        fprintf(stderr, "dpsm-bench-mpi-mesh local: %d ranks, %lld cells, %.0f sub-steps a step, still moving: %s\n",
-                size_, (long long)m->ncells, per_step, moving != 0.0 ? "yes" : "NO");
-        printf("ranks,cells,seconds_per_substep,active_seconds_per_substep,ratio_to_active,idle_ranks,"
-               "cell_updates_per_substep_max,cell_updates_per_substep_min,messages_per_substep_max,"
-               "messages_per_substep_min,bytes_per_substep_max\n");
-        printf("%d,%lld,%.6e,%.6e,%.4f,%d,%.0f,%.0f,%.2f,%.2f,%.0f\n", size_, (long long)m->ncells, local, active,
-               local / active, idle_ranks, most[0], least[0], most[1], least[1], most[2]);
+        fprintf(stderr, "dpsm-bench-mpi-mesh, a pile at the %s: %d ranks, %lld cells, %.0f sub-steps a step, still moving: %s\n",
+                where, size_, (long long)m->ncells, per_step, moving != 0.0 ? "yes" : "NO");
+        printf("pile,ranks,cells,seconds_per_substep,every_cell_seconds_per_substep,active_seconds_per_substep,"
+               "ratio_to_every_cell,idle_ranks,cell_updates_per_substep_max,cell_updates_per_substep_min,"
+               "messages_per_substep_max,messages_per_substep_min,bytes_per_substep_max\n");
+        printf("%s,%d,%lld,%.6e,%.6e,%.6e,%.4f,%d,%.0f,%.0f,%.2f,%.2f,%.0f\n", where, size_, (long long)m->ncells, local,
+               every_cell, active, local / every_cell, idle_ranks, most[0], least[0], most[1], least[1], most[2]);
     }
 }
 
@@ -276,7 +286,7 @@ int main(int argc, char **argv) {
     MPI_Comm_rank(MPI_COMM_WORLD, &rank_);
     MPI_Comm_size(MPI_COMM_WORLD, &size_);
     if (argc < 2) {
-        if (rank_ == 0) fprintf(stderr, "usage: mpiexec -n P dpsm-bench-mpi-mesh N [STEPS [local]]\n");
+        if (rank_ == 0) fprintf(stderr, "usage: mpiexec -n P dpsm-bench-mpi-mesh N [STEPS [corner|centre]]\n");
         MPI_Finalize();
         return 2;
     }
@@ -303,8 +313,9 @@ int main(int argc, char **argv) {
     MPI_Bcast(owner, (int)m.ncells, MPI_INT, 0, MPI_COMM_WORLD);
     part_t p = part_of(&m, owner);
 
-    if (argc > 3 && strcmp(argv[3], "local") == 0) {
-        local_run(&m, &p, steps);
+    if (argc > 3 && (strcmp(argv[3], "corner") == 0 || strcmp(argv[3], "centre") == 0)) {
+        if (strcmp(argv[3], "centre") == 0) pile_x = pile_y = 0.5 * (double)n;
+        local_run(&m, &p, steps, argv[3]);
         free(owner), free(p.global), free(p.owner);
         free(m.node_xy), free(m.cell_nodes), free(m.adj_start), free(m.adj);
         MPI_Finalize();

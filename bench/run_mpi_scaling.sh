@@ -5,8 +5,10 @@
 # docs/data/mpi_scaling.csv (a log in docs/data/mpi_scaling.log); then the
 # distributed triangle mesh of MESH_N (default 708: 1,002,528 cells) on 1, 2
 # and 4 ranks (oversubscribed past the cores) into
-# docs/data/mpi_mesh_scaling.csv, and its cost model extrapolated to 1,024
-# ranks into docs/data/mpi_mesh_model.txt. MESH_ONLY=1 runs the mesh alone.
+# docs/data/mpi_mesh_scaling.csv, a local pile on the same mesh (what ranks
+# at rest compute and send) into docs/data/mpi_mesh_rest.csv, and the cost
+# model extrapolated to 1,024 ranks into docs/data/mpi_mesh_model.txt.
+# MESH_ONLY=1 runs the mesh alone.
 #
 #   bash bench/run_mpi_scaling.sh      # about a minute on 2 cores
 #
@@ -39,6 +41,19 @@ mesh_n=${MESH_N:-708}
     head=0
   done
 } >"$data/mpi_mesh_scaling.csv"
+# A pile near a corner and one at the centre (where the parts meet), the rest
+# of the mesh at rest: what each rank computes and sends.
+{
+  head=1
+  for pile in corner centre; do
+    for p in 1 2 4; do
+      bind=core
+      [[ $p -gt $(nproc) ]] && bind=none
+      mpiexec -n "$p" --oversubscribe --bind-to "$bind" "$mesh_bench" "$mesh_n" 5 "$pile" | if [[ $head == 1 ]]; then cat; else tail -n 1; fi
+      head=0
+    done
+  done
+} >"$data/mpi_mesh_rest.csv"
 {
   echo "generated: $(date -u +%Y-%m-%dT%H:%M:%SZ) by bench/run_mpi_scaling.sh, source tree $(git -C "$root" describe --always --dirty 2>/dev/null || echo unknown)"
   echo "machine: $(uname -m), $(nproc --all) cores, $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2- | sed 's/^ //'); load average after the runs: $(cut -d' ' -f1-3 /proc/loadavg)"

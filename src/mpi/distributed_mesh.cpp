@@ -541,15 +541,16 @@ private:
 
     // Packs, for each neighbour, the listed cells' values that `pack(slot, c,
     // out)` finds changed (it writes them and returns true) as (position in
-    // the neighbour's list, values) and sends each neighbour that has any one
-    // synchronous message. `computed` (null: every listed cell) names the
-    // owned cells to look at.
+    // the neighbour's list, values), or the values alone when every listed
+    // cell changed, and sends each neighbour that has any one synchronous
+    // message. `computed` (null: every listed cell) names the owned cells to
+    // look at.
     template <class Pack>
     void send_changes(const CellLists &send, const SendSlots &slots, const std::vector<std::int64_t> *computed,
                       int width, int tag, Pack &&pack) {
         const std::size_t record = 1 + static_cast<std::size_t>(width);
         outgoing_.resize(send.ranks.size());
-        for (std::vector<double> &to : outgoing_) to.clear();
+        for (std::vector<double> &to : outgoing_) to.assign(1, kChangedCells);
         const auto look_at = [&](std::size_t neighbour, std::size_t position) {
             std::vector<double> &to = outgoing_[neighbour];
             const std::size_t slot = static_cast<std::size_t>(send.offsets[neighbour]) + position;
@@ -570,7 +571,18 @@ private:
         }
         sends_.clear();
         for (std::size_t r = 0; r < outgoing_.size(); ++r) {
-            if (outgoing_[r].empty()) continue;
+            std::vector<double> &to = outgoing_[r];
+            const std::size_t changed = (to.size() - 1) / record, listed = static_cast<std::size_t>(send.counts[r]);
+            if (changed == 0) continue;
+            if (changed == listed) {
+                // Every listed cell changed (a fully active border): the values alone, in the list's order.
+                whole_.assign(1 + listed * static_cast<std::size_t>(width), kEveryCell);
+                for (std::size_t k = 1; k < to.size(); k += record) {
+                    const std::size_t position = static_cast<std::size_t>(to[k]);
+                    std::copy(&to[k + 1], &to[k + record], &whole_[1 + position * static_cast<std::size_t>(width)]);
+                }
+                to.swap(whole_);
+            }
             sends_.emplace_back();
             check_mpi(MPI_Issend(outgoing_[r].data(), static_cast<int>(outgoing_[r].size()), MPI_DOUBLE, send.ranks[r],
                                  tag, neighbours_, &sends_.back()),
@@ -607,9 +619,14 @@ private:
                     throw Error(DPSM_ERR_INTERNAL, "dpsm_step: ghost values from rank " +
                                                        std::to_string(status.MPI_SOURCE) + ", which owns no ghost here");
                 const std::size_t r = static_cast<std::size_t>(from - receive.ranks.begin());
-                for (std::size_t k = 0; k + record <= incoming_.size(); k += record) {
-                    const std::size_t position = static_cast<std::size_t>(incoming_[k]);
-                    unpack(receive.cells[static_cast<std::size_t>(receive.offsets[r]) + position], &incoming_[k + 1]);
+                const std::int64_t *cells = &receive.cells[static_cast<std::size_t>(receive.offsets[r])];
+                if (!incoming_.empty() && incoming_[0] == kEveryCell) {
+                    const std::size_t n = std::min(static_cast<std::size_t>(receive.counts[r]),
+                                                   (incoming_.size() - 1) / static_cast<std::size_t>(width));
+                    for (std::size_t k = 0; k < n; ++k) unpack(cells[k], &incoming_[1 + k * static_cast<std::size_t>(width)]);
+                } else {
+                    for (std::size_t k = 1; k + record <= incoming_.size(); k += record)
+                        unpack(cells[static_cast<std::size_t>(incoming_[k])], &incoming_[k + 1]);
                 }
                 continue;
             }
@@ -691,6 +708,9 @@ private:
     }
 
     static constexpr int kTagGradients = 1, kTagHeights = 2;
+    // The first value of a message: (position, values) of the cells that
+    // changed, or the values of every listed cell in order.
+    static constexpr double kChangedCells = 0.0, kEveryCell = 1.0;
     MPI_Comm neighbours_;
     PartLinks links_;
     // Per owned cell, the places it has in the lists sent to neighbours.
@@ -698,7 +718,7 @@ private:
     // Per place in those lists, the value last sent (the ghost's copy).
     std::vector<double> sent_h_, sent_moving_, sent_gx_, sent_gy_;
     std::vector<std::vector<double>> outgoing_;
-    std::vector<double> incoming_;
+    std::vector<double> incoming_, whole_;
     std::vector<MPI_Request> sends_;
     std::vector<double> send_buffer_, receive_buffer_;
     std::vector<int> send_counts_, send_offsets_, receive_counts_, receive_offsets_;
