@@ -522,6 +522,19 @@ class _SerialLibraryTrap:
 
 
 class TestOneLibraryPerGrid(MpiTestCase):
+    def test_serial_constructors_refused(self):
+        for name, args in (("create_1d", (10, 0.1)), ("create_2d", (4, 4, 0.1, 0.1)), ("create_axisymmetric", (8, 0.1)),
+                           ("create_mesh", (NODES, [0, 3], [0, 1, 2])), ("load", ("x.dpsm",)),
+                           ("create_graph", ([0.0, 0.0], [1.0], [0, -1], [0.5, 0.0], [1.0])),
+                           ("create_dual_mesh", (NODES, [0, 1, 2])), ("from_meshio", (None,)),
+                           ("create_mesh_indexed", (0, NODES, [0, 3], [0, 1, 2])),
+                           ("create_graph_indexed", (0, [0.0, 0.0], [1.0], [0, -1], [0.5, 0.0], [1.0])),
+                           ("create_dual_mesh_indexed", (0, NODES, [0, 1, 2]))):
+            with self.subTest(constructor=name):
+                with self.assertRaisesRegex(TypeError, "DistributedGrid.%s would make a serial grid.*dpsm.mpi" % name):
+                    getattr(dpsm.mpi.DistributedGrid, name)(*args)
+                self.assertTrue(callable(getattr(dpsm.Grid, name)))
+
     def test_every_method_calls_libdpsm_mpi(self):
         core = sys.modules["dpsm._core"]
         real = core.lib

@@ -149,6 +149,22 @@ class DistributedGrid(Grid):
         return Grid.__repr__(self)[:-1] + " distributed>"
 
 
+def _not_distributed(name):
+    """A class method of ``dpsm.Grid`` that makes a serial grid, refused on ``DistributedGrid``: a
+    rank's part is made collectively by this module's functions."""
+    def refuse(cls, *args, **kwargs):
+        raise TypeError("DistributedGrid.%s would make a serial grid; a rank's part comes from dpsm.mpi.create_2d, "
+                        "create_graph, create_mesh or load (dpsm.Grid.%s makes a serial grid)" % (name, name))
+    refuse.__name__ = name
+    refuse.__doc__ = "Refused: ``dpsm.Grid.%s`` makes a serial grid; see ``dpsm.mpi``." % name
+    return classmethod(refuse)
+
+
+for _name in ("create_1d", "create_2d", "create_axisymmetric", "create_mesh", "create_mesh_indexed", "create_graph",
+              "create_graph_indexed", "create_dual_mesh", "create_dual_mesh_indexed", "from_meshio", "load"):
+    setattr(DistributedGrid, _name, _not_distributed(_name))
+
+
 def _communicator(comm, function):
     """``comm`` checked to be an mpi4py intracommunicator other than COMM_NULL; a rank that passes
     something else cannot take part in a collective call, so this fails on that rank alone (every rank
