@@ -235,8 +235,7 @@ static const double kSources[] = {0.0, 1e-3, -1e-3, 0.1, -0.1, 1.0, 1e-9, 0.0};
 static const double kDtFactors[] = {1e-6, 0.1, 0.5, 1.0, 2.0, 4.0, 10.0, 50.0, 0.999, 3.7};
 enum { kMaxSubsteps = 2000 };
 
-static void read_heights(const dpsm_grid *g, int64_t n, double *h, const char *whose) {
-    (void)n;
+static void read_heights(const dpsm_grid *g, double *h, const char *whose) {
     if (dpsm_get_heights(g, h) != DPSM_OK) die("dpsm_get_heights on %s failed: %s", whose, dpsm_last_error(g));
 }
 
@@ -269,22 +268,22 @@ static void check_state(const made_t *m, const double *h) {
 }
 
 /* One step of the grid and its serial twin, `dt` on both: the same status,
- * and on success the same heights. Returns 1 if it stepped. */
-static int step_both(made_t *m, double dt, double *h, double *hs) {
+ * and on success the same heights. */
+static void step_both(made_t *m, double dt, double *h, double *hs) {
     g_op = "dpsm_step";
-    read_heights(m->g, m->n, hs, "the grid");
+    read_heights(m->g, hs, "the grid");
     const int st = dpsm_step(m->g, dt), sst = dpsm_step(m->serial, dt);
     trace("dpsm_step(%.17g) -> %s (serial: %s)", dt, dpsm_status_string(st), dpsm_status_string(sst));
     if (st != sst)
         die("dpsm_step returned %s, the serial twin %s (%s | %s)", dpsm_status_string(st), dpsm_status_string(sst),
             dpsm_last_error(m->g), dpsm_last_error(m->serial));
-    read_heights(m->g, m->n, h, "the grid");
+    read_heights(m->g, h, "the grid");
     if (st != DPSM_OK) {
         if (st != DPSM_ERR_WORK_LIMIT) die("dpsm_step returned %s: %s", dpsm_status_string(st), dpsm_last_error(m->g));
         if (!strstr(dpsm_last_error(m->g), "dpsm_step")) die("dpsm_step failed with \"%s\"", dpsm_last_error(m->g));
         same_heights(hs, h, m->n, "a refused step changed the heights");
         g_work += (double)m->n;
-        return 0;
+        return;
     }
     if (*dpsm_last_error(m->g)) die("dpsm_step succeeded but left the message \"%s\"", dpsm_last_error(m->g));
     double substeps = 0.0, serial_substeps = 0.0;
@@ -295,7 +294,6 @@ static int step_both(made_t *m, double dt, double *h, double *hs) {
     read_serial_heights(m, hs);
     same_heights(h, hs, m->n, "the grid and its serial twin after a step");
     check_state(m, h);
-    return 1;
 }
 
 /* The grid through dpsm_save and dpsm_load_mpi: the same heights, and after
@@ -314,8 +312,8 @@ static void check_restart(made_t *m, double dt, double *h, double *hs) {
     if (dpsm_get_shape(copy, &sx, &sy) != DPSM_OK || sx != m->nx || sy != m->ny)
         die("the loaded grid's shape is %lld x %lld, not %lld x %lld", (long long)sx, (long long)sy,
             (long long)m->nx, (long long)m->ny);
-    read_heights(m->g, m->n, h, "the grid");
-    read_heights(copy, m->n, hs, "the loaded grid");
+    read_heights(m->g, h, "the grid");
+    read_heights(copy, hs, "the loaded grid");
     same_heights(h, hs, m->n, "the grid and the one loaded from its restart file");
     g_op = "dpsm_load";
     dpsm_grid *serial_copy = (dpsm_grid *)&serial_copy;
@@ -325,8 +323,8 @@ static void check_restart(made_t *m, double dt, double *h, double *hs) {
     if (a != b) die("after a restart: dpsm_step returned %s, on the loaded grid %s", dpsm_status_string(a),
                     dpsm_status_string(b));
     if (dpsm_step(m->serial, dt) != a) die("after a restart: the serial twin's step returned another status");
-    read_heights(m->g, m->n, h, "the grid");
-    read_heights(copy, m->n, hs, "the loaded grid");
+    read_heights(m->g, h, "the grid");
+    read_heights(copy, hs, "the loaded grid");
     same_heights(h, hs, m->n, "the grid and the one loaded from its restart file, after a step");
     read_serial_heights(m, hs);
     same_heights(h, hs, m->n, "the grid and its serial twin after a restart and a step");
@@ -378,7 +376,7 @@ static void run_scene(made_t *m, reader_t *r) {
     g_op = "dpsm_set_max_substeps";
     if (dpsm_set_max_substeps(m->g, kMaxSubsteps) != DPSM_OK || dpsm_set_max_substeps(m->serial, kMaxSubsteps) != DPSM_OK)
         die("dpsm_set_max_substeps failed: %s", dpsm_last_error(m->g));
-    read_heights(m->g, m->n, h, "the grid");
+    read_heights(m->g, h, "the grid");
     check_state(m, h);
     double stable = 0.0, dt = 0.0;
     if (dpsm_stable_dt(m->g, &stable) != DPSM_OK || !(stable > 0.0)) die("dpsm_stable_dt gave %g", stable);
