@@ -4,6 +4,7 @@
 Each seed is a small program in the byte code that fuzz_mpi.c reads (its
 opening comment tells it); the helpers below spell the operations out.
 Run it again after changing the byte code: python3 tests/fuzz/make_seeds_mpi.py
+(it keeps the regression_* inputs the fuzzer found).
 """
 import os
 
@@ -72,8 +73,9 @@ def seeds():
 
 def main():
     os.makedirs(OUT, exist_ok=True)
-    for old in os.listdir(OUT):
-        os.remove(os.path.join(OUT, old))
+    for old in os.listdir(OUT):  # keep the inputs the fuzzer found (regression_*)
+        if not old.startswith("regression_"):
+            os.remove(os.path.join(OUT, old))
     for name, data in sorted(seeds().items()):
         with open(os.path.join(OUT, name), "wb") as f:
             f.write(bytes(data))
