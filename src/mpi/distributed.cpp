@@ -74,9 +74,17 @@ Rect intersect(const Rect &a, const Rect &b) {
     return {i0, j0, std::max<std::int64_t>(0, i1 - i0), std::max<std::int64_t>(0, j1 - j0)};
 }
 
+// The end of [start, start + count) for a message; a host's block may pass
+// the range of int64 (i0 = INT64_MAX), which the message then spells out.
+std::string end_of(std::int64_t start, std::int64_t count) {
+    const bool overflows = count > 0 ? start > std::numeric_limits<std::int64_t>::max() - count
+                                     : start < std::numeric_limits<std::int64_t>::min() - count;
+    return overflows ? std::to_string(start) + " + " + std::to_string(count) : std::to_string(start + count);
+}
+
 std::string describe(const Rect &r) {
     std::ostringstream s;
-    s << "[" << r.i0 << ", " << r.i0 + r.ni << ") x [" << r.j0 << ", " << r.j0 + r.nj << ")";
+    s << "[" << r.i0 << ", " << end_of(r.i0, r.ni) << ") x [" << r.j0 << ", " << end_of(r.j0, r.nj) << ")";
     return s.str();
 }
 
