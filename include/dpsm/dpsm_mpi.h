@@ -204,11 +204,14 @@ DPSM_API int dpsm_load_mpi_f(MPI_Fint comm, const char *path, dpsm_grid **out);
  *    between two ghosts, and a ghost's outer edges, carry nothing on this
  *    rank (their fluxes read 0); edge kinds and levels are read on the faces
  *    of owned cells.
- *  - **Results** equal those of one serial mesh holding all cells (built with
- *    dpsm_create_graph() or dpsm_create_mesh() from the same cells in any
- *    order), bit for bit, for any partition and any number of ranks: every
- *    sum over a cell's faces or its gradient's neighbours is taken in the
- *    order of their global ids. Mass figures and step information are global,
+ *  - **Results** equal those of one serial mesh holding all cells, numbered
+ *    by their global ids (built with dpsm_create_graph() or
+ *    dpsm_create_mesh() with cell k the cell of global id k), bit for bit,
+ *    for any partition, any local order and any number of ranks: every sum
+ *    over a cell's faces or its gradient's neighbours is taken in the order
+ *    of their global ids, as a serial mesh takes it in the order of its cell
+ *    numbers (a serial mesh numbered otherwise adds in another order and
+ *    differs by round-off). Mass figures and step information are global,
  *    as on distributed 2D grids (their sums over ranks differ from the serial
  *    ones by round-off).
  *  - **Communication:** each sub-step sends the neighbouring ranks only the
