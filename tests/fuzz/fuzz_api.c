@@ -65,20 +65,14 @@
 
 #include <dpsm/dpsm.h>
 
+#define FUZZ_NAME "dpsm fuzz"
+#include "fuzz_support.h"
+
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 
 /* ------------------------------------------------------------------------ */
-/* Reading the input                                                         */
+/* Reading the input (fuzz_support.h: the bytes, failing loudly)            */
 /* ------------------------------------------------------------------------ */
-
-typedef struct {
-    const uint8_t *p;
-    size_t n, at;
-} reader_t;
-
-static unsigned u8(reader_t *r) { return r->at < r->n ? r->p[r->at++] : 0u; }
-static unsigned u16(reader_t *r) { return u8(r) | (u8(r) << 8); }
-static int more(const reader_t *r) { return r->at < r->n; }
 
 static int extreme_mode(void) {
     static int mode = -1;
@@ -130,42 +124,6 @@ static const double kTolerances[] = {1e-6, 1e-9, 1e-3, 1e-15, 0.1, 1.0, 1e3, 1e-
 
 static const double kDtFactors[] = {1e-12, 1e-6, 0.1, 0.5, 1.0, 1.5, 2.0, 4.0, 10.0, 100.0, 1000.0, 0.999, 3.7};
 static const double kDtBad[] = {0.0, -0.0, -1.0, NAN, INFINITY, -INFINITY, -1e-300};
-
-/* ------------------------------------------------------------------------ */
-/* Failing loudly                                                            */
-/* ------------------------------------------------------------------------ */
-
-static const char *g_op = "?"; /* the operation under way, for messages */
-static long g_opcount;
-
-/* DPSM_FUZZ_TRACE=1: one line per call on stderr (to see what an input does). */
-static int trace_on(void) {
-    static int on = -1;
-    if (on < 0) {
-        const char *e = getenv("DPSM_FUZZ_TRACE");
-        on = e && *e && *e != '0';
-    }
-    return on;
-}
-static void trace(const char *fmt, ...) {
-    if (!trace_on()) return;
-    va_list ap;
-    va_start(ap, fmt);
-    fprintf(stderr, "  [%ld] ", g_opcount);
-    vfprintf(stderr, fmt, ap);
-    va_end(ap);
-    fprintf(stderr, "\n");
-}
-
-static void die(const char *fmt, ...) {
-    va_list ap;
-    fprintf(stderr, "\ndpsm fuzz: check failed in operation %ld (%s): ", g_opcount, g_op);
-    va_start(ap, fmt);
-    vfprintf(stderr, fmt, ap);
-    va_end(ap);
-    fprintf(stderr, "\n");
-    abort();
-}
 
 /* ------------------------------------------------------------------------ */
 /* Grids and what the harness knows about them                               */
@@ -1574,27 +1532,6 @@ enum { MESH_POLYGONS = 0, MESH_GRAPH = 1, MESH_DUAL = 2 };
 static const double kMeshSpacings[] = {1.0, 0.5, 2.0, 0.25, 4.0};
 static const double kMeshHeights[] = {0.0, 1.0, 3.0, 10.0, -1.0, 0.5, 30.0, 100.0, -3.0, 1e3, 0.25, 7.0};
 static const double kMeshSources[] = {0.0, 1e-3, -1e-3, 0.1, -0.1, 1.0, 0.0, 1e-9};
-
-typedef struct {
-    uint64_t s;
-} prng_t;
-
-static uint64_t prng_next(prng_t *p) {
-    uint64_t x = p->s;
-    x ^= x >> 12;
-    x ^= x << 25;
-    x ^= x >> 27;
-    p->s = x;
-    return x * 0x2545F4914F6CDD1DULL;
-}
-static double prng_unit(prng_t *p) { return (double)(prng_next(p) >> 11) * (1.0 / 9007199254740992.0); }
-static unsigned prng_below(prng_t *p, unsigned n) { return (unsigned)(prng_next(p) % n); }
-
-static void *xcalloc(size_t n, size_t size) {
-    void *p = calloc(n ? n : 1, size);
-    if (!p) die("out of memory");
-    return p;
-}
 
 /* A mesh as this harness built it, in the host's numbering. */
 typedef struct {

@@ -51,6 +51,9 @@
 #include <dpsm/dpsm.h>
 #include <dpsm/dpsm_mpi.h>
 
+#define FUZZ_NAME "dpsm fuzz_mpi"
+#include "fuzz_support.h"
+
 int LLVMFuzzerInitialize(int *argc, char ***argv);
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 
@@ -59,77 +62,13 @@ static const double kWorkBudget = 2e6; /* cell sub-steps per input */
 
 #define COUNT(a) (sizeof(a) / sizeof((a)[0]))
 
-/* ------------------------------------------------------------------------ */
-/* Reading the input, failing loudly                                         */
-/* ------------------------------------------------------------------------ */
-
-typedef struct {
-    const uint8_t *p;
-    size_t n, at;
-} reader_t;
-
-static unsigned u8(reader_t *r) { return r->at < r->n ? r->p[r->at++] : 0u; }
-static unsigned u16(reader_t *r) { return u8(r) | (u8(r) << 8); }
-static int more(const reader_t *r) { return r->at < r->n; }
-
-static const char *g_op = "?";
-static long g_opcount;
-static double g_work;
-
-static void die(const char *fmt, ...) {
-    va_list ap;
-    fprintf(stderr, "\ndpsm fuzz_mpi: check failed in operation %ld (%s): ", g_opcount, g_op);
-    va_start(ap, fmt);
-    vfprintf(stderr, fmt, ap);
-    va_end(ap);
-    fprintf(stderr, "\n");
-    abort();
-}
-
-static int trace_on(void) {
-    static int on = -1;
-    if (on < 0) {
-        const char *e = getenv("DPSM_FUZZ_TRACE");
-        on = e && *e && *e != '0';
-    }
-    return on;
-}
-static void trace(const char *fmt, ...) {
-    if (!trace_on()) return;
-    va_list ap;
-    va_start(ap, fmt);
-    fprintf(stderr, "  [%ld] ", g_opcount);
-    vfprintf(stderr, fmt, ap);
-    va_end(ap);
-    fprintf(stderr, "\n");
-}
-
-static void *xcalloc(size_t n, size_t size) {
-    void *p = calloc(n ? n : 1, size);
-    if (!p) die("out of memory");
-    return p;
-}
+static double g_work; /* cell sub-steps spent on this input */
 
 static void *copy_of(const void *src, size_t bytes) {
     void *p = xcalloc(bytes, 1);
     memcpy(p, src, bytes);
     return p;
 }
-
-/* The harness's own random numbers, seeded from the input (xorshift*). */
-typedef struct {
-    uint64_t s;
-} prng_t;
-static uint64_t prng_next(prng_t *p) {
-    uint64_t x = p->s;
-    x ^= x >> 12;
-    x ^= x << 25;
-    x ^= x >> 27;
-    p->s = x;
-    return x * 0x2545F4914F6CDD1DULL;
-}
-static double prng_unit(prng_t *p) { return (double)(prng_next(p) >> 11) * (1.0 / 9007199254740992.0); }
-static unsigned prng_below(prng_t *p, unsigned n) { return (unsigned)(prng_next(p) % n); }
 
 /* The restart files of this process, removed after each input. */
 static const char *temp_path(int which) {
