@@ -480,7 +480,7 @@ static void expect_fresh_grid(const dpsm_grid *g, int64_t nx, int64_t ny) {
     const ledger_t l = read_ledger(g);
     REQUIRE(l.total == 0.0 && l.sourced == 0.0 && l.external == 0.0 && l.outflow == 0.0,
             "fresh ledger %g %g %g %g", l.total, l.sourced, l.external, l.outflow);
-    for (int i = DPSM_INFO_SUBSTEPS; i <= DPSM_INFO_BYTES_SENT; ++i) {
+    for (int i = DPSM_INFO_SUBSTEPS; i <= DPSM_INFO_SUBSTEPS_PER_EXCHANGE; ++i) {
         double v = 42.0;
         CHECK_OK(g, dpsm_get_step_info(g, i, &v));
         REQUIRE(v == 0.0, "step info %d before the first step = %g, expected 0", i, v);
@@ -1371,7 +1371,7 @@ static void test_step_info(void **state) {
     dpsm_grid *g = NULL;
     CHECK_OK(NULL, dpsm_create_1d(NX, dx, &g));
     double v = -1.0;
-    for (int i = DPSM_INFO_SUBSTEPS; i <= DPSM_INFO_BYTES_SENT; ++i) {
+    for (int i = DPSM_INFO_SUBSTEPS; i <= DPSM_INFO_SUBSTEPS_PER_EXCHANGE; ++i) {
         CHECK_OK(g, dpsm_get_step_info(g, i, &v));
         REQUIRE(v == 0.0, "info %d before any step: %g", i, v);
     }
@@ -1405,6 +1405,9 @@ static void test_step_info(void **state) {
     REQUIRE(own_updates == updates, "a serial grid's own cell updates %g differ from the step's %g", own_updates,
             updates);
     REQUIRE(messages == 0.0 && bytes == 0.0, "a serial grid sent %g messages of %g bytes", messages, bytes);
+    double per_exchange = -1.0;
+    CHECK_OK(g, dpsm_get_step_info(g, DPSM_INFO_SUBSTEPS_PER_EXCHANGE, &per_exchange));
+    REQUIRE(per_exchange == 0.0, "a serial grid exchanged every %g sub-steps", per_exchange);
     /* The heights agree: nothing steeper than the rest criterion. */
     CHECK_OK(g, dpsm_get_heights(g, h));
     const double s = max_face_slope(h, NULL, NX, 1, dx, 1.0);
@@ -2543,10 +2546,10 @@ static void test_bad_get_mass(void **state) {
 static void test_bad_get_step_info(void **state) {
     fixture_t *fx = *state;
     double v = 0.0;
-    const int bad[] = {-1, DPSM_INFO_BYTES_SENT + 1, 9, 255, INT_MAX, INT_MIN};
+    const int bad[] = {-1, DPSM_INFO_SUBSTEPS_PER_EXCHANGE + 1, 10, 255, INT_MAX, INT_MIN};
     for (size_t k = 0; k < sizeof bad / sizeof *bad; ++k)
         EXPECT_FAIL(fx, dpsm_get_step_info(fx->g, bad[k], &v), DPSM_ERR_UNKNOWN_ENUM, "dpsm_get_step_info", "item");
-    for (int i = DPSM_INFO_SUBSTEPS; i <= DPSM_INFO_BYTES_SENT; ++i)
+    for (int i = DPSM_INFO_SUBSTEPS; i <= DPSM_INFO_SUBSTEPS_PER_EXCHANGE; ++i)
         EXPECT_FAIL(fx, dpsm_get_step_info(fx->g, i, NULL), DPSM_ERR_NULL_POINTER, "dpsm_get_step_info", "value");
 }
 

@@ -134,6 +134,8 @@ module dpsm
   integer(c_int), parameter, public :: DPSM_INFO_MESSAGES_SENT = 6
   !> Step information: DPSM_INFO_BYTES_SENT, as in dpsm.h.
   integer(c_int), parameter, public :: DPSM_INFO_BYTES_SENT = 7
+  !> Step information: DPSM_INFO_SUBSTEPS_PER_EXCHANGE, as in dpsm.h.
+  integer(c_int), parameter, public :: DPSM_INFO_SUBSTEPS_PER_EXCHANGE = 8
   ! Defaults.
   !> Defaults: DPSM_DEFAULT_REPOSE_ANGLE, as in dpsm.h.
   real(c_double), parameter, public :: DPSM_DEFAULT_REPOSE_ANGLE = 0.52359877559829887_c_double

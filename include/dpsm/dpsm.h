@@ -210,6 +210,13 @@ typedef struct dpsm_grid dpsm_grid;
 #define DPSM_INFO_MESSAGES_SENT 6
 /** The bytes of those messages. 0 on a serial grid. */
 #define DPSM_INFO_BYTES_SENT 7
+/** The sub-steps a rank takes between two exchanges of ghost values with
+ *  its neighbours: 1 on a distributed 2D grid (its halo in every sub-step);
+ *  on a distributed mesh as many as the host's ghost layer allows
+ *  (dpsm_mpi.h, "Ghosts needed"), or 0.5 where it allows less than one (an
+ *  exchange of gradients and one of heights in every sub-step). The same on
+ *  every rank; 0 on a serial grid. */
+#define DPSM_INFO_SUBSTEPS_PER_EXCHANGE 8
 /** @} */
 
 /** The default angle of repose: 30 degrees, in radians. */
@@ -798,8 +805,10 @@ DPSM_API int dpsm_get_mass(const dpsm_grid *g, int quantity, double *value);
  * @brief Reads what the last successful dpsm_step() did.
  * @param g      the grid.
  * @param item   ::DPSM_INFO_SUBSTEPS, ::DPSM_INFO_TIME_INTEGRATED,
- *               ::DPSM_INFO_AT_REST, ::DPSM_INFO_MAX_EXCESS_SLOPE or
- *               ::DPSM_INFO_CELL_UPDATES.
+ *               ::DPSM_INFO_AT_REST, ::DPSM_INFO_MAX_EXCESS_SLOPE,
+ *               ::DPSM_INFO_CELL_UPDATES, ::DPSM_INFO_RANK_CELL_UPDATES,
+ *               ::DPSM_INFO_MESSAGES_SENT, ::DPSM_INFO_BYTES_SENT or
+ *               ::DPSM_INFO_SUBSTEPS_PER_EXCHANGE.
  * @param value  receives the figure (0 for every item before the first step).
  * @return ::DPSM_OK, ::DPSM_ERR_NULL_POINTER or ::DPSM_ERR_UNKNOWN_ENUM.
  */

@@ -710,11 +710,12 @@ int dpsm_get_step_info(const dpsm_grid *g, int item, double *value) {
                 break;
             case DPSM_INFO_MESSAGES_SENT: *value = info.messages_sent; break;
             case DPSM_INFO_BYTES_SENT: *value = info.bytes_sent; break;
+            case DPSM_INFO_SUBSTEPS_PER_EXCHANGE: *value = info.substeps_per_exchange; break;
             default:
                 fail(DPSM_ERR_UNKNOWN_ENUM, fn, "item = ", item,
                      " is not DPSM_INFO_SUBSTEPS, DPSM_INFO_TIME_INTEGRATED, DPSM_INFO_AT_REST,"
                      " DPSM_INFO_MAX_EXCESS_SLOPE, DPSM_INFO_CELL_UPDATES, DPSM_INFO_RANK_CELL_UPDATES,"
-                     " DPSM_INFO_MESSAGES_SENT or DPSM_INFO_BYTES_SENT");
+                     " DPSM_INFO_MESSAGES_SENT, DPSM_INFO_BYTES_SENT or DPSM_INFO_SUBSTEPS_PER_EXCHANGE");
         }
     });
 }

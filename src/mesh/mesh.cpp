@@ -139,56 +139,72 @@ void order_each_cells_faces(Mesh &m, const std::vector<RawFace> &faces) {
 // The least-squares gradient weights of every owned cell, weighted by
 // inverse distance squared, over one ring of neighbours across faces or two
 // (gradients_over_two_rings); a cell whose neighbours do not span the plane
-// gets none (its faces use the two-point slope alone). The second ring
-// through a ghost n is ghost_neighbours[ghost_start[n - owned] ..
-// ghost_start[n - owned + 1]), as n's owner knows them.
+// gets none (its faces use the two-point slope alone). The neighbours of a
+// ghost n are ghost_neighbours[ghost_start[n - owned] .. ghost_start[n -
+// owned + 1]), as n's owner knows them (-1: not on this rank). A ghost whose
+// rings are all on this rank gets its weights too, as its owner has them
+// (has_stencil); another ghost's list holds the cells whose gradients read
+// it (weights 0), so that a change of its height wakes them.
 void gradient_weights(Mesh &m, int rings, const std::vector<std::int64_t> &ghost_start,
-                      const std::vector<std::int64_t> &ghost_neighbours) {
-    m.grad_start.assign(m.cells + 1, 0);
-    m.grad_cells.clear();
+                      const std::vector<std::int64_t> &ghost_neighbours, std::vector<std::uint8_t> &has_stencil) {
+    std::vector<std::int64_t> stencil_start(static_cast<std::size_t>(m.cells) + 1, 0), stencil;
+    has_stencil.assign(static_cast<std::size_t>(m.cells), 0);
     std::vector<std::int64_t> seen(m.cells, -1), ring;
-    for (std::int64_t c = 0; c < m.owned; ++c) {
+    for (std::int64_t c = 0; c < m.cells; ++c) {
         ring.clear();
         seen[c] = c;
-        const auto visit = [&](std::int64_t n) {
-            if (n >= 0 && seen[n] != c) seen[n] = c, ring.push_back(n);
-        };
-        for (std::int64_t k = m.cell_face_start[c]; k < m.cell_face_start[c + 1]; ++k) visit(m.other[k]);
-        if (rings > 1) {
-            const std::size_t first = ring.size();
-            for (std::size_t r = 0; r < first; ++r) {
-                const std::int64_t n = ring[r];
-                if (n < m.owned) {
-                    for (std::int64_t k = m.cell_face_start[n]; k < m.cell_face_start[n + 1]; ++k) visit(m.other[k]);
-                } else {
-                    const std::size_t g = static_cast<std::size_t>(n - m.owned);
-                    for (std::int64_t k = ghost_start[g]; k < ghost_start[g + 1]; ++k) visit(ghost_neighbours[k]);
+        const auto visit_neighbours = [&](std::int64_t n) {
+            bool all_here = true;
+            const auto visit = [&](std::int64_t v) {
+                if (v >= 0 && seen[v] != c) seen[v] = c, ring.push_back(v);
+            };
+            if (n < m.owned) {
+                for (std::int64_t k = m.cell_face_start[n]; k < m.cell_face_start[n + 1]; ++k) visit(m.other[k]);
+            } else {
+                const std::size_t g = static_cast<std::size_t>(n - m.owned);
+                for (std::int64_t k = ghost_start[g]; k < ghost_start[g + 1]; ++k) {
+                    all_here = all_here && ghost_neighbours[k] >= 0;
+                    visit(ghost_neighbours[k]);
                 }
             }
+            return all_here;
+        };
+        bool complete = visit_neighbours(c);
+        if (rings > 1) {
+            const std::size_t first = ring.size();
+            for (std::size_t r = 0; r < first; ++r) complete = visit_neighbours(ring[r]) && complete;
         }
-        std::sort(ring.begin(), ring.end(),
-                  [&](std::int64_t l, std::int64_t r) { return m.global_id[l] < m.global_id[r]; });
-        m.grad_cells.insert(m.grad_cells.end(), ring.begin(), ring.end());
-        m.grad_start[c + 1] = static_cast<std::int64_t>(m.grad_cells.size());
+        if (complete) {
+            has_stencil[static_cast<std::size_t>(c)] = 1;
+            std::sort(ring.begin(), ring.end(),
+                      [&](std::int64_t l, std::int64_t r) { return m.global_id[l] < m.global_id[r]; });
+            stencil.insert(stencil.end(), ring.begin(), ring.end());
+        }
+        stencil_start[static_cast<std::size_t>(c) + 1] = static_cast<std::int64_t>(stencil.size());
     }
-    if (m.owned < m.cells) {
-        // A ghost's list: the owned cells that read it, in ascending order.
-        std::vector<std::int64_t> readers(static_cast<std::size_t>(m.cells - m.owned), 0);
-        for (std::int64_t k = 0; k < m.grad_start[m.owned]; ++k)
-            if (m.grad_cells[k] >= m.owned) ++readers[static_cast<std::size_t>(m.grad_cells[k] - m.owned)];
-        for (std::int64_t c = m.owned; c < m.cells; ++c)
-            m.grad_start[c + 1] = m.grad_start[c] + readers[static_cast<std::size_t>(c - m.owned)];
-        m.grad_cells.resize(static_cast<std::size_t>(m.grad_start[m.cells]));
-        std::vector<std::int64_t> next(m.grad_start.begin() + m.owned, m.grad_start.end() - 1);
-        for (std::int64_t c = 0; c < m.owned; ++c)
-            for (std::int64_t k = m.grad_start[c]; k < m.grad_start[c + 1]; ++k) {
-                const std::int64_t n = m.grad_cells[k];
-                if (n >= m.owned) m.grad_cells[static_cast<std::size_t>(next[static_cast<std::size_t>(n - m.owned)]++)] = c;
-            }
+    // A cell without its own stencil: the cells whose stencils hold it, in ascending order.
+    std::vector<std::int64_t> readers(static_cast<std::size_t>(m.cells), 0);
+    for (const std::int64_t n : stencil)
+        if (!has_stencil[static_cast<std::size_t>(n)]) ++readers[static_cast<std::size_t>(n)];
+    m.grad_start.assign(m.cells + 1, 0);
+    for (std::int64_t c = 0; c < m.cells; ++c) {
+        const std::size_t k = static_cast<std::size_t>(c);
+        m.grad_start[k + 1] = m.grad_start[k] + (has_stencil[k] ? stencil_start[k + 1] - stencil_start[k] : readers[k]);
+    }
+    m.grad_cells.assign(static_cast<std::size_t>(m.grad_start[m.cells]), 0);
+    std::vector<std::int64_t> next(m.grad_start.begin(), m.grad_start.end() - 1);
+    for (std::int64_t c = 0; c < m.cells; ++c) {
+        if (!has_stencil[static_cast<std::size_t>(c)]) continue;
+        for (std::int64_t k = stencil_start[c]; k < stencil_start[c + 1]; ++k) {
+            const std::int64_t n = stencil[static_cast<std::size_t>(k)];
+            m.grad_cells[static_cast<std::size_t>(next[c]++)] = n;
+            if (!has_stencil[static_cast<std::size_t>(n)]) m.grad_cells[static_cast<std::size_t>(next[n]++)] = c;
+        }
     }
     m.grad_wx.assign(m.grad_cells.size(), 0.0);
     m.grad_wy.assign(m.grad_cells.size(), 0.0);
-    for (std::int64_t c = 0; c < m.owned; ++c) {
+    for (std::int64_t c = 0; c < m.cells; ++c) {
+        if (!has_stencil[static_cast<std::size_t>(c)]) continue;
         double sxx = 0.0, sxy = 0.0, syy = 0.0;
         const std::int64_t k0 = m.grad_start[c], k1 = m.grad_start[c + 1];
         for (std::int64_t k = k0; k < k1; ++k) {
@@ -208,6 +224,67 @@ void gradient_weights(Mesh &m, int rings, const std::vector<std::int64_t> &ghost
             m.grad_wy[k] = w * (sxx * dy - sxy * dx) / det;
         }
     }
+}
+
+// How many sub-steps after an exchange each cell, gradient and face of a
+// part stays its owner's when stepped here (Mesh::reach), and the lists by
+// reach. Valid after 0 sub-steps: every cell. In sub-step j a gradient is
+// exact when its cell has its own stencil and every cell of it was exact
+// after j - 1; a face's flux when its cells and their gradients were; a
+// cell's new height when it was exact, all its faces over the whole mesh
+// are here (ghost_faces: as its owner counts them) and their fluxes exact.
+// Sets substeps_per_exchange to the highest j at which every owned cell is
+// exact (the caller takes the smallest over ranks).
+void set_reach(Mesh &m, const std::vector<std::uint8_t> &has_stencil, const std::vector<double> &ghost_faces) {
+    const std::size_t n = static_cast<std::size_t>(m.cells), nf = static_cast<std::size_t>(m.faces);
+    std::vector<std::uint8_t> valid(n, 1), gradient(n, 0), flux(nf, 0), faces_here(n, 1);
+    for (std::int64_t c = m.owned; c < m.cells; ++c)
+        faces_here[static_cast<std::size_t>(c)] =
+            static_cast<double>(m.cell_face_start[c + 1] - m.cell_face_start[c]) == ghost_faces[c - m.owned];
+    m.reach.assign(n, 0), m.gradient_reach.assign(n, 0), m.face_reach.assign(nf, 0);
+    m.substeps_per_exchange = 0;
+    for (int j = 1; j <= Mesh::kMaxReach; ++j) {
+        for (std::size_t c = 0; c < n; ++c) {
+            bool exact = has_stencil[c] && valid[c];
+            for (std::int64_t k = m.grad_start[c]; exact && k < m.grad_start[c + 1]; ++k)
+                exact = valid[static_cast<std::size_t>(m.grad_cells[k])] != 0;
+            gradient[c] = exact;
+            if (exact) m.gradient_reach[c] = static_cast<std::int8_t>(j);
+        }
+        for (std::size_t f = 0; f < nf; ++f) {
+            const std::size_t a = static_cast<std::size_t>(m.face_a[f]);
+            const std::int64_t b = m.face_b[f];
+            flux[f] = valid[a] && gradient[a] &&
+                      (b < 0 || (valid[static_cast<std::size_t>(b)] && gradient[static_cast<std::size_t>(b)]));
+            if (flux[f]) m.face_reach[f] = static_cast<std::int8_t>(j);
+        }
+        bool owned_exact = true;
+        for (std::size_t c = 0; c < n; ++c) {
+            bool exact = valid[c] && faces_here[c];
+            for (std::int64_t k = m.cell_face_start[c]; exact && k < m.cell_face_start[c + 1]; ++k)
+                exact = flux[static_cast<std::size_t>(m.cell_faces[k])] != 0;
+            valid[c] = exact;
+            if (exact) m.reach[c] = static_cast<std::int8_t>(j);
+            if (static_cast<std::int64_t>(c) < m.owned) owned_exact = owned_exact && exact;
+        }
+        if (!owned_exact) break;
+        m.substeps_per_exchange = j;
+    }
+    const auto by_reach = [](const std::vector<std::int8_t> &reach, std::int64_t from, std::int64_t to,
+                             std::vector<std::int64_t> &list, std::vector<std::int64_t> &with) {
+        list.clear();
+        for (std::int64_t c = from; c < to; ++c)
+            if (reach[static_cast<std::size_t>(c)] > 0) list.push_back(c);
+        std::stable_sort(list.begin(), list.end(), [&](std::int64_t l, std::int64_t r) {
+            return reach[static_cast<std::size_t>(l)] > reach[static_cast<std::size_t>(r)];
+        });
+        with.assign(Mesh::kMaxReach + 1, 0);
+        for (const std::int64_t c : list)
+            for (int j = 0; j <= reach[static_cast<std::size_t>(c)]; ++j) ++with[static_cast<std::size_t>(j)];
+    };
+    by_reach(m.reach, m.owned, m.cells, m.ghosts_by_reach, m.ghosts_with_reach);
+    by_reach(m.gradient_reach, m.owned, m.cells, m.ghosts_by_gradient_reach, m.ghosts_with_gradient_reach);
+    by_reach(m.face_reach, m.live_faces, m.faces, m.faces_by_reach, m.faces_with_reach);
 }
 
 // Renumbers cells and faces, derives what a face's slope needs and checks
@@ -349,7 +426,8 @@ void set_step_scale(Mesh &m) {
 std::shared_ptr<const Mesh> finish_serial(std::shared_ptr<Mesh> mesh) {
     Mesh &m = *mesh;
     const int rings = gradients_over_two_rings(static_cast<std::int64_t>(m.cell_faces.size()), m.cells) ? 2 : 1;
-    gradient_weights(m, rings, {}, {});
+    std::vector<std::uint8_t> has_stencil;
+    gradient_weights(m, rings, {}, {}, has_stencil);
     set_step_scale(m);
     return mesh;
 }
@@ -619,7 +697,9 @@ bool gradients_over_two_rings(std::int64_t cell_faces, std::int64_t cells) {
 
 void finish_part(Mesh &m, int rings, const std::vector<std::int64_t> &ghost_start,
                  const std::vector<std::int64_t> &ghost_neighbours, const std::vector<double> &ghost_faces) {
-    gradient_weights(m, rings, ghost_start, ghost_neighbours);
+    std::vector<std::uint8_t> has_stencil;
+    gradient_weights(m, rings, ghost_start, ghost_neighbours, has_stencil);
+    set_reach(m, has_stencil, ghost_faces);
     for (std::int64_t c = m.owned; c < m.cells; ++c) m.face_count[c] = ghost_faces[c - m.owned];
     set_step_scale(m);
 }

@@ -101,6 +101,25 @@ struct Mesh {
     // face may take this share of a cell's sand above its bed.
     std::vector<double> face_count;
 
+    // A part's redundant sub-steps (mpi/distributed_mesh.cpp). After an
+    // exchange every local cell holds its owner's values; where the host's
+    // ghost layer is deep, ghosts near the owned cells can then be stepped
+    // here exactly as their owners step them, for a few sub-steps, and the
+    // ranks exchange once per that many sub-steps. In the j-th sub-step
+    // after an exchange (from 1), cell c's gradient is its owner's if
+    // gradient_reach[c] >= j, face f's flux if face_reach[f] >= j, and cell
+    // c's new height if reach[c] >= j (owned cells: kMaxReach). Ghosts and
+    // faces beyond the owned ones are listed by reach, highest first, in
+    // ghosts_by_reach, ghosts_by_gradient_reach and faces_by_reach; every
+    // list's first count[j] entries are those whose reach is at least j.
+    // substeps_per_exchange: the sub-steps all ranks take per exchange (0:
+    // two exchanges in every sub-step, gradients then heights).
+    static constexpr int kMaxReach = 8;
+    std::vector<std::int8_t> reach, gradient_reach, face_reach;
+    std::vector<std::int64_t> ghosts_by_reach, ghosts_by_gradient_reach, faces_by_reach;
+    std::vector<std::int64_t> ghosts_with_reach, ghosts_with_gradient_reach, faces_with_reach;  // per j, 0 .. kMaxReach
+    int substeps_per_exchange = 0;
+
     // The smallest distance of any face (the rest tolerance's length scale).
     double min_distance = 0.0;
     // The smallest area over summed conductance of any cell: the largest

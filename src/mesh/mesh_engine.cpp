@@ -41,6 +41,12 @@ struct MeshScratch final : EngineState {
     std::vector<std::int64_t> faces, gradient_cells, update_cells, source_cells;
     std::vector<std::int64_t> sink_faces;  // faces onto open edges or open cells
     std::vector<std::int64_t> changed_ghosts;  // a part's ghosts whose owners sent new values
+    std::vector<std::int64_t> ghost_source_cells;  // a part's ghosts with a source, stepped where they are in reach
+    // A part that takes several sub-steps per exchange: the owned cells
+    // updated since the last exchange (all of them when batch_all).
+    std::vector<std::int64_t> batch_cells;
+    std::vector<std::uint8_t> in_batch;
+    bool batch_all = false;
     std::vector<double> available;         // bed: the sand a face may take
     std::vector<std::uint8_t> changed;     // dense: per cell, a face of it carried sand
     bool flux_clean = true;
@@ -178,6 +184,7 @@ public:
         if (s.flux.size() != nf) s.flux.assign(nf, 0.0);
         s.face_seen.resize(nf, 0), s.cell_seen.resize(n, 0);
         s.changed.resize(n, 0);
+        s.in_batch.resize(n, 0);
         MeshActivity &act = grid.mesh_activity();
         act.hot.resize(n, 0);
         if (!grid.bed().empty()) s.available.resize(n, 0.0);
@@ -197,9 +204,10 @@ public:
             if (sink && leaves < m.owned) s.sink_faces.push_back(f);
         }
         s.source_cells.clear();
+        s.ghost_source_cells.clear();
         const std::vector<double> &q = grid.source();
-        for (std::int64_t c = 0; c < std::min<std::int64_t>(m.owned, static_cast<std::int64_t>(q.size())); ++c)
-            if (kind[c] == kSand && q[c] != 0.0) s.source_cells.push_back(c);
+        for (std::int64_t c = 0; c < static_cast<std::int64_t>(q.size()); ++c)
+            if (kind[c] == kSand && q[c] != 0.0) (c < m.owned ? s.source_cells : s.ghost_source_cells).push_back(c);
     }
 
     bool may_move(const Grid &grid) const override { return grid.mesh_activity().may_move(); }
@@ -221,9 +229,14 @@ public:
             return;
         }
         Decomposition *parts = grid.decomposition();
+        // A part whose ghost layer is deep enough steps its ghosts in reach
+        // too and exchanges once per batch of sub-steps (Mesh::reach); the
+        // step ends with an exchange, so that a step starts exact.
+        const int per_exchange = parts ? m.substeps_per_exchange : 0;
         for (std::int64_t k = 0; k < plan.substeps; ++k) {
             double visited = 0.0;
-            SubstepSummary did = substep(grid, m, s, plan.sub_dt, record, visited);
+            const int in_batch = per_exchange > 0 ? static_cast<int>(k % per_exchange) + 1 : 0;
+            SubstepSummary did = substep(grid, m, s, plan.sub_dt, record, visited, in_batch);
             info.cell_updates += visited;
             if (parts) {
                 // Every rank takes the same sub-steps and stops at the same one.
@@ -231,7 +244,10 @@ public:
                 parts->after_sweep(agreed);
                 did = agreed[0];
             }
-            if (!book(did)) break;
+            const bool go_on = book(did);
+            if (in_batch > 0 && (!go_on || in_batch == per_exchange || k + 1 == plan.substeps))
+                exchange_batch(grid, m, s, *parts);
+            if (!go_on) break;
         }
     }
 
@@ -242,7 +258,51 @@ public:
     }
 
 private:
-    SubstepSummary substep(Grid &grid, const Mesh &m, MeshScratch &s, double dt, bool record, double &visited) const {
+    // The end of a batch: the owned cells' heights (residuals, moving
+    // flags) that changed since the last exchange go to the ranks that hold
+    // them as ghosts; ghosts that were beyond reach, and so differ from
+    // their owners' values, wake the cells that read them.
+    static void exchange_batch(Grid &grid, const Mesh &m, MeshScratch &s, Decomposition &parts) {
+        std::vector<std::int64_t> &changed_ghosts = s.changed_ghosts;
+        changed_ghosts.clear();
+        parts.exchange_ghost_heights(grid, s.batch_all ? nullptr : &s.batch_cells, changed_ghosts);
+        for (const std::int64_t c : s.batch_cells) s.in_batch[c] = 0;
+        s.batch_cells.clear();
+        s.batch_all = false;
+        MeshActivity &act = grid.mesh_activity();
+        for (const std::int64_t c : changed_ghosts) act.wake_around(m, c);
+        changed_ghosts.clear();
+    }
+
+    // The new height of a sand cell from its faces' fluxes and its source
+    // (with a bed: the sand it may lose); whether a face of it carried sand.
+    struct CellUpdate {
+        const Mesh &m;
+        const double *flux;
+        const std::uint8_t *kind;
+        const std::vector<double> &q, &zb;
+        std::vector<double> &h;
+        std::vector<float> &residual;
+        double dt;
+
+        bool operator()(std::int64_t c) const {
+            bool carried = false;
+            double rate = net_rate(m, flux, c, carried);
+            if (kind[c] != kSand) return carried;
+            if (!q.empty()) rate += zb.empty() ? q[c] : source_applied(zb, h, q, c, dt);
+            if (rate != 0.0) add_with_residual(h[c], residual[c], dt * rate);
+            if (!zb.empty() && h[c] < zb[c]) {
+                residual[c] = static_cast<float>(static_cast<double>(residual[c]) - (zb[c] - h[c]));
+                h[c] = zb[c];
+            }
+            return carried;
+        }
+    };
+
+    // `in_batch`: the sub-step's place after the last exchange (from 1) on a
+    // part that takes several per exchange; 0: two exchanges in this one.
+    SubstepSummary substep(Grid &grid, const Mesh &m, MeshScratch &s, double dt, bool record, double &visited,
+                           int in_batch) const {
         MeshActivity &act = grid.mesh_activity();
         const bool physics = grid.hysteresis() || !grid.bed().empty();
         // A part of a distributed mesh steps its owned cells and the faces
@@ -289,10 +349,19 @@ private:
             // The owned cells and the faces that touch them: all of a serial mesh.
             const std::int64_t n = m.owned, nf = m.live_faces;
             const bool parallel = threads > 1 && n >= kCellsForThreads;
+            // The ghosts in reach, in a part that steps them (none otherwise).
+            const std::int64_t *extra_cells = in_batch ? m.ghosts_by_reach.data() : nullptr;
+            const std::int64_t extra_count = in_batch ? m.ghosts_with_reach[static_cast<std::size_t>(in_batch)] : 0;
             if (law.isotropic) {
 #pragma omp parallel for num_threads(threads) if (parallel) schedule(static)
                 for (std::int64_t c = 0; c < n; ++c) gradient_of(m, h.data(), kind.data(), c, s.gx.data(), s.gy.data());
-                if (parts) parts->exchange_ghost_gradients(grid, s.gx.data(), s.gy.data(), nullptr, changed_ghosts);
+                if (in_batch) {
+                    for (std::int64_t k = 0; k < m.ghosts_with_gradient_reach[static_cast<std::size_t>(in_batch)]; ++k)
+                        gradient_of(m, h.data(), kind.data(), m.ghosts_by_gradient_reach[static_cast<std::size_t>(k)],
+                                    s.gx.data(), s.gy.data());
+                } else if (parts) {
+                    parts->exchange_ghost_gradients(grid, s.gx.data(), s.gy.data(), nullptr, changed_ghosts);
+                }
             }
             double *flux = s.flux.data();
 #pragma omp parallel for num_threads(threads) if (parallel) schedule(static) reduction(max : max_excess) reduction(|| : moved)
@@ -305,32 +374,40 @@ private:
                     max_excess = std::max(max_excess, excess);
                 }
             }
+            if (in_batch) {
+                // The faces beyond the owned cells' that the ghosts in reach need; they count for nothing here.
+                for (std::int64_t k = 0; k < m.faces_with_reach[static_cast<std::size_t>(in_batch)]; ++k) {
+                    const std::int64_t f = m.faces_by_reach[static_cast<std::size_t>(k)];
+                    double excess = 0.0;
+                    flux[f] = law(f, excess);
+                }
+            }
             s.flux_clean = false;
             std::uint8_t *changed = s.changed.data();
-            const bool has_source = !q.empty();
-            const std::vector<double> &zb = grid.bed();
+            const CellUpdate update_cell{m, flux, kind.data(), q, grid.bed(), h, residual, dt};
             std::int64_t changed_cells = 0;
 #pragma omp parallel for num_threads(threads) if (parallel) schedule(static) reduction(+ : changed_cells)
             for (std::int64_t c = 0; c < n; ++c) {
-                bool carried = false;
-                double rate = net_rate(m, flux, c, carried);
+                const bool carried = update_cell(c);
                 changed[c] = carried;
                 changed_cells += carried;
-                if (kind[c] != kSand) continue;
-                if (has_source) rate += zb.empty() ? q[c] : source_applied(zb, h, q, c, dt);
-                if (rate != 0.0) add_with_residual(h[c], residual[c], dt * rate);
-                if (!zb.empty() && h[c] < zb[c]) {
-                    residual[c] = static_cast<float>(static_cast<double>(residual[c]) - (zb[c] - h[c]));
-                    h[c] = zb[c];
-                }
             }
-            visited = static_cast<double>(n);
+            for (std::int64_t k = 0; k < extra_count; ++k) {
+                const std::int64_t c = extra_cells[k];
+                changed[c] = update_cell(c);
+            }
+            visited = static_cast<double>(n + extra_count);
             if (grid.hysteresis()) {
                 std::vector<std::uint8_t> &moving = grid.moving_for_stepping();
                 for (std::int64_t c = 0; c < n; ++c) moving[c] = kind[c] == kSand && changed[c];
+                for (std::int64_t k = 0; k < extra_count; ++k)
+                    moving[extra_cells[k]] = kind[extra_cells[k]] == kSand && changed[extra_cells[k]];
             }
             changed_ghosts.clear();
-            if (parts) parts->exchange_ghost_heights(grid, nullptr, changed_ghosts);
+            if (in_batch)
+                s.batch_all = true;
+            else if (parts)
+                parts->exchange_ghost_heights(grid, nullptr, changed_ghosts);
             // The next sub-step looks at the cells that changed and those whose
             // gradients read them; where that is most of the mesh, at all.
             const std::size_t most = static_cast<std::size_t>(kDenseShare * static_cast<double>(n));
@@ -345,6 +422,10 @@ private:
                     }
                 for (const std::int64_t c : s.source_cells) act.wake_around(m, c);
                 for (const std::int64_t c : changed_ghosts) act.wake_around(m, c);
+                for (std::int64_t k = 0; k < extra_count && !act.all_hot; ++k)
+                    if (changed[extra_cells[k]]) act.wake_around(m, extra_cells[k]);
+                if (in_batch)
+                    for (const std::int64_t c : s.ghost_source_cells) act.wake_around(m, c);
             }
         } else {
             // The faces of the hot cells, the owned cells whose gradients they
@@ -352,14 +433,24 @@ private:
             std::uint32_t stamp = next_stamp(s);
             s.faces.clear();
             s.gradient_cells.clear();
+            // On a part that steps its ghosts in reach: their faces and gradients too.
+            const auto face_in_reach = [&](std::int64_t f) {
+                return f < m.live_faces || (in_batch && m.face_reach[static_cast<std::size_t>(f)] >= in_batch);
+            };
+            const auto gradient_in_reach = [&](std::int64_t c) {
+                return c < m.owned || (in_batch && m.gradient_reach[static_cast<std::size_t>(c)] >= in_batch);
+            };
+            const auto cell_in_reach = [&](std::int64_t c) {
+                return c < m.owned || (in_batch && m.reach[static_cast<std::size_t>(c)] >= in_batch);
+            };
             const auto look_at_faces_of = [&](std::int64_t c) {
                 for (std::int64_t k = m.cell_face_start[c]; k < m.cell_face_start[c + 1]; ++k) {
                     const std::int64_t f = m.cell_faces[k];
-                    if (f >= m.live_faces || s.face_seen[f] == stamp) continue;
+                    if (!face_in_reach(f) || s.face_seen[f] == stamp) continue;
                     s.face_seen[f] = stamp;
                     s.faces.push_back(f);
                     for (const std::int64_t e : {m.face_a[f], m.face_b[f]})
-                        if (e >= 0 && e < m.owned && s.cell_seen[e] != stamp) {
+                        if (e >= 0 && gradient_in_reach(e) && s.cell_seen[e] != stamp) {
                             s.cell_seen[e] = stamp;
                             s.gradient_cells.push_back(e);
                         }
@@ -372,7 +463,7 @@ private:
             }
             if (law.isotropic) {
                 for (const std::int64_t c : s.gradient_cells) gradient_of(m, h.data(), kind.data(), c, s.gx.data(), s.gy.data());
-                if (parts) {
+                if (parts && !in_batch) {
                     // A ghost whose gradient changed makes its faces steep or flat
                     // whether or not anything near them here changed.
                     parts->exchange_ghost_gradients(grid, s.gx.data(), s.gy.data(), &s.gradient_cells, changed_ghosts);
@@ -388,10 +479,12 @@ private:
                 const double v = law(f, excess);
                 s.flux[f] = v;
                 if (v == 0.0) continue;
-                moved = true;
-                max_excess = std::max(max_excess, excess);
+                if (f < m.live_faces) {
+                    moved = true;
+                    max_excess = std::max(max_excess, excess);
+                }
                 for (const std::int64_t e : {m.face_a[f], m.face_b[f]})
-                    if (e >= 0 && e < m.owned && s.cell_seen[e] != update_stamp) {
+                    if (e >= 0 && cell_in_reach(e) && s.cell_seen[e] != update_stamp) {
                         s.cell_seen[e] = update_stamp;
                         s.update_cells.push_back(e);
                     }
@@ -402,6 +495,12 @@ private:
                     s.cell_seen[c] = update_stamp;
                     s.update_cells.push_back(c);
                 }
+            if (in_batch)
+                for (const std::int64_t c : s.ghost_source_cells)
+                    if (cell_in_reach(c) && s.cell_seen[c] != update_stamp) {
+                        s.cell_seen[c] = update_stamp;
+                        s.update_cells.push_back(c);
+                    }
             for (const std::int64_t c : s.update_cells) {
                 if (kind[c] != kSand) continue;
                 bool carried = false;
@@ -410,7 +509,12 @@ private:
                 if (rate != 0.0) add_with_residual(h[c], residual[c], dt * rate);
             }
             visited = static_cast<double>(s.gradient_cells.size() + s.update_cells.size() - carried_cells);
-            if (parts) parts->exchange_ghost_heights(grid, &s.update_cells, changed_ghosts);
+            if (in_batch) {
+                for (const std::int64_t c : s.update_cells)
+                    if (c < m.owned && !s.in_batch[c]) s.in_batch[c] = 1, s.batch_cells.push_back(c);
+            } else if (parts) {
+                parts->exchange_ghost_heights(grid, &s.update_cells, changed_ghosts);
+            }
             act.cool_all();
             for (const std::int64_t c : s.update_cells) act.wake_around(m, c);
             for (const std::int64_t c : changed_ghosts) act.wake_around(m, c);
@@ -427,10 +531,12 @@ private:
         }
         if (record) {
             std::vector<double> &faces = grid.face_fluxes().x;
+            // A part records the faces of its owned cells only (those beyond carry nothing here).
             if (dense) {
-                for (std::int64_t f = 0; f < m.faces; ++f) faces[f] += s.flux[f] * dt;
+                for (std::int64_t f = 0; f < m.live_faces; ++f) faces[f] += s.flux[f] * dt;
             } else {
-                for (const std::int64_t f : s.faces) faces[f] += s.flux[f] * dt;
+                for (const std::int64_t f : s.faces)
+                    if (f < m.live_faces) faces[f] += s.flux[f] * dt;
             }
         }
         if (!dense)

@@ -81,6 +81,8 @@ struct StepInfo {
     // On a distributed grid, this rank's own: its cell updates, and the
     // messages and bytes of ghost cells' values it sent (0 on a serial grid).
     double rank_cell_updates = 0.0, messages_sent = 0.0, bytes_sent = 0.0;
+    // Sub-steps between two exchanges of ghost values (0 on a serial grid).
+    double substeps_per_exchange = 0.0;
 };
 
 // Everything of a grid besides its geometry that later results depend on, as

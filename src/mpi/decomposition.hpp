@@ -137,6 +137,9 @@ public:
         bytes = bytes_sent_;
         messages_sent_ = bytes_sent_ = 0.0;
     }
+    // The sub-steps taken between two exchanges of ghost values: a block of
+    // a grid refreshes its halo in every sub-step.
+    virtual double substeps_per_exchange(const Grid &) const { return 1.0; }
     // Collective: the sum over all ranks, the same on every rank.
     virtual double sum(double local) const = 0;
     // Collective: as sum(), for a call that a rank may have refused (its

@@ -30,6 +30,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstdlib>
 #include <limits>
 #include <memory>
 #include <sstream>
@@ -176,6 +177,7 @@ struct PartLinks {
     CellLists send_heights, receive_heights;      // every ghost
     CellLists send_gradients, receive_gradients;  // the ghosts across a face from an owned cell
     std::int64_t global_cells = 0;
+    int edge_faces = 0;  // the most faces on the domain edge of any cell, over all ranks
 };
 
 // Checks the owners and the ghosts of all ranks' parts together, learns each
@@ -340,6 +342,20 @@ PartLinks link_parts(MPI_Comm comm, Mesh &m, const std::vector<int> &owner_of_ce
     check_mpi(MPI_Allreduce(MPI_IN_PLACE, smallest, 2, MPI_DOUBLE, MPI_MIN, comm), "MPI_Allreduce of the scales");
     m.step_scale = smallest[0];
     m.min_distance = smallest[1];
+    // Sub-steps per exchange: as many as every rank's ghost layer allows
+    // (mesh.cpp, set_reach), at most DPSM_MPI_SUBSTEPS_PER_EXCHANGE (0: the
+    // two exchanges in every sub-step, for comparisons).
+    int most[2] = {-m.substeps_per_exchange, 0};
+    for (std::int64_t c = 0; c < m.cells; ++c) {
+        int edges = 0;
+        for (std::int64_t k = m.cell_face_start[c]; k < m.cell_face_start[c + 1]; ++k) edges += m.other[k] < 0;
+        most[1] = std::max(most[1], edges);
+    }
+    if (const char *limit = std::getenv("DPSM_MPI_SUBSTEPS_PER_EXCHANGE"))
+        if (*limit) most[0] = std::max(most[0], -std::max(0, std::atoi(limit)));
+    check_mpi(MPI_Allreduce(MPI_IN_PLACE, most, 2, MPI_INT, MPI_MAX, comm), "MPI_Allreduce of the ghost layers' reach");
+    m.substeps_per_exchange = -most[0];
+    links.edge_faces = most[1];
 
     for (int r = 0; r < size; ++r) {
         const std::vector<std::int64_t> &ghosts = ghosts_of[static_cast<std::size_t>(r)];
@@ -365,6 +381,7 @@ public:
           gradient_slots_(links_.send_gradients, owned),
           sent_h_(links_.send_heights.cells.size(), 0.0),
           sent_moving_(links_.send_heights.cells.size(), 0.0),
+          sent_residual_(links_.send_heights.cells.size(), 0.0),
           sent_gx_(links_.send_gradients.cells.size(), 0.0),
           sent_gy_(links_.send_gradients.cells.size(), 0.0) {
         // Ghosts' gradients start at 0 on every rank (mesh_engine.cpp), as sent_gx_ and sent_gy_ do.
@@ -385,13 +402,21 @@ public:
                                      static_cast<double>(grid.relaxation())};
         const std::vector<double> state = local_state(grid);
         flags.insert(flags.end(), state.begin(), state.end());
+        // Whether a host changed edge kinds or levels (read on the ghosts' edge faces when they are stepped here).
+        const bool steps_ghosts = grid.geometry().mesh->substeps_per_exchange > 0;
+        flags.push_back(steps_ghosts && (grid.edges_version() != exchanged_edges_ ||
+                                         grid.side_levels_version() != exchanged_levels_)
+                            ? 1.0
+                            : 0.0);
         // The relaxation mode: every rank steps in time or every rank relaxes.
         flags.push_back(-static_cast<double>(grid.relaxation()));
         std::vector<double> v = agree_on_step(grid, dt, refused, flags);
         if (v[2] != -v.back())
             throw Error(DPSM_ERR_INVALID_VALUE, "dpsm_step: the ranks of the distributed mesh differ in the relaxation "
                                                 "(dpsm_set_relaxation); every rank must step the same way");
-        std::vector<double> agreed(v.begin() + 3, v.end() - 1);
+        const bool edges_changed = v[v.size() - 2] != 0.0;
+        std::vector<double> agreed(v.begin() + 3, v.end() - 2);
+        if (edges_changed) exchange_edges(grid);
         if (v[0] != 0.0 || v[1] != 0.0) {
             // A host changed something on some rank: the ghosts take their owners' values, then the flags again.
             if (v[0] != 0.0) exchange_masks(grid);
@@ -418,6 +443,13 @@ public:
 
     void before_sweep(Grid &) override {}
 
+    // K sub-steps per exchange where the ghost layer allows K >= 1, else an
+    // exchange of gradients and one of heights in every sub-step.
+    double substeps_per_exchange(const Grid &grid) const override {
+        const int k = grid.geometry().mesh->substeps_per_exchange;
+        return k > 0 ? static_cast<double>(k) : 0.5;
+    }
+
     // Point-to-point, each value only when it changed since it was last sent
     // (the ghost's copy on the other rank is then that value): a part whose
     // cells near its neighbours are at rest sends nothing.
@@ -440,21 +472,32 @@ public:
     void exchange_ghost_heights(Grid &grid, const std::vector<std::int64_t> *computed,
                                 std::vector<std::int64_t> &changed_ghosts) override {
         std::vector<double> &h = grid.heights_for_stepping();
+        std::vector<float> &residual = grid.residuals_for_stepping();
         const bool hysteresis = grid.hysteresis();
         std::vector<std::uint8_t> &moving = grid.moving_for_stepping();
-        const int width = hysteresis ? 2 : 1;
+        // A part that steps its ghosts needs their residuals too (the next
+        // update adds to them), in the message's last place.
+        const bool residuals = grid.geometry().mesh->substeps_per_exchange > 0;
+        const int width = 1 + hysteresis + residuals;
         send_changes(links_.send_heights, height_slots_, computed, width, kTagHeights,
                      [&](std::size_t slot, std::int64_t c, double *out) {
                          const double flag = hysteresis ? moving[c] : 0.0;
-                         if (h[c] == sent_h_[slot] && flag == sent_moving_[slot]) return false;
+                         const double rest = residuals ? residual[c] : 0.0;
+                         if (h[c] == sent_h_[slot] && flag == sent_moving_[slot] && rest == sent_residual_[slot])
+                             return false;
                          out[0] = sent_h_[slot] = h[c];
                          if (hysteresis) out[1] = sent_moving_[slot] = flag;
+                         if (residuals) out[width - 1] = sent_residual_[slot] = rest;
                          return true;
                      });
         receive_changes(links_.receive_heights, width, kTagHeights, [&](std::int64_t c, const double *in) {
+            // A ghost stepped here already holds its owner's values: it changed only beyond reach.
+            const bool changed = h[c] != in[0] || (hysteresis && moving[c] != in[1]) ||
+                                 (residuals && residual[c] != static_cast<float>(in[width - 1]));
             h[c] = in[0];
             if (hysteresis) moving[c] = static_cast<std::uint8_t>(in[1]);
-            changed_ghosts.push_back(c);
+            if (residuals) residual[c] = static_cast<float>(in[width - 1]);
+            if (changed) changed_ghosts.push_back(c);
         });
     }
 
@@ -520,23 +563,68 @@ private:
     // cells that read them, and what was sent is what the ghosts now hold.
     void send_all_heights(Grid &grid) {
         std::vector<double> &h = grid.heights_for_stepping();
+        std::vector<float> &residual = grid.residuals_for_stepping();
         std::vector<std::uint8_t> &moving = grid.moving_for_stepping();
         const bool hysteresis = grid.hysteresis();
         const Mesh &m = *grid.geometry().mesh;
+        const bool residuals = m.substeps_per_exchange > 0;
         MeshActivity &activity = grid.mesh_activity();
-        exchange(links_.send_heights, links_.receive_heights, 2,
-                 [&](std::int64_t c, double *out) { out[0] = h[c], out[1] = hysteresis ? moving[c] : 0.0; },
+        exchange(links_.send_heights, links_.receive_heights, 3,
+                 [&](std::int64_t c, double *out) {
+                     out[0] = h[c], out[1] = hysteresis ? moving[c] : 0.0, out[2] = residuals ? residual[c] : 0.0;
+                 },
                  [&](std::int64_t c, const double *in) {
                      const bool changed = h[c] != in[0] || (hysteresis && moving[c] != in[1]);
                      h[c] = in[0];
                      if (hysteresis) moving[c] = static_cast<std::uint8_t>(in[1]);
+                     if (residuals) residual[c] = static_cast<float>(in[2]);
                      if (changed) activity.wake_around(m, c);
                  });
         for (std::size_t slot = 0; slot < links_.send_heights.cells.size(); ++slot) {
             const std::int64_t c = links_.send_heights.cells[slot];
             sent_h_[slot] = h[c];
             sent_moving_[slot] = hysteresis ? moving[c] : 0.0;
+            sent_residual_[slot] = residuals ? residual[c] : 0.0;
         }
+    }
+
+    // The kinds and levels of the ghosts' faces on the domain edge from
+    // their owners, for the ghosts stepped here: each cell's edge faces in
+    // the order its sums take them (their midpoints), alike on both ranks
+    // when the ghost's faces are all here. Set as a host would set them.
+    void exchange_edges(Grid &grid) {
+        const Mesh &m = *grid.geometry().mesh;
+        const std::size_t most = static_cast<std::size_t>(links_.edge_faces);
+        const std::vector<double> &levels = grid.side_levels(0);
+        std::vector<std::uint8_t> open(static_cast<std::size_t>(m.faces));
+        for (std::int64_t f = 0; f < m.faces; ++f) open[f] = m.face_b[f] < 0 && grid.edge_open(f);
+        std::vector<double> level = levels.empty() ? std::vector<double>(static_cast<std::size_t>(m.faces), 0.0) : levels;
+        const auto edge_faces = [&](std::int64_t c, std::vector<std::int64_t> &out) {
+            out.clear();
+            for (std::int64_t k = m.cell_face_start[c]; k < m.cell_face_start[c + 1]; ++k)
+                if (m.other[k] < 0) out.push_back(m.cell_faces[k]);
+        };
+        std::vector<std::int64_t> faces;
+        const std::vector<std::uint8_t> open_before = open;
+        const std::vector<double> level_before = level;
+        if (most > 0)
+            exchange(links_.send_heights, links_.receive_heights, static_cast<int>(2 * most),
+                     [&](std::int64_t c, double *out) {
+                         edge_faces(c, faces);
+                         std::fill(out, out + 2 * most, 0.0);
+                         for (std::size_t k = 0; k < faces.size(); ++k)
+                             out[2 * k] = open[faces[k]], out[2 * k + 1] = level[faces[k]];
+                     },
+                     [&](std::int64_t c, const double *in) {
+                         if (m.reach[static_cast<std::size_t>(c)] < 1) return;  // not stepped here
+                         edge_faces(c, faces);
+                         for (std::size_t k = 0; k < faces.size(); ++k)
+                             open[faces[k]] = in[2 * k] != 0.0, level[faces[k]] = in[2 * k + 1];
+                     });
+        if (open != open_before) grid.set_edge_open(open.data());
+        if (level != level_before) grid.set_side_levels(0, level.data());
+        exchanged_edges_ = grid.edges_version();
+        exchanged_levels_ = grid.side_levels_version();
     }
 
     // Packs, for each neighbour, the listed cells' values that `pack(slot, c,
@@ -716,7 +804,7 @@ private:
     // Per owned cell, the places it has in the lists sent to neighbours.
     SendSlots height_slots_, gradient_slots_;
     // Per place in those lists, the value last sent (the ghost's copy).
-    std::vector<double> sent_h_, sent_moving_, sent_gx_, sent_gy_;
+    std::vector<double> sent_h_, sent_moving_, sent_residual_, sent_gx_, sent_gy_;
     std::vector<std::vector<double>> outgoing_;
     std::vector<double> incoming_, whole_;
     std::vector<MPI_Request> sends_;
@@ -724,6 +812,8 @@ private:
     std::vector<int> send_counts_, send_offsets_, receive_counts_, receive_offsets_;
     std::uint64_t exchanged_masks_ = std::numeric_limits<std::uint64_t>::max();    // none yet
     std::uint64_t exchanged_heights_ = std::numeric_limits<std::uint64_t>::max();  // none yet
+    std::uint64_t exchanged_edges_ = std::numeric_limits<std::uint64_t>::max();    // none yet
+    std::uint64_t exchanged_levels_ = std::numeric_limits<std::uint64_t>::max();   // none yet
     HeldLevels held_;
 };
 

@@ -221,6 +221,7 @@ void step_in_time(Grid &grid, double dt, std::int64_t most) {
     if (Decomposition *decomposition = grid.decomposition()) {
         info.cell_updates = grid.global_sum(info.cell_updates);
         decomposition->take_traffic(info.messages_sent, info.bytes_sent);
+        info.substeps_per_exchange = decomposition->substeps_per_exchange(grid);
     }
     const bool whole_dt = source_active || !(info.at_rest || !bounded);
     info.time_integrated = whole_dt ? dt : static_cast<double>(info.substeps) * sub_dt;

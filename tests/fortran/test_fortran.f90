@@ -239,6 +239,8 @@ contains
     call expect(slope_excess == value, 'INFO_RANK_CELL_UPDATES of a serial grid is INFO_CELL_UPDATES')
     call dpsm_get_step_info(g, DPSM_INFO_MESSAGES_SENT, value)
     call expect(value == 0, 'INFO_MESSAGES_SENT is 0 on a serial grid')
+    call dpsm_get_step_info(g, DPSM_INFO_SUBSTEPS_PER_EXCHANGE, value)
+    call expect(value == 0, 'INFO_SUBSTEPS_PER_EXCHANGE is 0 on a serial grid')
     call dpsm_get_step_info(g, DPSM_INFO_MAX_EXCESS_SLOPE, slope_excess)
     call expect(slope_excess == 0, 'INFO_MAX_EXCESS_SLOPE is 0 at rest: no face carried sand')
     call dpsm_get_heights(g, h2)

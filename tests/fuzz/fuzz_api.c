@@ -154,7 +154,9 @@ typedef struct {
 } slot_t;
 
 /* The step information items this header knows (a newer header may add some). */
-#if defined(DPSM_INFO_BYTES_SENT)
+#if defined(DPSM_INFO_SUBSTEPS_PER_EXCHANGE)
+#define NINFO (DPSM_INFO_SUBSTEPS_PER_EXCHANGE + 1)
+#elif defined(DPSM_INFO_BYTES_SENT)
 #define NINFO (DPSM_INFO_BYTES_SENT + 1)
 #elif defined(DPSM_INFO_CELL_UPDATES)
 #define NINFO (DPSM_INFO_CELL_UPDATES + 1)
@@ -219,7 +221,8 @@ static void same_but_fluxes(const slot_t *s, const snap_t *a, const snap_t *b, i
         if (memcmp(&a->mass[q], &b->mass[q], sizeof(double)) != 0)
             die("%s: mass %s differs: %.17g vs %.17g", what, mass_names[q], a->mass[q], b->mass[q]);
     static const char *const info_names[] = {"SUBSTEPS", "TIME_INTEGRATED", "AT_REST", "MAX_EXCESS_SLOPE",
-                                             "CELL_UPDATES", "RANK_CELL_UPDATES", "MESSAGES_SENT", "BYTES_SENT"};
+                                             "CELL_UPDATES", "RANK_CELL_UPDATES", "MESSAGES_SENT", "BYTES_SENT",
+                                             "SUBSTEPS_PER_EXCHANGE"};
     for (int i = 0; i < NINFO; ++i)
         if (memcmp(&a->info[i], &b->info[i], sizeof(double)) != 0)
             die("%s: step info %s differs: %.17g vs %.17g", what, info_names[i], a->info[i], b->info[i]);

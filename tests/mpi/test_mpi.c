@@ -422,6 +422,10 @@ static void compare_step_info(const dpsm_grid *g, const dpsm_grid *serial, const
         OK(serial, dpsm_get_step_info(serial, items[k], &b));
         require(a == b, "%s: step info %s is %.17g distributed, %.17g serial", what, names[k], a, b);
     }
+    double per_exchange = -1.0;
+    OK(g, dpsm_get_step_info(g, DPSM_INFO_SUBSTEPS_PER_EXCHANGE, &per_exchange));
+    require(per_exchange == 1.0, "%s: a distributed 2D grid exchanged its halo every %g sub-steps, not every one", what,
+            per_exchange);
 }
 
 static void compare_mass(const dpsm_grid *g, const dpsm_grid *serial, const char *what) {

@@ -5,14 +5,18 @@
  * lattice of triangles (whose gradients read two rings of cells) or of quads
  * (one ring). Every rank owns the cells a partition gives it (METIS's, when
  * the test is built with METIS, a random one, and strips) and holds the cells
- * within two faces of them as ghosts, in a shuffled local order, with
- * deliberately wrong values in the ghosts' slots of every array. Each rank
+ * within two faces of them as ghosts (and, in a second run, within five or
+ * seven faces: a deep layer, over which a rank takes several sub-steps per
+ * exchange), in a shuffled local order, with deliberately wrong values in
+ * the ghosts' slots of every array (edge faces included). Each rank
  * also runs the scene alone on a serial mesh of all cells and requires,
  * after every step:
  *   - its owned and ghost cells' heights equal the serial heights bit for bit;
  *   - the step information equals the serial figures;
  *   - the mass figures equal the serial ones to 1e-12 of the mass;
  *   - the faces of its owned cells carried what the serial faces did, bit for bit.
+ *   - with a deep layer, several sub-steps per exchange and at most one
+ *     message to each other rank per batch of sub-steps.
  * Then a refusing rank and inconsistent partitions must fail on every rank
  * with a message naming the problem.
  */
@@ -341,6 +345,7 @@ typedef struct {
     const int64_t *global;  /* local -> global cell; NULL: the serial mesh */
     const int *owner;
     int64_t *face_nodes;    /* per face, its global node pair */
+    const int64_t *face_cells;  /* per face, its two local cells (a part's only) */
 } run_t;
 
 /* Sets the scene on a grid; ghost slots get wrong but valid values. */
@@ -379,8 +384,10 @@ static void set_scene(const mesh_t *m, int scene, run_t *r) {
         double *levels = xcalloc((size_t)r->nfaces, sizeof(double));
         for (int64_t f = 0; f < r->nfaces; ++f) {
             const double x = 0.5 * (m->node_xy[2 * r->face_nodes[2 * f]] + m->node_xy[2 * r->face_nodes[2 * f + 1]]);
-            edge[f] = x < 0.5 ? DPSM_OPEN : DPSM_WALL;
-            levels[f] = scene == SCENE_PHYSICS ? 0.08 + 0.02 * x : 0.0;
+            /* a ghost's edge face: its owner's kind and level count, not these */
+            const int ghost = !serial && r->owner[r->face_cells[2 * f]] != rank_;
+            edge[f] = (x < 0.5) != ghost ? DPSM_OPEN : DPSM_WALL;
+            levels[f] = ghost ? 0.5 : scene == SCENE_PHYSICS ? 0.08 + 0.02 * x : 0.0;
         }
         OK(r->g, dpsm_set_edge_kinds(r->g, edge));
         OK(r->g, dpsm_set_side_levels(r->g, DPSM_MESH_EDGE, levels));
@@ -420,16 +427,55 @@ static void compare_faces(const run_t *serial, const run_t *part, const int64_t 
     free(fs), free(fp);
 }
 
-static void run_scene(const mesh_t *m, int scene, int kind, int graph) {
+/* The sub-steps between two exchanges of the last run_scene (the same on every rank). */
+static double per_exchange_;
+/* DPSM_MPI_SUBSTEPS_PER_EXCHANGE as set for the parts made (-1: not set). */
+static int substeps_limit_ = -1;
+
+/* A part with two layers of ghosts exchanges in every sub-step; with a deep
+ * layer, several sub-steps per exchange: after the first step (where the
+ * host's settings travel too) a rank sends at most one message to each other
+ * rank per batch of sub-steps, the last batch possibly short, and one more
+ * where the step ends at rest (relaxation: a last sub-step finds no sand
+ * moving). */
+static void check_exchanges(const dpsm_grid *part, int layers, int step, const char *at) {
+    double per_exchange = -1.0, substeps = 0.0, messages = 0.0;
+    OK(part, dpsm_get_step_info(part, DPSM_INFO_SUBSTEPS_PER_EXCHANGE, &per_exchange));
+    OK(part, dpsm_get_step_info(part, DPSM_INFO_SUBSTEPS, &substeps));
+    OK(part, dpsm_get_step_info(part, DPSM_INFO_MESSAGES_SENT, &messages));
+    per_exchange_ = per_exchange;
+    if (substeps_limit_ >= 0) {
+        const double want = substeps_limit_ == 0 ? 0.5 : substeps_limit_;
+        require(per_exchange == want, "%s: DPSM_MPI_SUBSTEPS_PER_EXCHANGE=%d gave %g sub-steps per exchange", at,
+                substeps_limit_, per_exchange);
+        return;
+    }
+    if (size_ == 1) {
+        require(per_exchange >= 1.0, "%s: one rank exchanges nothing, yet every %g sub-steps", at, per_exchange);
+        return;
+    }
+    if (layers <= 2) {
+        require(per_exchange <= 1.0, "%s: two layers of ghosts give %g sub-steps per exchange", at, per_exchange);
+        return;
+    }
+    require(per_exchange >= 2.0, "%s: %d layers of ghosts give %g sub-steps per exchange, not several", at, layers,
+            per_exchange);
+    const double batches = ceil((substeps + 1.0) / fmax(per_exchange, 1.0));
+    require(step == 0 || messages <= (size_ - 1) * batches,
+            "%s: %g messages for %g sub-steps at %g per exchange to %d other ranks", at, messages, substeps,
+            per_exchange, size_ - 1);
+}
+
+static void run_scene(const mesh_t *m, int scene, int kind, int graph, int layers) {
     int *owner = xcalloc((size_t)m->ncells, sizeof(int));
     if (!partition(m, kind, owner)) {
         free(owner);
         return;
     }
-    part_t p = part_of(m, owner, 2);
+    part_t p = part_of(m, owner, layers);
     char where[256];
-    snprintf(where, sizeof where, "%s, %s partition, %s", scene_names[scene], partition_names[kind],
-             graph ? "graph" : "polygons");
+    snprintf(where, sizeof where, "%s, %s partition, %s, %d layers of ghosts", scene_names[scene],
+             partition_names[kind], graph ? "graph" : "polygons", layers);
     run_t serial = {0}, part = {0};
     OK(NULL, dpsm_create_mesh(m->nnodes, m->node_xy, m->ncells, m->cell_start, m->cell_nodes, &serial.g));
     serial.ncells = m->ncells;
@@ -457,7 +503,7 @@ static void run_scene(const mesh_t *m, int scene, int kind, int graph) {
             const int64_t a = serial_cells[2 * s], b = serial_cells[2 * s + 1];
             const int64_t la = p.local[a], lb = b < 0 ? -1 : p.local[b];
             if (la < 0 || (b >= 0 && lb < 0)) continue;
-            if (b < 0 && owner[a] != rank_) continue;  /* a ghost's edge faces need not be given */
+            if (b < 0 && owner[a] != rank_ && layers <= 2) continue;  /* a ghost's edge faces need not be given */
             const int64_t u = serial.face_nodes[2 * s], w = serial.face_nodes[2 * s + 1];
             fc[2 * nfaces] = la, fc[2 * nfaces + 1] = lb;
             fxy[2 * nfaces] = 0.5 * (m->node_xy[2 * u] + m->node_xy[2 * w]);
@@ -503,11 +549,12 @@ static void run_scene(const mesh_t *m, int scene, int kind, int graph) {
         for (int64_t s = 0; s < serial.nfaces; ++s) {
             const int64_t a = serial_cells[2 * s], b = serial_cells[2 * s + 1];
             const int64_t la = p.local[a], lb = b < 0 ? -1 : p.local[b];
-            if (la < 0 || (b >= 0 && lb < 0) || (b < 0 && owner[a] != rank_)) continue;
+            if (la < 0 || (b >= 0 && lb < 0) || (b < 0 && owner[a] != rank_ && layers <= 2)) continue;
             part.face_nodes[2 * next] = serial.face_nodes[2 * s], part.face_nodes[2 * next + 1] = serial.face_nodes[2 * s + 1];
             ++next;
         }
     }
+    part.face_cells = part_cells;
     set_scene(m, scene, &serial);
     set_scene(m, scene, &part);
     double *hs = xcalloc((size_t)m->ncells, sizeof(double)), *hp = xcalloc((size_t)p.ncells, sizeof(double));
@@ -575,6 +622,7 @@ static void run_scene(const mesh_t *m, int scene, int kind, int graph) {
         require(fabs(edge_s - edge_p) <= 1e-12 * fmax(1.0, fabs(total)), "%s: edge outflow %.17g, serial %.17g", at,
                 edge_p, edge_s);
         if (scene != SCENE_TO_REST) compare_faces(&serial, &part, serial_cells, part_cells, at);
+        check_exchanges(part.g, layers, step, at);
     }
     free(hs), free(hp), free(part_cells);
     dpsm_destroy(loaded);
@@ -796,16 +844,39 @@ int main(int argc, char **argv) {
         mesh_t m = lattice(shape == 0 ? 14 : 12, shape == 0);
         for (int scene = 0; scene < N_SCENES; ++scene)
             for (int kind = 0; kind < N_PARTITIONS; ++kind)
-                for (int graph = 0; graph < 2; ++graph) {
-                    long before = failures_, mine, total = 0;
-                    run_scene(&m, scene, kind, graph);
-                    mine = failures_ - before;
-                    MPI_Allreduce(&mine, &total, 1, MPI_LONG, MPI_SUM, MPI_COMM_WORLD);
-                    if (rank_ == 0)
-                        printf("  %s, %s: %s, %s partition, %s: %s\n", shape == 0 ? "triangles" : "quads",
-                               scene_names[scene], graph ? "graph" : "polygons", partition_names[kind],
-                               total == 0 ? "heights bit for bit" : "FAILED", total == 0 ? "" : "see above");
-                }
+                for (int graph = 0; graph < 2; ++graph)
+                    for (int deep = 0; deep < 2; ++deep) {
+                        /* Two layers of ghosts (one exchange per sub-step) and a deep layer (several sub-steps per exchange). */
+                        const int layers = deep ? (shape == 0 ? 7 : 5) : 2;
+                        long before = failures_, mine, total = 0;
+                        run_scene(&m, scene, kind, graph, layers);
+                        mine = failures_ - before;
+                        MPI_Allreduce(&mine, &total, 1, MPI_LONG, MPI_SUM, MPI_COMM_WORLD);
+                        if (rank_ == 0)
+                            printf("  %s, %s: %s, %s partition, %d layers of ghosts (%g sub-steps per exchange): "
+                                   "%s%s\n",
+                                   shape == 0 ? "triangles" : "quads", scene_names[scene], graph ? "graph" : "polygons",
+                                   partition_names[kind], layers, per_exchange_,
+                                   total == 0 ? "heights bit for bit" : "FAILED", total == 0 ? "" : ", see above");
+                    }
+        if (shape == 0) {
+            /* A deep layer held to fewer sub-steps per exchange by the environment, for comparisons. */
+            for (substeps_limit_ = 0; substeps_limit_ <= 1; ++substeps_limit_) {
+                char value[16];
+                snprintf(value, sizeof value, "%d", substeps_limit_);
+                setenv("DPSM_MPI_SUBSTEPS_PER_EXCHANGE", value, 1);
+                const long before = failures_;
+                run_scene(&m, SCENE_PHYSICS, PART_METIS, 0, 7);
+                long mine = failures_ - before, total = 0;
+                MPI_Allreduce(&mine, &total, 1, MPI_LONG, MPI_SUM, MPI_COMM_WORLD);
+                if (rank_ == 0)
+                    printf("  triangles, %s: 7 layers of ghosts, DPSM_MPI_SUBSTEPS_PER_EXCHANGE=%s (%g sub-steps per "
+                           "exchange): %s\n", scene_names[SCENE_PHYSICS], value, per_exchange_,
+                           total == 0 ? "heights bit for bit" : "FAILED, see above");
+            }
+            unsetenv("DPSM_MPI_SUBSTEPS_PER_EXCHANGE");
+            substeps_limit_ = -1;
+        }
         free_mesh(&m);
     }
     {

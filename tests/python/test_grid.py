@@ -278,9 +278,9 @@ class Test2D(LedgerMixin, unittest.TestCase):
         g = self.g
         g.set_repose_angle(0.6)
         for item in (dpsm.INFO_SUBSTEPS, dpsm.INFO_TIME_INTEGRATED, dpsm.INFO_AT_REST, dpsm.INFO_MAX_EXCESS_SLOPE,
-                     dpsm.INFO_CELL_UPDATES, dpsm.INFO_RANK_CELL_UPDATES, dpsm.INFO_MESSAGES_SENT, dpsm.INFO_BYTES_SENT):
+                     dpsm.INFO_CELL_UPDATES, dpsm.INFO_RANK_CELL_UPDATES, dpsm.INFO_MESSAGES_SENT, dpsm.INFO_BYTES_SENT, dpsm.INFO_SUBSTEPS_PER_EXCHANGE):
             self.assertEqual(g.get_step_info(item), 0.0)
-        self.assertFails(dpsm.ERR_UNKNOWN_ENUM, g.get_step_info, 9)
+        self.assertFails(dpsm.ERR_UNKNOWN_ENUM, g.get_step_info, dpsm.INFO_SUBSTEPS_PER_EXCHANGE + 1)
         g.set_heights(self.cone)
         total = g.get_mass(dpsm.MASS_TOTAL)
         g.step(100.0)

@@ -98,6 +98,8 @@ DPSM_INFO_RANK_CELL_UPDATES = 5
 DPSM_INFO_MESSAGES_SENT = 6
 ## Step information: DPSM_INFO_BYTES_SENT, as in dpsm.h.
 DPSM_INFO_BYTES_SENT = 7
+## Step information: DPSM_INFO_SUBSTEPS_PER_EXCHANGE, as in dpsm.h.
+DPSM_INFO_SUBSTEPS_PER_EXCHANGE = 8
 
 # Defaults.
 ## Defaults: DPSM_DEFAULT_REPOSE_ANGLE, as in dpsm.h.

@@ -1139,7 +1139,7 @@ class Grid:
         """``dpsm_get_step_info``: ``INFO_SUBSTEPS``, ``INFO_TIME_INTEGRATED``,
         ``INFO_AT_REST``, ``INFO_MAX_EXCESS_SLOPE``, ``INFO_CELL_UPDATES``, and on
         a distributed grid this rank's ``INFO_RANK_CELL_UPDATES``, ``INFO_MESSAGES_SENT``
-        and ``INFO_BYTES_SENT``, of the last step."""
+        and ``INFO_BYTES_SENT``, and ``INFO_SUBSTEPS_PER_EXCHANGE``, of the last step."""
         f = "dpsm_get_step_info"
         value = ctypes.c_double()
         self._call(f, _c_int(item, "item", f, C.DPSM_ERR_UNKNOWN_ENUM), ctypes.byref(value))
