@@ -4,7 +4,7 @@
  * mpiexec (bench/run_mpi_scaling.sh); prints one CSV line on rank 0 (a log on
  * stderr). Never run by the tests.
  *
- *   mpiexec -n P dpsm-bench-mpi-mesh N [STEPS]   2 N^2 triangles (N = 708: 1,002,528 cells)
+ *   mpiexec -n P dpsm-bench-mpi-mesh N [STEPS [LAYERS]]   2 N^2 triangles (N = 708: 1,002,528 cells)
  *
  * The scene is fully active (a plane steeper than the angle of repose with
  * ripples, the domain edge open), so every sub-step moves sand everywhere.
@@ -16,6 +16,10 @@
  * distributed part takes beyond that. Machine-independent counts go beside:
  * owned and ghost cells, neighbouring ranks, and the messages and bytes a
  * rank sent per sub-step (DPSM_INFO_MESSAGES_SENT, DPSM_INFO_BYTES_SENT).
+ * LAYERS (default 2, the least dpsm needs) is the depth of each rank's ghost
+ * layer in faces: a deeper one lets the ranks take several sub-steps per
+ * exchange (DPSM_INFO_SUBSTEPS_PER_EXCHANGE, in the line) at the price of
+ * stepping the ghosts near their parts too (the cell updates per sub-step).
  *
  *   mpiexec -n P dpsm-bench-mpi-mesh N STEPS corner|centre
  *
@@ -134,12 +138,12 @@ typedef struct {
     int *owner;
 } part_t;
 
-/* The cells METIS gives this rank and the two layers of ghosts around them. */
-static part_t part_of(const mesh_t *m, const int *owner) {
+/* The cells METIS gives this rank and `layers` layers of ghosts around them. */
+static part_t part_of(const mesh_t *m, const int *owner, int layers) {
     part_t p = {0, 0, 0, NULL, NULL};
     int *depth = xcalloc((size_t)m->ncells, sizeof(int));
     for (int64_t c = 0; c < m->ncells; ++c) depth[c] = owner[c] == rank_ ? 0 : -1;
-    for (int d = 1; d <= 2; ++d)
+    for (int d = 1; d <= layers; ++d)
         for (int64_t c = 0; c < m->ncells; ++c)
             if (depth[c] == d - 1)
                 for (int64_t k = m->adj_start[c]; k < m->adj_start[c + 1]; ++k)
@@ -196,7 +200,7 @@ static dpsm_grid *make_grid(const mesh_t *m, const part_t *p, int distributed, i
 
 /* What this rank did per sub-step over the timed steps (dpsm_get_step_info). */
 typedef struct {
-    double cell_updates, messages, bytes;
+    double cell_updates, messages, bytes, substeps_per_exchange;
 } traffic_t;
 
 /* The slowest rank's seconds per sub-step, best of 3 runs of `steps` steps;
@@ -205,7 +209,7 @@ static double time_substeps(dpsm_grid *g, int steps, double *substeps_per_step, 
     double dt = 0.0;
     CHECK(g, dpsm_stable_dt(g, &dt));
     double best = INFINITY, all_substeps = 0.0;
-    traffic_t sum = {0.0, 0.0, 0.0};
+    traffic_t sum = {0.0, 0.0, 0.0, 0.0};
     for (int run = 0; run < 3; ++run) {
         double substeps = 0.0;
         MPI_Barrier(MPI_COMM_WORLD);
@@ -221,6 +225,7 @@ static double time_substeps(dpsm_grid *g, int steps, double *substeps_per_step, 
             sum.messages += v;
             CHECK(g, dpsm_get_step_info(g, DPSM_INFO_BYTES_SENT, &v));
             sum.bytes += v;
+            CHECK(g, dpsm_get_step_info(g, DPSM_INFO_SUBSTEPS_PER_EXCHANGE, &sum.substeps_per_exchange));
             substeps += k;
             *moving = rest == 0.0;
         }
@@ -234,6 +239,7 @@ static double time_substeps(dpsm_grid *g, int steps, double *substeps_per_step, 
         did->cell_updates = sum.cell_updates / all_substeps;
         did->messages = sum.messages / all_substeps;
         did->bytes = sum.bytes / all_substeps;
+        did->substeps_per_exchange = sum.substeps_per_exchange;
     }
     return best;
 }
@@ -311,9 +317,16 @@ int main(int argc, char **argv) {
         free(xadj), free(adjncy), free(part);
     }
     MPI_Bcast(owner, (int)m.ncells, MPI_INT, 0, MPI_COMM_WORLD);
-    part_t p = part_of(&m, owner);
+    const int local = argc > 3 && (strcmp(argv[3], "corner") == 0 || strcmp(argv[3], "centre") == 0);
+    const int layers = argc > 3 && !local ? atoi(argv[3]) : 2;
+    if (layers < 1) {
+        if (rank_ == 0) fprintf(stderr, "dpsm-bench-mpi-mesh: LAYERS is %s, not a number of layers from 1\n", argv[3]);
+        MPI_Finalize();
+        return 2;
+    }
+    part_t p = part_of(&m, owner, layers);
 
-    if (argc > 3 && (strcmp(argv[3], "corner") == 0 || strcmp(argv[3], "centre") == 0)) {
+    if (local) {
         if (strcmp(argv[3], "centre") == 0) pile_x = pile_y = 0.5 * (double)n;
         local_run(&m, &p, steps, argv[3]);
         free(owner), free(p.global), free(p.owner);
@@ -321,19 +334,12 @@ int main(int argc, char **argv) {
         MPI_Finalize();
         return 0;
     }
-    /* The ranks that hold this rank's cells as ghosts (from the partition). */
+    /* The ranks that own this rank's ghosts (and, layers being alike, hold its cells as ghosts). */
     int64_t neighbours = 0;
     {
         char *to = xcalloc((size_t)size_, 1);
-        for (int64_t c = 0; c < m.ncells; ++c) {
-            if (owner[c] != rank_) continue;
-            for (int64_t k = m.adj_start[c]; k < m.adj_start[c + 1]; ++k) {
-                const int64_t b = m.adj[k];
-                if (owner[b] != rank_) to[owner[b]] = 1;
-                for (int64_t j = m.adj_start[b]; j < m.adj_start[b + 1]; ++j)
-                    if (owner[m.adj[j]] != rank_) to[owner[m.adj[j]]] = 1;
-            }
-        }
+        for (int64_t k = 0; k < p.ncells; ++k)
+            if (p.owner[k] != rank_) to[p.owner[k]] = 1;
         for (int r = 0; r < size_; ++r) neighbours += to[r];
         free(to);
     }
@@ -357,18 +363,20 @@ int main(int argc, char **argv) {
     dpsm_destroy(alone);
 
     /* The largest figures over the ranks (the slowest rank sets the pace). */
-    double v[8] = {(double)p.owned, (double)p.ghosts, (double)neighbours, did.messages, did.bytes,
-                   part_bytes / alone_bytes, moving, moving_alone};
-    MPI_Allreduce(MPI_IN_PLACE, v, 8, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
+    double v[9] = {(double)p.owned, (double)p.ghosts, (double)neighbours, did.messages, did.bytes,
+                   part_bytes / alone_bytes, moving, moving_alone, did.cell_updates};
+    MPI_Allreduce(MPI_IN_PLACE, v, 9, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
     double ratio_min = part_bytes / alone_bytes;
     MPI_Allreduce(MPI_IN_PLACE, &ratio_min, 1, MPI_DOUBLE, MPI_MIN, MPI_COMM_WORLD);
     if (rank_ == 0) {
         fprintf(stderr, "dpsm-bench-mpi-mesh: %d ranks, %lld cells, %.0f sub-steps a step, still moving at the end: %s\n",
                 size_, (long long)m.ncells, per_step, v[6] != 0.0 && v[7] != 0.0 ? "yes" : "NO (not fully active)");
         printf("ranks,cells,owned_max,ghosts_max,neighbours_max,messages_per_substep_max,bytes_per_substep_max,"
-               "seconds_per_substep,alone_seconds_per_substep,communication_share,memory_ratio_min,memory_ratio_max\n");
-        printf("%d,%lld,%.0f,%.0f,%.0f,%.2f,%.0f,%.6e,%.6e,%.3f,%.3f,%.3f\n", size_, (long long)m.ncells, v[0], v[1],
-               v[2], v[3], v[4], distributed, compute, 1.0 - compute / distributed, ratio_min, v[5]);
+               "seconds_per_substep,alone_seconds_per_substep,communication_share,memory_ratio_min,memory_ratio_max,"
+               "layers,substeps_per_exchange,cell_updates_per_substep_max\n");
+        printf("%d,%lld,%.0f,%.0f,%.0f,%.3f,%.0f,%.6e,%.6e,%.3f,%.3f,%.3f,%d,%g,%.0f\n", size_, (long long)m.ncells,
+               v[0], v[1], v[2], v[3], v[4], distributed, compute, 1.0 - compute / distributed, ratio_min, v[5],
+               layers, did.substeps_per_exchange, v[8]);
     }
     free(owner), free(p.global), free(p.owner);
     free(m.node_xy), free(m.cell_nodes), free(m.adj_start), free(m.adj);

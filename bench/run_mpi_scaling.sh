@@ -4,8 +4,9 @@
 # cores of this machine), and the communication alone, into
 # docs/data/mpi_scaling.csv (a log in docs/data/mpi_scaling.log); then the
 # distributed triangle mesh of MESH_N (default 708: 1,002,528 cells) on 1, 2
-# and 4 ranks (oversubscribed past the cores) into
-# docs/data/mpi_mesh_scaling.csv, a local pile on the same mesh (what ranks
+# and 4 ranks (oversubscribed past the cores), with two layers of ghosts and
+# with deeper ones (MESH_LAYERS, default "8 12": 2 and 4 sub-steps per
+# exchange), into docs/data/mpi_mesh_scaling.csv, a local pile on the same mesh (what ranks
 # at rest compute and send) into docs/data/mpi_mesh_rest.csv, and the cost
 # model extrapolated to 1,024 ranks into docs/data/mpi_mesh_model.txt.
 # MESH_ONLY=1 runs the mesh alone.
@@ -39,6 +40,13 @@ mesh_n=${MESH_N:-708}
     [[ $p -gt $(nproc) ]] && bind=none
     mpiexec -n "$p" --oversubscribe --bind-to "$bind" "$mesh_bench" "$mesh_n" 5 | if [[ $head == 1 ]]; then cat; else tail -n 1; fi
     head=0
+  done
+  for layers in ${MESH_LAYERS:-8 12}; do
+    for p in 2 4; do
+      bind=core
+      [[ $p -gt $(nproc) ]] && bind=none
+      mpiexec -n "$p" --oversubscribe --bind-to "$bind" "$mesh_bench" "$mesh_n" 5 "$layers" | tail -n 1
+    done
   done
 } >"$data/mpi_mesh_scaling.csv"
 # A pile near a corner and one at the centre (where the parts meet), the rest
