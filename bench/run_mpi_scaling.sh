@@ -11,7 +11,7 @@
 # model extrapolated to 1,024 ranks into docs/data/mpi_mesh_model.txt.
 # MESH_ONLY=1 runs the mesh alone.
 #
-#   bash bench/run_mpi_scaling.sh      # about a minute on 2 cores
+#   bash bench/run_mpi_scaling.sh      # a few minutes on 2 cores
 #
 # BUILD_DIR (default build-bench) is the build tree. Runs as root too (CI does).
 set -euo pipefail
