@@ -6,7 +6,8 @@
 ! rank's file must fail on every rank; a decomposition with a gap must fail
 ! on every rank with a message that says so. A mesh of quads handed over by
 ! dpsm_create_mesh_mpi (strips of columns, one layer of ghosts, indices and
-! global ids from 1) must equal the serial mesh bit for bit, and a global id
+! global ids from 1) must equal the serial mesh bit for bit and exchange
+! twice a sub-step (DPSM_INFO_SUBSTEPS_PER_EXCHANGE 0.5), and a global id
 ! out of range must fail on every rank naming it from 1.
 program test_mpi_fortran
   use, intrinsic :: iso_c_binding, only: c_double, c_int64_t
@@ -129,7 +130,7 @@ contains
   ! the columns beside them as ghosts; cells numbered row by row from 1.
   subroutine mesh_parts()
     integer, parameter :: m = 16
-    real(c_double) :: node_xy(2, (m + 1)*(m + 1)), hs(m*m), x, y
+    real(c_double) :: node_xy(2, (m + 1)*(m + 1)), hs(m*m), x, y, per_exchange
     integer(c_int64_t) :: cell_start(m*m + 1), cell_nodes(4*m*m)
     integer(c_int64_t), allocatable :: part_start(:), part_nodes(:), global_id(:)
     integer, allocatable :: owner(:)
@@ -197,6 +198,12 @@ contains
           count(hp /= hs(global_id))
       end if
     end do
+    ! One layer of ghosts: a ghost's gradient is its owner's to send, two exchanges a sub-step.
+    call dpsm_get_step_info(part, DPSM_INFO_SUBSTEPS_PER_EXCHANGE, per_exchange)
+    if ((ranks > 1 .and. per_exchange /= 0.5_c_double) .or. (ranks == 1 .and. per_exchange /= 8)) then
+      failures = failures + 1
+      print '(a,i0,a,f0.1)', 'FAIL: rank ', rank, ' one layer of ghosts gave sub-steps per exchange ', per_exchange
+    end if
     call dpsm_destroy(part)
     call dpsm_destroy(whole)
     ! A global id beyond the mesh's m*m cells, named as Fortran counts.

@@ -293,6 +293,8 @@ class TestDistributed2D(MpiTestCase):
                         self.assertEqual(as_list(g.get_heights()), as_list(s.get_heights_region(*block)),
                                          "this rank's block differs from the serial grid")
                         self.assertEqual(g.get_step_info(dpsm.INFO_SUBSTEPS), s.get_step_info(dpsm.INFO_SUBSTEPS))
+                        self.assertEqual(g.get_step_info(dpsm.INFO_SUBSTEPS_PER_EXCHANGE), 1.0,
+                                         "a block exchanges its halo in every sub-step")
                         self.assertTrue(same_on_every_rank, "the global mass differs between ranks")
                         self.assertAlmostEqual(mass, s.get_mass(dpsm.MASS_TOTAL), delta=1e-12 * mass)
                         for mine, serial in outflows:
@@ -358,7 +360,13 @@ class TestDistributedMesh(MpiTestCase):
                         same_on_every_rank = everywhere_equal(mass)
                         ranks_updates = comm.allreduce(g.get_step_info(dpsm.INFO_RANK_CELL_UPDATES))
                         ranks_messages = comm.allreduce(g.get_step_info(dpsm.INFO_MESSAGES_SENT))
+                        per_exchange = g.get_step_info(dpsm.INFO_SUBSTEPS_PER_EXCHANGE)
+                        same_per_exchange = everywhere_equal(per_exchange)
                         with self.subTest(how=how, start_index=start_index, step=n):
+                            # two layers of ghosts on triangles: two exchanges a sub-step (alone: nothing to wait for)
+                            self.assertEqual(per_exchange, 0.5 if SIZE > 1 else 8.0)
+                            self.assertTrue(same_per_exchange, "the ranks differ in their sub-steps per exchange")
+                            self.assertEqual(s.get_step_info(dpsm.INFO_SUBSTEPS_PER_EXCHANGE), 0.0)
                             self.assertEqual((g.kind, g.shape), ("mesh", (len(part.cells),)))
                             self.assertEqual(ranks_updates, g.get_step_info(dpsm.INFO_CELL_UPDATES),
                                              "the ranks' own cell updates do not add up to the step's")
