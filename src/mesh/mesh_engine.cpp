@@ -184,7 +184,7 @@ public:
         if (s.flux.size() != nf) s.flux.assign(nf, 0.0);
         s.face_seen.resize(nf, 0), s.cell_seen.resize(n, 0);
         s.changed.resize(n, 0);
-        s.in_batch.resize(n, 0);
+        if (grid.decomposition()) s.in_batch.resize(n, 0);
         MeshActivity &act = grid.mesh_activity();
         act.hot.resize(n, 0);
         if (!grid.bed().empty()) s.available.resize(n, 0.0);
@@ -344,6 +344,7 @@ private:
         const int threads = grid.step_threads();
         double max_excess = 0.0;
         bool moved = false;
+        const CellUpdate update_cell{m, s.flux.data(), kind.data(), q, grid.bed(), h, residual, dt};
 
         if (dense) {
             // The owned cells and the faces that touch them: all of a serial mesh.
@@ -384,7 +385,6 @@ private:
             }
             s.flux_clean = false;
             std::uint8_t *changed = s.changed.data();
-            const CellUpdate update_cell{m, flux, kind.data(), q, grid.bed(), h, residual, dt};
             std::int64_t changed_cells = 0;
 #pragma omp parallel for num_threads(threads) if (parallel) schedule(static) reduction(+ : changed_cells)
             for (std::int64_t c = 0; c < n; ++c) {
@@ -474,6 +474,12 @@ private:
             // The cells to update: those of faces that carried sand, and the sources.
             const std::uint32_t update_stamp = next_stamp(s);
             s.update_cells.clear();
+            const auto to_update = [&](std::int64_t c) {
+                if (cell_in_reach(c) && s.cell_seen[c] != update_stamp) {
+                    s.cell_seen[c] = update_stamp;
+                    s.update_cells.push_back(c);
+                }
+            };
             for (const std::int64_t f : s.faces) {
                 double excess = 0.0;
                 const double v = law(f, excess);
@@ -484,30 +490,13 @@ private:
                     max_excess = std::max(max_excess, excess);
                 }
                 for (const std::int64_t e : {m.face_a[f], m.face_b[f]})
-                    if (e >= 0 && cell_in_reach(e) && s.cell_seen[e] != update_stamp) {
-                        s.cell_seen[e] = update_stamp;
-                        s.update_cells.push_back(e);
-                    }
+                    if (e >= 0) to_update(e);
             }
             const std::size_t carried_cells = s.update_cells.size();
-            for (const std::int64_t c : s.source_cells)
-                if (s.cell_seen[c] != update_stamp) {
-                    s.cell_seen[c] = update_stamp;
-                    s.update_cells.push_back(c);
-                }
+            for (const std::int64_t c : s.source_cells) to_update(c);
             if (in_batch)
-                for (const std::int64_t c : s.ghost_source_cells)
-                    if (cell_in_reach(c) && s.cell_seen[c] != update_stamp) {
-                        s.cell_seen[c] = update_stamp;
-                        s.update_cells.push_back(c);
-                    }
-            for (const std::int64_t c : s.update_cells) {
-                if (kind[c] != kSand) continue;
-                bool carried = false;
-                double rate = net_rate(m, s.flux.data(), c, carried);
-                if (!q.empty()) rate += q[c];
-                if (rate != 0.0) add_with_residual(h[c], residual[c], dt * rate);
-            }
+                for (const std::int64_t c : s.ghost_source_cells) to_update(c);
+            for (const std::int64_t c : s.update_cells) update_cell(c);
             visited = static_cast<double>(s.gradient_cells.size() + s.update_cells.size() - carried_cells);
             if (in_batch) {
                 for (const std::int64_t c : s.update_cells)

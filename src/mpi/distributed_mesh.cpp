@@ -403,8 +403,7 @@ public:
         const std::vector<double> state = local_state(grid);
         flags.insert(flags.end(), state.begin(), state.end());
         // Whether a host changed edge kinds or levels (read on the ghosts' edge faces when they are stepped here).
-        const bool steps_ghosts = grid.geometry().mesh->substeps_per_exchange > 0;
-        flags.push_back(steps_ghosts && (grid.edges_version() != exchanged_edges_ ||
+        flags.push_back(steps_ghosts(grid) && (grid.edges_version() != exchanged_edges_ ||
                                          grid.side_levels_version() != exchanged_levels_)
                             ? 1.0
                             : 0.0);
@@ -443,6 +442,9 @@ public:
 
     void before_sweep(Grid &) override {}
 
+    // Whether this part steps the ghosts in reach (several sub-steps per exchange, Mesh::reach).
+    static bool steps_ghosts(const Grid &grid) { return grid.geometry().mesh->substeps_per_exchange > 0; }
+
     // K sub-steps per exchange where the ghost layer allows K >= 1, else an
     // exchange of gradients and one of heights in every sub-step.
     double substeps_per_exchange(const Grid &grid) const override {
@@ -477,7 +479,7 @@ public:
         std::vector<std::uint8_t> &moving = grid.moving_for_stepping();
         // A part that steps its ghosts needs their residuals too (the next
         // update adds to them), in the message's last place.
-        const bool residuals = grid.geometry().mesh->substeps_per_exchange > 0;
+        const bool residuals = steps_ghosts(grid);
         const int width = 1 + hysteresis + residuals;
         send_changes(links_.send_heights, height_slots_, computed, width, kTagHeights,
                      [&](std::size_t slot, std::int64_t c, double *out) {
@@ -567,7 +569,7 @@ private:
         std::vector<std::uint8_t> &moving = grid.moving_for_stepping();
         const bool hysteresis = grid.hysteresis();
         const Mesh &m = *grid.geometry().mesh;
-        const bool residuals = m.substeps_per_exchange > 0;
+        const bool residuals = steps_ghosts(grid);
         MeshActivity &activity = grid.mesh_activity();
         exchange(links_.send_heights, links_.receive_heights, 3,
                  [&](std::int64_t c, double *out) {
