@@ -552,10 +552,10 @@ static void test_values_are_checked_behind_the_checksum(void **state) {
     REQUIRE(get_u32(good + kOffsetVersion) == 1, "the small file is of version %u, not 1",
             get_u32(good + kOffsetVersion));
     memcpy(bytes, good, size);
-    put_u32(bytes + kOffsetVersion, 8);
+    put_u32(bytes + kOffsetVersion, 9);
     reseal(bytes, size);
     write_file(bad, bytes, size);
-    require_refused(bad, "written by a newer dpsm, version 8", "version 8");
+    require_refused(bad, "written by a newer dpsm, version 9", "version 9");
 
     /* The relaxations' flags: DPSM_RELAX_AUTO's needs version 3, and a file
      * cannot ask for both. */
@@ -576,6 +576,11 @@ static void test_values_are_checked_behind_the_checksum(void **state) {
     require_refused(bad, "need version 7", "the flag of a mesh's part in version 6");
     write_with_header(bad, bytes, good, size, 7, 1u << 16);
     require_refused(bad, "holds no mesh", "the flag of a mesh's part on a grid");
+    /* Version 8's flag, a mesh in longitude and latitude, needs version 8 and a mesh. */
+    write_with_header(bad, bytes, good, size, 7, 1u << 17);
+    require_refused(bad, "need version 8", "the flag of a geographic mesh in version 7");
+    write_with_header(bad, bytes, good, size, 8, 1u << 17);
+    require_refused(bad, "holds no mesh", "the flag of a geographic mesh on a grid");
 
     require_refused_with_f64(bad, bytes, good, size, kOffsetRepose, 2.0, "angle of repose 2 radians",
                              "a repose angle of 2");

@@ -197,6 +197,7 @@ module dpsm
   public :: dpsm_create_mesh, dpsm_create_graph, dpsm_create_dual_mesh
   public :: dpsm_create_mesh_indexed, dpsm_create_graph_indexed, dpsm_create_dual_mesh_indexed
   public :: dpsm_get_face_count, dpsm_get_mesh_faces, dpsm_set_edge_kinds
+  public :: dpsm_create_mesh_geographic, dpsm_create_dual_mesh_geographic, dpsm_get_cell_centres
   ! Not in C: .true. when g holds a grid (its handle is not NULL).
   public :: dpsm_associated
   ! Not in C: for companion modules (dpsm_mpi) whose own C constructors make
@@ -230,6 +231,12 @@ module dpsm
   interface dpsm_create_dual_mesh_indexed
     module procedure create_dual_mesh_indexed_i64, create_dual_mesh_indexed_i32
   end interface dpsm_create_dual_mesh_indexed
+  interface dpsm_create_mesh_geographic
+    module procedure create_mesh_geographic_i64, create_mesh_geographic_i32
+  end interface dpsm_create_mesh_geographic
+  interface dpsm_create_dual_mesh_geographic
+    module procedure create_dual_mesh_geographic_i64, create_dual_mesh_geographic_i32
+  end interface dpsm_create_dual_mesh_geographic
   interface dpsm_get_face_count
     module procedure get_face_count_i64, get_face_count_i32
   end interface dpsm_get_face_count
@@ -363,6 +370,34 @@ module dpsm
       integer(c_int64_t), intent(in) :: triangle_nodes(*) ! from start_index
       type(c_ptr), intent(out) :: out
     end function c_dpsm_create_dual_mesh_indexed
+
+    integer(c_int) function c_dpsm_create_mesh_geographic(start_index, nnodes, node_lonlat, ncells, cell_start, &
+                                                          cell_nodes, out) bind(C, name='dpsm_create_mesh_geographic')
+      import :: c_int, c_int64_t, c_double, c_ptr
+      integer(c_int), value :: start_index
+      integer(c_int64_t), value :: nnodes, ncells
+      real(c_double), intent(in) :: node_lonlat(*)
+      integer(c_int64_t), intent(in) :: cell_start(*), cell_nodes(*) ! from start_index
+      type(c_ptr), intent(out) :: out
+    end function c_dpsm_create_mesh_geographic
+
+    integer(c_int) function c_dpsm_create_dual_mesh_geographic(start_index, nnodes, node_lonlat, ntriangles, &
+                                                               triangle_nodes, out) &
+        bind(C, name='dpsm_create_dual_mesh_geographic')
+      import :: c_int, c_int64_t, c_double, c_ptr
+      integer(c_int), value :: start_index
+      integer(c_int64_t), value :: nnodes, ntriangles
+      real(c_double), intent(in) :: node_lonlat(*)
+      integer(c_int64_t), intent(in) :: triangle_nodes(*) ! from start_index
+      type(c_ptr), intent(out) :: out
+    end function c_dpsm_create_dual_mesh_geographic
+
+    integer(c_int) function c_dpsm_get_cell_centres(g, cell_xy, cell_area) bind(C, name='dpsm_get_cell_centres')
+      import :: c_int, c_double, c_ptr
+      type(c_ptr), value :: g
+      real(c_double), intent(out), optional :: cell_xy(*) ! absent: NULL
+      real(c_double), intent(out), optional :: cell_area(*) ! absent: NULL
+    end function c_dpsm_get_cell_centres
 
     integer(c_int) function c_dpsm_get_face_count(g, nfaces) bind(C, name='dpsm_get_face_count')
       import :: c_int, c_int64_t, c_ptr
@@ -1025,7 +1060,7 @@ contains
 
   !> The polygons' constructor behind dpsm_create_mesh(_indexed): the shapes
   !> checked, then C's dpsm_create_mesh_indexed on the host's arrays.
-  subroutine make_mesh(g, fn, start_index, nnodes, node_xy, ncells, cell_start, cell_nodes, ierr)
+  subroutine make_mesh(g, fn, start_index, nnodes, node_xy, ncells, cell_start, cell_nodes, ierr, geographic)
     type(dpsm_grid), intent(out) :: g
     character(len=*), intent(in) :: fn
     integer, intent(in) :: start_index
@@ -1034,14 +1069,20 @@ contains
     integer(c_int64_t), intent(in) :: ncells
     integer(c_int64_t), intent(in), contiguous :: cell_start(:), cell_nodes(:)
     integer, intent(out), optional :: ierr
+    logical, intent(in), optional :: geographic ! node_xy holds longitude and latitude: dpsm_create_mesh_geographic
     type(c_ptr) :: ptr
     integer(c_int) :: status
-    character(len=:), allocatable :: count_name
+    character(len=:), allocatable :: count_name, xy_name
+    logical :: lonlat
+    lonlat = .false.
+    if (present(geographic)) lonlat = geographic
+    xy_name = 'node_xy'
+    if (lonlat) xy_name = 'node_lonlat'
     status = DPSM_OK
     ! Counts below 1 and a start index other than 0 and 1 are refused by C,
     ! with its message, before it reads an array.
     if (nnodes >= 1 .and. ncells >= 1 .and. (start_index == 0 .or. start_index == 1)) then
-      status = check_columns(fn, 'node_xy', shape(node_xy), 2, nnodes, 'nnodes')
+      status = check_columns(fn, xy_name, shape(node_xy), 2, nnodes, 'nnodes')
       if (status == DPSM_OK) status = check_columns(fn, 'cell_start', shape(cell_start), 1, ncells + 1, 'ncells+1')
       ! C reads cell_start(ncells+1)-start_index node indices once
       ! cell_start(1) is start_index and every cell has at least 3 nodes; it
@@ -1053,8 +1094,12 @@ contains
                                count_name)
     end if
     ptr = c_null_ptr
-    if (status == DPSM_OK) &
+    if (status == DPSM_OK .and. lonlat) then
+      status = c_dpsm_create_mesh_geographic(int(start_index, c_int), nnodes, node_xy, ncells, cell_start, cell_nodes, &
+                                             ptr)
+    else if (status == DPSM_OK) then
       status = c_dpsm_create_mesh_indexed(int(start_index, c_int), nnodes, node_xy, ncells, cell_start, cell_nodes, ptr)
+    end if
     call adopt(g, ptr, status)
     call finish(status, ierr, fn)
   end subroutine make_mesh
@@ -1198,7 +1243,7 @@ contains
 
   !> The dual's constructor behind dpsm_create_dual_mesh(_indexed): the
   !> shapes checked, then C's dpsm_create_dual_mesh_indexed on the host's arrays.
-  subroutine make_dual_mesh(g, fn, start_index, nnodes, node_xy, ntriangles, triangle_nodes, ierr)
+  subroutine make_dual_mesh(g, fn, start_index, nnodes, node_xy, ntriangles, triangle_nodes, ierr, geographic)
     type(dpsm_grid), intent(out) :: g
     character(len=*), intent(in) :: fn
     integer, intent(in) :: start_index
@@ -1207,20 +1252,117 @@ contains
     integer(c_int64_t), intent(in) :: ntriangles
     integer(c_int64_t), intent(in), contiguous :: triangle_nodes(:, :)
     integer, intent(out), optional :: ierr
+    logical, intent(in), optional :: geographic ! node_xy holds longitude and latitude
     type(c_ptr) :: ptr
     integer(c_int) :: status
+    logical :: lonlat
+    lonlat = .false.
+    if (present(geographic)) lonlat = geographic
     status = DPSM_OK
     if (nnodes >= 1 .and. ntriangles >= 1) then
-      status = check_columns(fn, 'node_xy', shape(node_xy), 2, nnodes, 'nnodes')
+      if (lonlat) then
+        status = check_columns(fn, 'node_lonlat', shape(node_xy), 2, nnodes, 'nnodes')
+      else
+        status = check_columns(fn, 'node_xy', shape(node_xy), 2, nnodes, 'nnodes')
+      end if
       if (status == DPSM_OK) &
         status = check_columns(fn, 'triangle_nodes', shape(triangle_nodes), 3, ntriangles, 'ntriangles')
     end if
     ptr = c_null_ptr
-    if (status == DPSM_OK) &
+    if (status == DPSM_OK .and. lonlat) then
+      status = c_dpsm_create_dual_mesh_geographic(int(start_index, c_int), nnodes, node_xy, ntriangles, &
+                                                  triangle_nodes, ptr)
+    else if (status == DPSM_OK) then
       status = c_dpsm_create_dual_mesh_indexed(int(start_index, c_int), nnodes, node_xy, ntriangles, triangle_nodes, ptr)
+    end if
     call adopt(g, ptr, status)
     call finish(status, ierr, fn)
   end subroutine make_dual_mesh
+
+  !> dpsm_create_mesh_geographic(g, start_index, nnodes, node_lonlat, ncells, cell_start, cell_nodes[, ierr]):
+  !> as dpsm_create_mesh_indexed, node_lonlat(2, nnodes) the longitude and
+  !> latitude of each node in degrees: lengths and areas on the sphere.
+  subroutine create_mesh_geographic_i64(g, start_index, nnodes, node_lonlat, ncells, cell_start, cell_nodes, ierr)
+    type(dpsm_grid), intent(out) :: g
+    integer, intent(in) :: start_index
+    integer(c_int64_t), intent(in) :: nnodes
+    real(c_double), intent(in), contiguous :: node_lonlat(:, :)
+    integer(c_int64_t), intent(in) :: ncells
+    integer(c_int64_t), intent(in), contiguous :: cell_start(:), cell_nodes(:)
+    integer, intent(out), optional :: ierr
+    call make_mesh(g, 'dpsm_create_mesh_geographic', start_index, nnodes, node_lonlat, ncells, cell_start, cell_nodes, &
+                   ierr, geographic=.true.)
+  end subroutine create_mesh_geographic_i64
+
+  subroutine create_mesh_geographic_i32(g, start_index, nnodes, node_lonlat, ncells, cell_start, cell_nodes, ierr)
+    type(dpsm_grid), intent(out) :: g
+    integer, intent(in) :: start_index
+    integer(c_int32_t), intent(in) :: nnodes
+    real(c_double), intent(in), contiguous :: node_lonlat(:, :)
+    integer(c_int32_t), intent(in) :: ncells
+    integer(c_int32_t), intent(in) :: cell_start(:), cell_nodes(:)
+    integer, intent(out), optional :: ierr
+    call create_mesh_geographic_i64(g, start_index, i64(nnodes), node_lonlat, i64(ncells), i64(cell_start), &
+                                    i64(cell_nodes), ierr)
+  end subroutine create_mesh_geographic_i32
+
+  !> dpsm_create_dual_mesh_geographic(g, start_index, nnodes, node_lonlat, ntriangles, triangle_nodes[, ierr]):
+  !> as dpsm_create_dual_mesh_indexed, node_lonlat(2, nnodes) in degrees.
+  subroutine create_dual_mesh_geographic_i64(g, start_index, nnodes, node_lonlat, ntriangles, triangle_nodes, ierr)
+    type(dpsm_grid), intent(out) :: g
+    integer, intent(in) :: start_index
+    integer(c_int64_t), intent(in) :: nnodes
+    real(c_double), intent(in), contiguous :: node_lonlat(:, :)
+    integer(c_int64_t), intent(in) :: ntriangles
+    integer(c_int64_t), intent(in), contiguous :: triangle_nodes(:, :)
+    integer, intent(out), optional :: ierr
+    call make_dual_mesh(g, 'dpsm_create_dual_mesh_geographic', start_index, nnodes, node_lonlat, ntriangles, &
+                        triangle_nodes, ierr, geographic=.true.)
+  end subroutine create_dual_mesh_geographic_i64
+
+  subroutine create_dual_mesh_geographic_i32(g, start_index, nnodes, node_lonlat, ntriangles, triangle_nodes, ierr)
+    type(dpsm_grid), intent(out) :: g
+    integer, intent(in) :: start_index
+    integer(c_int32_t), intent(in) :: nnodes
+    real(c_double), intent(in), contiguous :: node_lonlat(:, :)
+    integer(c_int32_t), intent(in) :: ntriangles
+    integer(c_int32_t), intent(in), contiguous :: triangle_nodes(:, :)
+    integer, intent(out), optional :: ierr
+    call create_dual_mesh_geographic_i64(g, start_index, i64(nnodes), node_lonlat, i64(ntriangles), &
+                                         i64(triangle_nodes), ierr)
+  end subroutine create_dual_mesh_geographic_i32
+
+  !> dpsm_get_cell_centres(g[, cell_xy][, cell_area][, ierr]): where each
+  !> cell's height stands, cell_xy(2, ncells) (longitude and latitude in
+  !> degrees on a geographic mesh), and the area that turns it into a volume,
+  !> cell_area(ncells), ncells = nx*ny of dpsm_get_shape (x fastest on a grid);
+  !> either may be left out (pass them by keyword), not both.
+  subroutine dpsm_get_cell_centres(g, cell_xy, cell_area, ierr)
+    type(dpsm_grid), intent(in) :: g
+    real(c_double), intent(inout), contiguous, optional :: cell_xy(:, :)
+    real(c_double), intent(inout), contiguous, optional :: cell_area(:)
+    integer, intent(out), optional :: ierr
+    integer(c_int) :: status
+    integer(c_int64_t) :: nx, ny
+    call clear_message(g)
+    status = c_dpsm_get_shape(g%ptr, nx, ny)
+    if (status == DPSM_OK .and. present(cell_xy)) then
+      if (size(cell_xy, 1) /= 2 .or. int(size(cell_xy, 2), c_int64_t) /= nx*ny) then
+        status = DPSM_ERR_INVALID_SIZE
+        call set_message(g, 'dpsm_get_cell_centres: cell_xy has shape '//shape_string(shape(cell_xy))// &
+                         ' but the grid has '//itoa(nx*ny)//' cells: pass cell_xy(2, '//itoa(nx*ny)//')')
+      end if
+    end if
+    if (status == DPSM_OK .and. present(cell_area)) then
+      if (int(size(cell_area), c_int64_t) /= nx*ny) then
+        status = DPSM_ERR_INVALID_SIZE
+        call set_message(g, 'dpsm_get_cell_centres: cell_area has '//itoa(int(size(cell_area), c_int64_t))// &
+                         ' values but the grid has '//itoa(nx*ny)//' cells: pass cell_area('//itoa(nx*ny)//')')
+      end if
+    end if
+    if (status == DPSM_OK) status = c_dpsm_get_cell_centres(g%ptr, cell_xy, cell_area)
+    call finish(status, ierr, 'dpsm_get_cell_centres', g)
+  end subroutine dpsm_get_cell_centres
 
   !> dpsm_get_face_count(g, nfaces[, ierr]): the faces of a mesh, interior and
   !> on the domain edge (DPSM_ERR_NOT_APPLICABLE on a grid).

@@ -454,6 +454,88 @@ DPSM_API int dpsm_create_dual_mesh_indexed(int start_index, int64_t nnodes, cons
                                            const int64_t *triangle_nodes, dpsm_grid **out);
 
 /**
+ * @brief As dpsm_create_mesh_indexed(), with the nodes in longitude and
+ *        latitude (degrees): a mesh on the sphere, as coastal models (ADCIRC,
+ *        Delft3D FM's spherical models) hold it.
+ *
+ * Degrees are never taken as metres: every length, distance and area the
+ * model uses is taken on a sphere of radius 6371008.8 m (the Earth's mean
+ * radius): cell areas are those of the spherical polygons with great-circle
+ * edges, face lengths and the distances between cell centres are
+ * great-circle lengths, centroids are those of the spherical polygons, and
+ * each cell's least-squares gradient is taken over its neighbours' offsets
+ * as seen from it on the sphere. Directions (a face's normal and tangent)
+ * come from the stereographic projection about the nodes' mean direction,
+ * which keeps angles; the chords it draws turn them by about `d r / (4 R^2)`
+ * for cells `d` apart at `r` from that centre (2e-5 radians for 1 km cells
+ * 2800 km away). The mesh must lie within 90 degrees of arc of the centre. Heights stay in metres; dpsm_get_cell_centres() gives the
+ * centres in degrees and the areas in square metres, dpsm_stable_dt() and
+ * the ledger (square metres times metres) follow the sphere.
+ *
+ * Everything else, the start index included, is as dpsm_create_mesh_indexed();
+ * a mesh made by this function is saved and loaded as one (restart format
+ * version 8).
+ *
+ * @param start_index  where the indices count from: 0 or 1.
+ * @param nnodes       number of nodes, at least 1.
+ * @param node_lonlat  `2*nnodes` values: the longitude (within [-540, 540])
+ *                     and latitude (within [-90, 90]) of each node, degrees.
+ * @param ncells       number of cells, at least 1.
+ * @param cell_start   `ncells+1` offsets into `cell_nodes`, from `start_index`.
+ * @param cell_nodes   node indices, from `start_index`.
+ * @param out          receives the new mesh, or NULL on failure.
+ * @return as dpsm_create_mesh_indexed(); also ::DPSM_ERR_INVALID_VALUE for a
+ *         latitude or longitude out of range and for a mesh that reaches more
+ *         than 90 degrees of arc from its centre (the message names the node).
+ */
+DPSM_API int dpsm_create_mesh_geographic(int start_index, int64_t nnodes, const double *node_lonlat, int64_t ncells,
+                                         const int64_t *cell_start, const int64_t *cell_nodes, dpsm_grid **out);
+
+/**
+ * @brief As dpsm_create_dual_mesh_indexed(), with the nodes in longitude and
+ *        latitude (degrees): the median dual of a triangle mesh on the sphere.
+ *
+ * Lengths, distances and areas are on the sphere, as
+ * dpsm_create_mesh_geographic() says: each triangle gives a third of its
+ * spherical area to each of its nodes' cells, and the dual's faces (from an
+ * edge's midpoint to a triangle's centroid, both taken in the projection's
+ * plane) are measured along great circles.
+ *
+ * @param start_index     where the indices count from: 0 or 1.
+ * @param nnodes          number of nodes, at least 1; every node in some triangle.
+ * @param node_lonlat     `2*nnodes` values: longitude and latitude of each node, degrees.
+ * @param ntriangles      number of triangles, at least 1.
+ * @param triangle_nodes  `3*ntriangles` node indices, from `start_index`.
+ * @param out             receives the new mesh, or NULL on failure.
+ * @return as dpsm_create_mesh_geographic().
+ */
+DPSM_API int dpsm_create_dual_mesh_geographic(int start_index, int64_t nnodes, const double *node_lonlat,
+                                              int64_t ntriangles, const int64_t *triangle_nodes, dpsm_grid **out);
+
+/**
+ * @brief Reads where each cell's height stands and the area that turns it
+ *        into a volume: what a host needs to place heights on the cells.
+ *
+ * On a mesh of polygons the centre is the polygon's centroid; on a graph,
+ * the centre the host gave; on a median dual, the node. On a geographic mesh
+ * (dpsm_create_mesh_geographic()) centres are longitude and latitude in
+ * degrees and areas square metres on the sphere. On a 2D grid cell `(i, j)`
+ * is centred at `((i + 1/2) dx, (j + 1/2) dy)` with area `dx dy`; on a 1D grid
+ * at `((i + 1/2) dx, 0)` with `dx`; on an axisymmetric grid at radius
+ * `(i + 1/2) dr` with the ring's area `2 pi r dr`: the weights of the mass
+ * ledger. A block of a distributed grid counts from its own first cell (add
+ * `i0 dx`, `j0 dy` for the global position); a part of a distributed mesh
+ * gives every local cell, its ghosts included.
+ *
+ * @param g          the grid or mesh.
+ * @param cell_xy    room for `2*ncells` values (x, y per cell, in the host's
+ *                   cell order, x fastest on a grid), or NULL.
+ * @param cell_area  room for `ncells` values, or NULL.
+ * @return ::DPSM_OK or ::DPSM_ERR_NULL_POINTER (no grid, or both arrays NULL).
+ */
+DPSM_API int dpsm_get_cell_centres(const dpsm_grid *g, double *cell_xy, double *cell_area);
+
+/**
  * @brief Reads the number of faces of a mesh (interior and domain edge).
  * @param g       the mesh.
  * @param nfaces  receives the count.

@@ -432,6 +432,68 @@ int dpsm_create_dual_mesh(int64_t nnodes, const double *node_xy, int64_t ntriang
     });
 }
 
+// Geographic meshes and where each cell lies (issue 36): a block of its own,
+// beside the constructors it extends.
+
+int dpsm_create_mesh_geographic(int start_index, int64_t nnodes, const double *node_lonlat, int64_t ncells,
+                                const int64_t *cell_start, const int64_t *cell_nodes, dpsm_grid **out) {
+    const char *fn = "dpsm_create_mesh_geographic";
+    return create_mesh(out, start_index, fn, [&] {
+        return dpsm::mesh_from_polygons(nnodes, node_lonlat, ncells, cell_start, cell_nodes, fn, start_index, true);
+    });
+}
+
+int dpsm_create_dual_mesh_geographic(int start_index, int64_t nnodes, const double *node_lonlat, int64_t ntriangles,
+                                     const int64_t *triangle_nodes, dpsm_grid **out) {
+    const char *fn = "dpsm_create_dual_mesh_geographic";
+    return create_mesh(out, start_index, fn, [&] {
+        return dpsm::mesh_from_dual(nnodes, node_lonlat, ntriangles, triangle_nodes, fn, start_index, true);
+    });
+}
+
+int dpsm_get_cell_centres(const dpsm_grid *g, double *cell_xy, double *cell_area) {
+    const char *fn = "dpsm_get_cell_centres";
+    return guarded(g, fn, [&] {
+        require_grid(g, fn);
+        if (!cell_xy && !cell_area) fail(DPSM_ERR_NULL_POINTER, fn, "cell_xy and cell_area are both NULL");
+        const dpsm::Geometry &geo = g->core.geometry();
+        if (const dpsm::Mesh *mesh = mesh_of(g)) {
+            for (std::int64_t k = 0; k < mesh->cells; ++k) {
+                const std::int64_t c = mesh->cell_of_host[k];
+                if (cell_area) cell_area[k] = mesh->area[c];
+                if (!cell_xy) continue;
+                if (mesh->projection) {
+                    // In degrees, the longitude on the turn of the host's own
+                    // nodes: a dual's cell is its node; a polygon's centroid
+                    // lies on the turn of its first node.
+                    const dpsm::MeshInput &in = mesh->input;
+                    const std::int64_t node = in.kind == dpsm::MeshInput::kDual
+                                                  ? k
+                                                  : in.cell_nodes[in.cell_start[k] - in.start_index] - in.start_index;
+                    if (in.kind == dpsm::MeshInput::kDual) {
+                        cell_xy[2 * k] = in.node_xy[2 * node], cell_xy[2 * k + 1] = in.node_xy[2 * node + 1];
+                        continue;
+                    }
+                    double lon = 0.0;
+                    mesh->projection->inverse({mesh->x[c], mesh->y[c]}, lon, cell_xy[2 * k + 1]);
+                    cell_xy[2 * k] = lon + 360.0 * std::round((in.node_xy[2 * node] - lon) / 360.0);
+                } else {
+                    cell_xy[2 * k] = mesh->x[c], cell_xy[2 * k + 1] = mesh->y[c];
+                }
+            }
+            return;
+        }
+        for (std::int64_t j = 0; j < geo.ny; ++j)
+            for (std::int64_t i = 0; i < geo.nx; ++i) {
+                const std::int64_t c = i + geo.nx * j;
+                if (cell_area) cell_area[c] = geo.cell_area(c);
+                if (!cell_xy) continue;
+                cell_xy[2 * c] = (static_cast<double>(i) + 0.5) * geo.dx;
+                cell_xy[2 * c + 1] = geo.dim == 2 ? (static_cast<double>(j) + 0.5) * geo.dy : 0.0;
+            }
+    });
+}
+
 int dpsm_get_face_count(const dpsm_grid *g, int64_t *nfaces) {
     const char *fn = "dpsm_get_face_count";
     return guarded(g, fn, [&] {

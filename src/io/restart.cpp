@@ -76,9 +76,12 @@ constexpr std::uint32_t kMeshFromOne = 1u << 15;
 // local cell its global id, i64, and its owner's rank, i32). The block record
 // holds the global mesh's cells as global_nx (global_ny = 1, i0 = j0 = 0).
 constexpr std::uint32_t kMeshPart = 1u << 16;
+// Version 8: the mesh record's nodes are longitude and latitude in degrees
+// (dpsm_create_mesh_geographic and the dual's); no data of its own.
+constexpr std::uint32_t kMeshGeographic = 1u << 17;
 constexpr std::uint32_t kKnownFlags = kHasSource | kHasBed | kHasAngleField | kHasMoving | kIsBlock | kRelaxToRest |
                                       kRelaxAuto | kHasSideOutflows | kHasSideLevels | kRecordsFluxes | kIsMesh |
-                                      kHasEdgeKinds | kMeshFromOne | kMeshPart;
+                                      kHasEdgeKinds | kMeshFromOne | kMeshPart | kMeshGeographic;
 // The flags a file of version 1 cannot hold, those version 2 cannot, and so on.
 constexpr std::uint32_t kVersion2Flags = kIsBlock | kRelaxToRest;
 constexpr std::uint32_t kVersion3Flags = kRelaxAuto;
@@ -86,6 +89,7 @@ constexpr std::uint32_t kVersion4Flags = kHasSideOutflows | kHasSideLevels | kRe
 constexpr std::uint32_t kVersion5Flags = kIsMesh | kHasEdgeKinds;
 constexpr std::uint32_t kVersion6Flags = kMeshFromOne;
 constexpr std::uint32_t kVersion7Flags = kMeshPart;
+constexpr std::uint32_t kVersion8Flags = kMeshGeographic;
 // The fixed part of the mesh record: kind, a reserved word, and four counts.
 constexpr std::size_t kMeshRecordBytes = 40;
 
@@ -93,6 +97,7 @@ constexpr std::uint32_t side_levels_flag(int side) { return kHasSideLevelsOfXMin
 
 // The oldest version that holds a file with these flags.
 std::uint32_t version_for(std::uint32_t flags) {
+    if (flags & kVersion8Flags) return 8;
     if (flags & kVersion7Flags) return 7;
     if (flags & kVersion6Flags) return 6;
     if (flags & kVersion5Flags) return 5;
@@ -237,6 +242,7 @@ std::uint32_t flags_of(const Grid &g) {
     if (g.geometry().is_mesh()) flags |= kIsMesh;
     if (g.geometry().is_mesh() && g.geometry().mesh->input.start_index == 1) flags |= kMeshFromOne;
     if (g.geometry().is_mesh() && !g.geometry().mesh->input.owner.empty()) flags |= kMeshPart;
+    if (g.geometry().is_mesh() && g.geometry().mesh->input.geographic) flags |= kMeshGeographic;
     if (!g.edge_open_flags().empty()) flags |= kHasEdgeKinds;
     return flags;
 }
@@ -556,7 +562,7 @@ void check_layout(const Header &h, const std::string &path, const char *fn) {
     if (h.flags & ~kKnownFlags) bad("unknown array flags ", hex32(h.flags & ~kKnownFlags));
     const std::pair<std::uint32_t, std::uint32_t> needs[] = {
         {kVersion2Flags, 2}, {kVersion3Flags, 3}, {kVersion4Flags, 4}, {kVersion5Flags, 5}, {kVersion6Flags, 6},
-        {kVersion7Flags, 7}};
+        {kVersion7Flags, 7}, {kVersion8Flags, 8}};
     for (const auto &[flags, version] : needs)
         if ((h.flags & flags) && h.version < version)
             bad("the flags ", hex32(h.flags & flags), " are set in a file of version ", h.version, " (they need version ",
@@ -566,6 +572,7 @@ void check_layout(const Header &h, const std::string &path, const char *fn) {
     if ((h.flags & kIsBlock) && h.dim != 2) bad("a block of a distributed grid must have dim = 2, not ", h.dim);
     if ((h.flags & kHasEdgeKinds) && !(h.flags & kIsMesh)) bad("edge kinds are set but the file holds no mesh");
     if ((h.flags & kMeshPart) && !(h.flags & kIsMesh)) bad("a part of a distributed mesh is set but the file holds no mesh");
+    if ((h.flags & kMeshGeographic) && !(h.flags & kIsMesh)) bad("geographic nodes are set but the file holds no mesh");
     if ((h.flags & kMeshFromOne) && !(h.flags & kIsMesh))
         bad("the mesh's indices are said to count from 1 but the file holds no mesh");
     if (h.flags & kIsMesh) {
@@ -829,6 +836,7 @@ void load_restart(const char *path, Geometry &geometry, GridState &state, Restar
         read_mesh_counts(body, header);
         read_mesh(body, header, mesh_input);
         mesh_input.start_index = (header.flags & kMeshFromOne) ? 1 : 0;
+        mesh_input.geographic = (header.flags & kMeshGeographic) != 0;
         if (header.flags & kMeshPart) {
             body.array(mesh_input.global_id, static_cast<std::size_t>(header.nx), &Reader::i64);
             body.array(mesh_input.owner, static_cast<std::size_t>(header.nx), &Reader::i32);

@@ -5,12 +5,14 @@
 #include <cmath>
 #include <cstdlib>
 #include <numeric>
+#include <sstream>
 #include <string>
 #include <utility>
 
 #include "dpsm/dpsm.h"
 #include "model/error.hpp"
 #include "model/limits.hpp"
+#include "mesh/sphere.hpp"
 
 namespace dpsm {
 
@@ -34,6 +36,11 @@ struct RawFace {
     Vec normal_length;  // length times the unit normal, pointing from a to b (outwards on the edge)
     bool normal_known;  // false on a graph: the normal is taken along a to b
     std::int64_t along = 0;  // polygons: the edge's place in cell a, which orders the host's faces
+    // When positive, the distance between the face's cells (on the domain
+    // edge: between the cell and its mirror image) instead of the one
+    // between their centres in the plane: on the sphere for a geographic
+    // mesh; for a graph's cell whose centre lies on this edge face.
+    double distance = 0.0;
 };
 
 struct RawCells {
@@ -207,9 +214,17 @@ void gradient_weights(Mesh &m, int rings, const std::vector<std::int64_t> &ghost
         if (!has_stencil[static_cast<std::size_t>(c)]) continue;
         double sxx = 0.0, sxy = 0.0, syy = 0.0;
         const std::int64_t k0 = m.grad_start[c], k1 = m.grad_start[c + 1];
+        // The neighbours' offsets: in the plane, or on a geographic mesh as
+        // seen from the cell on the sphere (great-circle distance and
+        // direction), so that the gradient is the true one in metres.
+        const auto offset = [&](std::int64_t n) {
+            if (!m.projection) return PlanePoint{m.x[n] - m.x[c], m.y[n] - m.y[c]};
+            return m.projection->offset({m.x[c], m.y[c]}, {m.x[n], m.y[n]});
+        };
         for (std::int64_t k = k0; k < k1; ++k) {
             const std::int64_t n = m.grad_cells[k];
-            const double dx = m.x[n] - m.x[c], dy = m.y[n] - m.y[c];
+            const PlanePoint o = offset(n);
+            const double dx = o.x, dy = o.y;
             const double w = 1.0 / (dx * dx + dy * dy);
             sxx += w * dx * dx, sxy += w * dx * dy, syy += w * dy * dy;
         }
@@ -218,7 +233,8 @@ void gradient_weights(Mesh &m, int rings, const std::vector<std::int64_t> &ghost
         if (!(det > 1e-6 * trace * trace)) continue;
         for (std::int64_t k = k0; k < k1; ++k) {
             const std::int64_t n = m.grad_cells[k];
-            const double dx = m.x[n] - m.x[c], dy = m.y[n] - m.y[c];
+            const PlanePoint o = offset(n);
+            const double dx = o.x, dy = o.y;
             const double w = 1.0 / (dx * dx + dy * dy);
             m.grad_wx[k] = w * (syy * dx - sxy * dy) / det;
             m.grad_wy[k] = w * (sxx * dy - sxy * dx) / det;
@@ -355,16 +371,17 @@ std::shared_ptr<Mesh> assemble(MeshInput &&input, const RawCells &cells, const s
         double d;
         if (b >= 0) {
             const Vec between = Vec{m.x[b], m.y[b]} - ca;
-            d = norm(between);
-            if (!(d > 0.0))
+            const double apart = norm(between);
+            if (!(apart > 0.0))
                 fail(DPSM_ERR_INVALID_VALUE, function, name_face(), " joins two cells whose centres coincide at (",
                      ca.x, ", ", ca.y, ")");
-            e = (1.0 / d) * between;
+            e = (1.0 / apart) * between;
+            d = raw.distance > 0.0 ? raw.distance : apart;
             if (!raw.normal_known) nl = raw.length * e;
         } else {
             // The outside is the cell's mirror image across the face.
             const Vec to_mid = raw.mid - ca;
-            d = 2.0 * norm(to_mid);
+            d = raw.distance > 0.0 ? raw.distance : 2.0 * norm(to_mid);
             if (!raw.normal_known) nl = (raw.length / norm(to_mid)) * to_mid;
             e = (1.0 / raw.length) * nl;
             if (!(d > 0.0))
@@ -454,12 +471,51 @@ std::size_t end_of_edge(const std::vector<EdgeUse> &edges, std::size_t k, const 
     return end;
 }
 
+// Two nodes at the same point that cells use: the edges through them would
+// not join, and the cells there would meet at two domain edges (open ones
+// let sand leave in the middle of the domain). Refused, naming both nodes
+// and a cell of each. `nodes` are the cells' node indices from 0, `cell_of`
+// gives the cell of a position in them, `what` names the cells.
+template <class CellOf>
+void refuse_coincident_nodes(const double *node_xy, const std::int64_t *nodes, std::int64_t count, CellOf &&cell_of,
+                             const char *what, const char *function, int base) {
+    std::vector<std::int64_t> used(nodes, nodes + count);
+    std::sort(used.begin(), used.end());
+    used.erase(std::unique(used.begin(), used.end()), used.end());
+    std::sort(used.begin(), used.end(), [&](std::int64_t l, std::int64_t r) {
+        const double lx = node_xy[2 * l], rx = node_xy[2 * r];
+        if (lx != rx) return lx < rx;
+        const double ly = node_xy[2 * l + 1], ry = node_xy[2 * r + 1];
+        return ly != ry ? ly < ry : l < r;
+    });
+    for (std::size_t k = 1; k < used.size(); ++k) {
+        const std::int64_t p = used[k - 1], q = used[k];
+        if (node_xy[2 * p] != node_xy[2 * q] || node_xy[2 * p + 1] != node_xy[2 * q + 1]) continue;
+        const auto first_cell = [&](std::int64_t node) { return cell_of(std::find(nodes, nodes + count, node) - nodes); };
+        fail(DPSM_ERR_INVALID_VALUE, function, "nodes ", p + base, " and ", q + base, " lie at the same point (",
+             node_xy[2 * p], ", ", node_xy[2 * p + 1], "), used by ", what, " ", first_cell(p) + base, " and ",
+             first_cell(q) + base, ": edges through them would not join, and the ", what,
+             " there would meet at a domain edge; give the ", what, " one node there");
+    }
+}
+
+// A geographic mesh's nodes in the plane of `projection`, 2 per node.
+std::vector<double> to_plane(const Stereographic &projection, const double *node_lonlat, std::int64_t nnodes) {
+    std::vector<double> plane(static_cast<std::size_t>(2 * nnodes));
+    for (std::int64_t n = 0; n < nnodes; ++n) {
+        const PlanePoint p = projection.forward(node_lonlat[2 * n], node_lonlat[2 * n + 1]);
+        plane[2 * n] = p.x, plane[2 * n + 1] = p.y;
+    }
+    return plane;
+}
+
 std::shared_ptr<Mesh> assemble_polygons(std::int64_t nnodes, const double *node_xy, std::int64_t ncells,
                                         const std::int64_t *cell_start, const std::int64_t *cell_nodes,
-                                        const PartOfMesh *part, const char *function, int base) {
+                                        const PartOfMesh *part, const char *function, int base,
+                                        bool geographic = false) {
     require_count(nnodes, function, "nnodes");
     require_count(ncells, function, "ncells");
-    require_coordinates(node_xy, nnodes, function, "node_xy", "node", base);
+    require_coordinates(node_xy, nnodes, function, geographic ? "node_lonlat" : "node_xy", "node", base);
     if (!cell_start) fail(DPSM_ERR_NULL_POINTER, function, "cell_start is NULL");
     if (!cell_nodes) fail(DPSM_ERR_NULL_POINTER, function, "cell_nodes is NULL");
     if (cell_start[0] != base)
@@ -478,6 +534,7 @@ std::shared_ptr<Mesh> assemble_polygons(std::int64_t nnodes, const double *node_
     MeshInput input;
     input.kind = MeshInput::kPolygons;
     input.start_index = base;
+    input.geographic = geographic;
     input.node_xy.assign(node_xy, node_xy + 2 * nnodes);
     input.cell_start.assign(cell_start, cell_start + ncells + 1);
     input.cell_nodes.assign(cell_nodes, cell_nodes + total);
@@ -485,6 +542,19 @@ std::shared_ptr<Mesh> assemble_polygons(std::int64_t nnodes, const double *node_
     std::vector<std::int64_t> start_buffer, nodes_buffer;
     cell_start = from_zero(cell_start, ncells + 1, base, start_buffer);
     cell_nodes = from_zero(cell_nodes, total, base, nodes_buffer);
+    refuse_coincident_nodes(
+        node_xy, cell_nodes, total,
+        [&](std::int64_t at) { return std::upper_bound(cell_start, cell_start + ncells + 1, at) - cell_start - 1; },
+        "cells", function, base);
+    // A geographic mesh is built in the plane of its projection, then its
+    // lengths and areas are taken on the sphere (below).
+    std::shared_ptr<const Stereographic> projection;
+    std::vector<double> plane;
+    if (geographic) {
+        projection = std::make_shared<const Stereographic>(node_xy, nnodes, function, base);
+        plane = to_plane(*projection, node_xy, nnodes);
+        node_xy = plane.data();
+    }
     const auto node = [&](std::int64_t n) { return Vec{node_xy[2 * n], node_xy[2 * n + 1]}; };
 
     RawCells cells;
@@ -553,7 +623,32 @@ std::shared_ptr<Mesh> assemble_polygons(std::int64_t nnodes, const double *node_
     // host's order, edge by edge in each cell's order.
     std::sort(faces.begin(), faces.end(),
               [](const RawFace &l, const RawFace &r) { return l.a != r.a ? l.a < r.a : l.along < r.along; });
-    return assemble(std::move(input), cells, faces, part, function, base);
+    if (projection) {
+        const auto point = [](Vec v) { return PlanePoint{v.x, v.y}; };
+        std::vector<PlanePoint> corners;
+        for (std::int64_t c = 0; c < ncells; ++c) {
+            corners.clear();
+            for (std::int64_t k = cell_start[c]; k < cell_start[c + 1]; ++k) corners.push_back(point(node(cell_nodes[k])));
+            const std::int64_t count = static_cast<std::int64_t>(corners.size());
+            cells.area[c] = std::fabs(projection->polygon_area(corners.data(), count));
+            const PlanePoint centroid = projection->polygon_centroid(corners.data(), count);
+            cells.centre[c] = Vec{centroid.x, centroid.y};
+        }
+        for (RawFace &face : faces) {
+            const std::int64_t k0 = cell_start[face.a], count = cell_start[face.a + 1] - k0;
+            const Vec p = node(cell_nodes[k0 + face.along]), q = node(cell_nodes[k0 + (face.along + 1) % count]);
+            const double length = projection->distance(point(p), point(q));
+            face.normal_length = (length / face.length) * face.normal_length;
+            face.length = length;
+            const PlanePoint mid = projection->midpoint(point(p), point(q));
+            face.mid = Vec{mid.x, mid.y};
+            face.distance = face.b >= 0 ? projection->distance(point(cells.centre[face.a]), point(cells.centre[face.b]))
+                                        : 2.0 * projection->distance(point(cells.centre[face.a]), point(face.mid));
+        }
+    }
+    std::shared_ptr<Mesh> mesh = assemble(std::move(input), cells, faces, part, function, base);
+    mesh->projection = projection;
+    return mesh;
 }
 
 std::shared_ptr<Mesh> assemble_graph(std::int64_t ncells, const double *cell_xy, const double *cell_area,
@@ -577,7 +672,14 @@ std::shared_ptr<Mesh> assemble_graph(std::int64_t ncells, const double *cell_xy,
         cells.centre[c] = Vec{cell_xy[2 * c], cell_xy[2 * c + 1]};
     }
     std::vector<RawFace> faces(nfaces);
-    std::vector<std::vector<double>> angles(ncells);
+    // Per cell, the direction from its centre to each of its faces and the
+    // face; the faces on the domain edge whose midpoint is the cell's centre.
+    struct Towards {
+        double angle;
+        std::int64_t face;
+    };
+    std::vector<std::vector<Towards>> angles(ncells);
+    std::vector<std::int64_t> edge_at_centre;
     for (std::int64_t f = 0; f < nfaces; ++f) {
         const std::int64_t host_a = face_cells[2 * f], host_b = face_cells[2 * f + 1];
         if (!is_index(host_a, ncells, base))
@@ -605,22 +707,85 @@ std::shared_ptr<Mesh> assemble_graph(std::int64_t ncells, const double *cell_xy,
         face.normal_known = false;
         for (const std::int64_t c : {a, b}) {
             if (c < 0) continue;
-            const Vec to = face.mid - cells.centre[c];
-            if (norm(to) > 0.0) angles[c].push_back(std::atan2(to.y, to.x));
+            const std::int64_t other = c == a ? b : a;
+            Vec to = face.mid - cells.centre[c];
+            // A centre on the face's midpoint: a right triangle's circumcentre
+            // on its hypotenuse, as Delft3D FM writes mesh2d_face_x/y. The face
+            // lies towards the cell across it; on the domain edge, in the gap
+            // the cell's other faces leave (found below).
+            if (norm(to) <= 1e-6 * face.length) {
+                if (other < 0) {
+                    edge_at_centre.push_back(f);
+                    continue;
+                }
+                to = cells.centre[other] - cells.centre[c];
+            }
+            if (norm(to) > 0.0) angles[c].push_back({std::atan2(to.y, to.x), f});
         }
     }
     // A cell is closed when its faces surround its centre: no gap of half a
-    // turn or more between the directions to their midpoints.
+    // turn or more between the directions to their midpoints. A face on the
+    // domain edge at the cell's centre faces the middle of the widest gap.
+    const auto widest_gap = [](std::vector<Towards> &dir, double &from) {
+        std::sort(dir.begin(), dir.end(), [](const Towards &l, const Towards &r) { return l.angle < r.angle; });
+        if (dir.empty()) return from = 0.0, 2.0 * M_PI;
+        double gap = dir.front().angle + 2.0 * M_PI - dir.back().angle;
+        from = dir.back().angle;
+        for (std::size_t k = 1; k < dir.size(); ++k)
+            if (dir[k].angle - dir[k - 1].angle > gap) gap = dir[k].angle - dir[k - 1].angle, from = dir[k - 1].angle;
+        return gap;
+    };
+    std::vector<std::int64_t> face_count(static_cast<std::size_t>(ncells), 0);
+    for (const RawFace &face : faces) {
+        ++face_count[face.a];
+        if (face.b >= 0) ++face_count[face.b];
+    }
+    for (const std::int64_t f : edge_at_centre) {
+        RawFace &face = faces[f];
+        if (face_count[face.a] != 3 || angles[face.a].size() != 2)
+            fail(DPSM_ERR_INVALID_VALUE, function, "face ", f + base, " (cell ", face.a + base,
+                 " and the domain edge) has its midpoint at the cell's centre (", cells.centre[face.a].x, ", ",
+                 cells.centre[face.a].y, "); only a triangle's centre may lie on one of its faces (a right triangle's "
+                 "circumcentre, on its hypotenuse), and cell ", face.a + base, " has ", face_count[face.a], " faces");
+        double from = 0.0;
+        const double gap = widest_gap(angles[face.a], from);
+        const double towards = from + 0.5 * gap;
+        const Vec outward{std::cos(towards), std::sin(towards)};
+        face.normal_length = face.length * outward;
+        face.normal_known = true;
+        // The outside mirrors the centroid of a triangle on this face: two
+        // thirds of the triangle's height, 2 area / length, from the face, twice.
+        face.distance = 2.0 * (2.0 * cells.area[face.a] / (3.0 * face.length));
+        angles[face.a].push_back({towards, f});
+    }
     for (std::int64_t c = 0; c < ncells; ++c) {
         if (part && part->ghost[c]) continue;  // a ghost's faces beyond the owned cells need not be given
-        std::vector<double> &dir = angles[c];
-        std::sort(dir.begin(), dir.end());
-        double gap = dir.empty() ? 7.0 : dir.front() + 2.0 * M_PI - dir.back();
-        for (std::size_t k = 1; k < dir.size(); ++k) gap = std::max(gap, dir[k] - dir[k - 1]);
-        if (dir.size() < 3 || gap >= M_PI * (1.0 - 1e-9))
-            fail(DPSM_ERR_INVALID_VALUE, function, "the faces of cell ", c + base, " (", dir.size(),
-                 " of them) do not close it: their midpoints leave a gap of ", gap * 180.0 / M_PI,
-                 " degrees around its centre; give every face of the cell, domain edges with b = ", base - 1);
+        std::vector<Towards> &dir = angles[c];
+        double from = 0.0;
+        const double gap = widest_gap(dir, from);
+        if (dir.size() >= 3 && gap < M_PI * (1.0 - 1e-9)) continue;
+        std::ostringstream given;
+        given.precision(17);
+        std::vector<std::int64_t> listed;
+        for (const Towards &t : dir) listed.push_back(t.face);
+        std::sort(listed.begin(), listed.end());
+        for (std::size_t k = 0; k < listed.size(); ++k) given << (k ? ", " : "") << listed[k] + base;
+        const double degrees = 180.0 / M_PI;
+        const auto normalised = [](double angle) { return angle < 0.0 ? angle + 360.0 : angle; };
+        std::ostringstream where;
+        where.precision(17);
+        if (dir.size() > 1)
+            where << "no face lies between " << normalised(from * degrees) << " and "
+                  << normalised(std::fmod(from + gap, 2.0 * M_PI) * degrees) << " degrees";
+        else
+            where << (dir.empty() ? "it has no face" : "its one face lies at ")
+                  << (dir.empty() ? std::string() : std::to_string(std::lround(normalised(dir[0].angle * degrees))) + " degrees");
+        fail(DPSM_ERR_INVALID_VALUE, function, "the faces of cell ", c + base, " (", dir.size(), " of them",
+             dir.empty() ? "" : dir.size() == 1 ? ": face " : ": faces ", given.str(), ") do not close it: around its "
+             "centre (", cells.centre[c].x, ", ", cells.centre[c].y, ") ", where.str(),
+             " (counter-clockwise from +x), so a face is missing there; give every face of the cell, "
+             "domain edges with b = ",
+             base - 1);
     }
     MeshInput input;
     input.kind = MeshInput::kGraph;
@@ -638,8 +803,9 @@ std::shared_ptr<Mesh> assemble_graph(std::int64_t ncells, const double *cell_xy,
 
 std::shared_ptr<const Mesh> mesh_from_polygons(std::int64_t nnodes, const double *node_xy, std::int64_t ncells,
                                                const std::int64_t *cell_start, const std::int64_t *cell_nodes,
-                                               const char *function, int base) {
-    return finish_serial(assemble_polygons(nnodes, node_xy, ncells, cell_start, cell_nodes, nullptr, function, base));
+                                               const char *function, int base, bool geographic) {
+    return finish_serial(
+        assemble_polygons(nnodes, node_xy, ncells, cell_start, cell_nodes, nullptr, function, base, geographic));
 }
 
 std::shared_ptr<const Mesh> mesh_from_graph(std::int64_t ncells, const double *cell_xy, const double *cell_area,
@@ -705,10 +871,11 @@ void finish_part(Mesh &m, int rings, const std::vector<std::int64_t> &ghost_star
 }
 
 std::shared_ptr<const Mesh> mesh_from_dual(std::int64_t nnodes, const double *node_xy, std::int64_t ntriangles,
-                                           const std::int64_t *triangle_nodes, const char *function, int base) {
+                                           const std::int64_t *triangle_nodes, const char *function, int base,
+                                           bool geographic) {
     require_count(nnodes, function, "nnodes");
     require_count(ntriangles, function, "ntriangles");
-    require_coordinates(node_xy, nnodes, function, "node_xy", "node", base);
+    require_coordinates(node_xy, nnodes, function, geographic ? "node_lonlat" : "node_xy", "node", base);
     if (!triangle_nodes) fail(DPSM_ERR_NULL_POINTER, function, "triangle_nodes is NULL");
     for (std::int64_t k = 0; k < 3 * ntriangles; ++k)
         if (!is_index(triangle_nodes[k], nnodes, base))
@@ -718,12 +885,39 @@ std::shared_ptr<const Mesh> mesh_from_dual(std::int64_t nnodes, const double *no
     MeshInput input;
     input.kind = MeshInput::kDual;
     input.start_index = base;
+    input.geographic = geographic;
     input.node_xy.assign(node_xy, node_xy + 2 * nnodes);
     input.cell_nodes.assign(triangle_nodes, triangle_nodes + 3 * ntriangles);
     // From here on the indices count from 0 (the messages add base again).
     std::vector<std::int64_t> nodes_buffer;
     triangle_nodes = from_zero(triangle_nodes, 3 * ntriangles, base, nodes_buffer);
+    refuse_coincident_nodes(
+        node_xy, triangle_nodes, 3 * ntriangles, [](std::int64_t at) { return at / 3; }, "triangles", function, base);
+    // A geographic mesh: as in assemble_polygons, the plane, then the sphere.
+    std::shared_ptr<const Stereographic> projection;
+    std::vector<double> plane;
+    if (geographic) {
+        projection = std::make_shared<const Stereographic>(node_xy, nnodes, function, base);
+        plane = to_plane(*projection, node_xy, nnodes);
+        node_xy = plane.data();
+    }
     const auto node = [&](std::int64_t n) { return Vec{node_xy[2 * n], node_xy[2 * n + 1]}; };
+    // Lengths and areas: in the plane, or on the sphere.
+    const auto point = [](Vec v) { return PlanePoint{v.x, v.y}; };
+    const auto length_of = [&](Vec p, Vec q) { return projection ? projection->distance(point(p), point(q)) : norm(q - p); };
+    // An edge's midpoint and a triangle's centroid: on the sphere for a
+    // geographic mesh, so that no length depends on where the plane is centred.
+    const auto midpoint_of = [&](Vec p, Vec q) {
+        if (!projection) return 0.5 * (p + q);
+        const PlanePoint mid = projection->midpoint(point(p), point(q));
+        return Vec{mid.x, mid.y};
+    };
+    const auto centroid_of = [&](const std::int64_t *v) {
+        if (!projection) return (1.0 / 3.0) * (node(v[0]) + node(v[1]) + node(v[2]));
+        const PlanePoint corners[3] = {point(node(v[0])), point(node(v[1])), point(node(v[2]))};
+        const PlanePoint centroid = projection->polygon_centroid(corners, 3);
+        return Vec{centroid.x, centroid.y};
+    };
     RawCells cells;
     cells.area.assign(nnodes, 0.0);
     cells.centre.resize(nnodes);
@@ -735,10 +929,14 @@ std::shared_ptr<const Mesh> mesh_from_dual(std::int64_t nnodes, const double *no
         if (v[0] == v[1] || v[1] == v[2] || v[0] == v[2])
             fail(DPSM_ERR_INVALID_VALUE, function, "triangle ", t + base, " has fewer than 3 distinct nodes");
         const Vec p = node(v[0]), q = node(v[1]), r = node(v[2]);
-        const double area = 0.5 * std::fabs(cross(q - p, r - p));
+        double area = 0.5 * std::fabs(cross(q - p, r - p));
         const double perimeter = norm(q - p) + norm(r - q) + norm(p - r);
         if (!(area > 1e-12 * perimeter * perimeter))
             fail(DPSM_ERR_INVALID_VALUE, function, "triangle ", t + base, " has zero area: its nodes lie on a line");
+        if (projection) {
+            const PlanePoint corners[3] = {point(p), point(q), point(r)};
+            area = std::fabs(projection->polygon_area(corners, 3));
+        }
         for (int k = 0; k < 3; ++k) {
             cells.area[v[k]] += area / 3.0;
             edges.push_back({std::min(v[k], v[(k + 1) % 3]), std::max(v[k], v[(k + 1) % 3]), t, k});
@@ -752,7 +950,7 @@ std::shared_ptr<const Mesh> mesh_from_dual(std::int64_t nnodes, const double *no
     for (std::size_t k = 0; k < edges.size();) {
         const std::size_t end = end_of_edge(edges, k, function, base, "triangles");
         const EdgeUse &first = edges[k];
-        const Vec p = node(first.lo), q = node(first.hi), m = 0.5 * (p + q);
+        const Vec p = node(first.lo), q = node(first.hi), m = midpoint_of(p, q);
         // The dual face between the edge's nodes: from the edge's midpoint to
         // the centroid of each triangle on it; its normal, integrated along
         // it, points from lo to hi.
@@ -762,22 +960,22 @@ std::shared_ptr<const Mesh> mesh_from_dual(std::int64_t nnodes, const double *no
         face.normal_length = Vec{0.0, 0.0};
         Vec mid_sum{0.0, 0.0};
         for (std::size_t u = k; u < end; ++u) {
-            const std::int64_t *v = triangle_nodes + 3 * edges[u].cell;
-            const Vec centroid = (1.0 / 3.0) * (node(v[0]) + node(v[1]) + node(v[2]));
+            const Vec centroid = centroid_of(triangle_nodes + 3 * edges[u].cell);
             const Vec seg = centroid - m;
-            Vec normal{seg.y, -seg.x};
+            const double length = length_of(m, centroid);
+            Vec normal = (length / norm(seg)) * Vec{seg.y, -seg.x};
             if (dot(normal, q - p) < 0.0) normal = -1.0 * normal;
             face.normal_length = face.normal_length + normal;
-            face.length += norm(seg);
-            mid_sum = mid_sum + norm(seg) * (0.5 * (centroid + m));
+            face.length += length;
+            mid_sum = mid_sum + length * (0.5 * (centroid + m));
         }
         face.mid = (1.0 / face.length) * mid_sum;
         face.normal_known = true;
+        if (projection) face.distance = length_of(p, q);
         faces.push_back(face);
         if (end - k == 1) {
             // A boundary edge: each of its nodes has half of it on the domain edge.
-            const std::int64_t *v = triangle_nodes + 3 * first.cell;
-            const Vec centroid = (1.0 / 3.0) * (node(v[0]) + node(v[1]) + node(v[2]));
+            const Vec centroid = centroid_of(triangle_nodes + 3 * first.cell);
             Vec outward{(q - p).y, -(q - p).x};
             if (dot(outward, m - centroid) < 0.0) outward = -1.0 * outward;
             outward = (1.0 / norm(outward)) * outward;
@@ -785,16 +983,19 @@ std::shared_ptr<const Mesh> mesh_from_dual(std::int64_t nnodes, const double *no
                 RawFace half;
                 half.a = n, half.b = -1;
                 half.mid = 0.5 * (node(n) + m);
-                half.length = norm(m - node(n));
+                half.length = length_of(node(n), m);
                 half.normal_length = half.length * outward;
                 half.normal_known = true;
+                if (projection) half.distance = length_of(node(n), m);  // twice to the midpoint of the half
                 edge_faces.push_back(half);
             }
         }
         k = end;
     }
     faces.insert(faces.end(), edge_faces.begin(), edge_faces.end());
-    return finish_serial(assemble(std::move(input), cells, faces, nullptr, function, base));
+    std::shared_ptr<Mesh> mesh = assemble(std::move(input), cells, faces, nullptr, function, base);
+    mesh->projection = projection;
+    return finish_serial(std::move(mesh));
 }
 
 std::shared_ptr<const Mesh> mesh_from_input(const MeshInput &input, const char *function) {
@@ -805,7 +1006,8 @@ std::shared_ptr<const Mesh> mesh_from_input(const MeshInput &input, const char *
                 input.cell_start.back() - input.start_index != static_cast<std::int64_t>(input.cell_nodes.size()))
                 fail(DPSM_ERR_BAD_FILE, function, "the mesh's cells do not match their node list");
             return mesh_from_polygons(static_cast<std::int64_t>(input.node_xy.size() / 2), input.node_xy.data(), ncells,
-                                      input.cell_start.data(), input.cell_nodes.data(), function, input.start_index);
+                                      input.cell_start.data(), input.cell_nodes.data(), function, input.start_index,
+                                      input.geographic);
         }
         case MeshInput::kGraph:
             return mesh_from_graph(input.ncells, input.cell_xy.data(), input.cell_area.data(),
@@ -814,7 +1016,7 @@ std::shared_ptr<const Mesh> mesh_from_input(const MeshInput &input, const char *
         case MeshInput::kDual:
             return mesh_from_dual(static_cast<std::int64_t>(input.node_xy.size() / 2), input.node_xy.data(),
                                   static_cast<std::int64_t>(input.cell_nodes.size() / 3), input.cell_nodes.data(),
-                                  function, input.start_index);
+                                  function, input.start_index, input.geographic);
     }
     fail(DPSM_ERR_BAD_FILE, function, "unknown mesh kind ", static_cast<unsigned>(input.kind));
 }

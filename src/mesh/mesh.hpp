@@ -13,6 +13,8 @@
 #include <string>
 #include <vector>
 
+#include "mesh/sphere.hpp"
+
 namespace dpsm {
 
 // What the host gave, kept to save in a restart file and to build the same
@@ -25,6 +27,10 @@ struct MeshInput {
     // numbers of cells, nodes and faces begin, in its arrays and in every
     // message that names one of them, of the constructor and later ones.
     int start_index = 0;
+    // The nodes' coordinates are longitude and latitude in degrees (the
+    // _geographic constructors); lengths and areas are then on the sphere
+    // (mesh/sphere.hpp).
+    bool geographic = false;
     // kPolygons and kDual: nodes and cells over them (kDual: 3 per triangle,
     // cell_start empty).
     std::vector<double> node_xy;
@@ -120,6 +126,10 @@ struct Mesh {
     std::vector<std::int64_t> ghosts_with_reach, ghosts_with_gradient_reach, faces_with_reach;  // per j, 0 .. kMaxReach
     int substeps_per_exchange = 0;
 
+    // A geographic mesh (MeshInput::geographic): the plane its x and y lie in
+    // (null on other meshes); lengths, distances and areas are on the sphere.
+    std::shared_ptr<const Stereographic> projection;
+
     // The smallest distance of any face (the rest tolerance's length scale).
     double min_distance = 0.0;
     // The smallest area over summed conductance of any cell: the largest
@@ -134,15 +144,18 @@ struct Mesh {
 // for the domain edge in face_cells; the messages count from it too, quote
 // the host's values and name array positions as the host writes them
 // (host_position).
+// With `geographic`, node_xy holds longitude and latitude in degrees
+// (mesh/sphere.hpp).
 std::shared_ptr<const Mesh> mesh_from_polygons(std::int64_t nnodes, const double *node_xy, std::int64_t ncells,
                                                const std::int64_t *cell_start, const std::int64_t *cell_nodes,
-                                               const char *function, int base);
+                                               const char *function, int base, bool geographic = false);
 std::shared_ptr<const Mesh> mesh_from_graph(std::int64_t ncells, const double *cell_xy, const double *cell_area,
                                             std::int64_t nfaces, const std::int64_t *face_cells,
                                             const double *face_xy, const double *face_length, const char *function,
                                             int base);
 std::shared_ptr<const Mesh> mesh_from_dual(std::int64_t nnodes, const double *node_xy, std::int64_t ntriangles,
-                                           const std::int64_t *triangle_nodes, const char *function, int base);
+                                           const std::int64_t *triangle_nodes, const char *function, int base,
+                                           bool geographic = false);
 // A rank's part of a distributed mesh, from the same arrays plus, per host
 // cell, its global id and whether it is a ghost; checked as the builders
 // above check, except that a ghost's faces need not close it. Not finished:

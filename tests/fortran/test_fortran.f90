@@ -974,6 +974,7 @@ contains
 
     call test_dual_mesh()
     call test_graph()
+    call test_geographic_and_centres()
   end subroutine test_meshes
 
   !> The median dual of 2 triangles over the unit square: one cell per node.
@@ -1035,6 +1036,62 @@ contains
     call expect(index(dpsm_last_error(), 'triangle_nodes(3, ntriangles)') > 0, &
                 'dpsm_create_dual_mesh with 1 triangle for 2 fails: '//dpsm_last_error())
   end subroutine test_dual_mesh
+
+  !> Issue 36: meshes in longitude and latitude, and where each cell lies.
+  !> The octant of the sphere between (0, 0), (90, 0) and (0, 90) as one
+  !> triangle (a polygon and a dual) has the area pi R^2 / 2; a quad mesh's
+  !> centres are its centroids, a 2D grid's its cell centres.
+  subroutine test_geographic_and_centres()
+    type(dpsm_grid) :: g
+    real(c_double), parameter :: radius = 6371008.8_c_double, pi = 3.14159265358979323846_c_double
+    real(c_double) :: lonlat(2, 3), xy(2, 4), area(4), quad_xy(2, 6), centre(2, 2), cell_area(2)
+    integer(c_int64_t) :: start(2), nodes(3), tris(3, 1)
+    integer :: ierr
+    lonlat = reshape([0.0_c_double, 0.0_c_double, 90.0_c_double, 0.0_c_double, 0.0_c_double, 90.0_c_double], [2, 3])
+    start = [1_c_int64_t, 4_c_int64_t]
+    nodes = [1_c_int64_t, 2_c_int64_t, 3_c_int64_t]
+    call dpsm_create_mesh_geographic(g, 1, 3_c_int64_t, lonlat, 1_c_int64_t, start, nodes, ierr)
+    call expect(ierr == DPSM_OK, 'dpsm_create_mesh_geographic: '//dpsm_last_error())
+    call dpsm_get_cell_centres(g, cell_area=area(1:1), ierr=ierr)
+    call expect(ierr == DPSM_OK .and. close_to(area(1), pi*radius**2/2, 1e-12_c_double), &
+                'the octant has the area pi R^2 / 2 on the sphere')
+    call dpsm_destroy(g)
+    tris(:, 1) = [1_c_int64_t, 2_c_int64_t, 3_c_int64_t]
+    call dpsm_create_dual_mesh_geographic(g, 1, 3, lonlat, 1, int(tris, c_int32_t), ierr)
+    call expect(ierr == DPSM_OK, 'dpsm_create_dual_mesh_geographic (default integers): '//dpsm_last_error())
+    call dpsm_get_cell_centres(g, xy(:, 1:3), area(1:3), ierr)
+    call expect(ierr == DPSM_OK .and. close_to(sum(area(1:3)), pi*radius**2/2, 1e-12_c_double), &
+                'the dual cells of the octant share its area')
+    call expect(abs(xy(1, 2) - 90) < 1e-9_c_double .and. abs(xy(2, 3) - 90) < 1e-9_c_double, &
+                'a geographic dual cell stands at its node, in degrees')
+    call dpsm_destroy(g)
+    lonlat(2, 3) = 91
+    call dpsm_create_mesh_geographic(g, 1, 3_c_int64_t, lonlat, 1_c_int64_t, start, nodes, ierr)
+    call expect(ierr == DPSM_ERR_INVALID_VALUE, 'a latitude of 91 is refused')
+    call expect(index(dpsm_last_error(), 'node_lonlat(2, 3)') > 0, &
+                'a latitude of 91 is refused, named as Fortran holds it: '//dpsm_last_error())
+    ! Two unit squares: centroids (0.5, 0.5) and (1.5, 0.5), areas 1.
+    quad_xy = reshape([0.0_c_double, 0.0_c_double, 1.0_c_double, 0.0_c_double, 2.0_c_double, 0.0_c_double, &
+                       0.0_c_double, 1.0_c_double, 1.0_c_double, 1.0_c_double, 2.0_c_double, 1.0_c_double], [2, 6])
+    call dpsm_create_mesh(g, 6, quad_xy, 2, [1, 5, 9], [1, 2, 5, 4, 2, 3, 6, 5], ierr)
+    call expect(ierr == DPSM_OK, 'two squares')
+    call dpsm_get_cell_centres(g, centre, cell_area, ierr)
+    call expect(ierr == DPSM_OK .and. all(abs(centre - reshape([0.5_c_double, 0.5_c_double, 1.5_c_double, &
+                0.5_c_double], [2, 2])) < 1e-15_c_double) .and. all(abs(cell_area - 1) < 1e-15_c_double), &
+                'dpsm_get_cell_centres: the squares'' centroids and areas')
+    call dpsm_get_cell_centres(g, centre(:, 1:1), ierr=ierr)
+    call expect(ierr == DPSM_ERR_INVALID_SIZE, 'dpsm_get_cell_centres refuses a cell_xy of one cell for two')
+    call expect(index(dpsm_last_error(g), 'cell_xy(2, 2)') > 0, &
+                'dpsm_get_cell_centres refuses a cell_xy of one cell for two: '//dpsm_last_error(g))
+    call dpsm_get_cell_centres(g, ierr=ierr)
+    call expect(ierr == DPSM_ERR_NULL_POINTER, 'dpsm_get_cell_centres without an array fails')
+    call dpsm_destroy(g)
+    call dpsm_create_2d(g, 2, 2, 0.5_c_double, 2.0_c_double)
+    call dpsm_get_cell_centres(g, xy, area)
+    call expect(all(abs(xy(:, 4) - [0.75_c_double, 3.0_c_double]) < 1e-15_c_double) .and. &
+                all(abs(area - 1) < 1e-15_c_double), 'a 2D grid''s cell (2, 2) lies at (0.75, 3), area dx dy')
+    call dpsm_destroy(g)
+  end subroutine test_geographic_and_centres
 
   !> A graph of 2 unit squares side by side: one interior face, 6 on the edge.
   subroutine test_graph()

@@ -1423,7 +1423,7 @@ static void op_null_grid(reader_t *r) {
     int64_t a, c;
     int st;
     const char *fn;
-    switch (b >= kLaterOps ? 25 + (b - kLaterOps) % 5 : b % 25) {
+    switch (b >= kLaterOps ? 25 + (b - kLaterOps) % 6 : b % 25) {
         case 0: st = dpsm_set_repose_angle(NULL, 0.5), fn = "dpsm_set_repose_angle"; break;
         case 1: st = dpsm_set_mobility(NULL, 1.0), fn = "dpsm_set_mobility"; break;
         case 2: st = dpsm_set_scheme(NULL, 0), fn = "dpsm_set_scheme"; break;
@@ -1455,6 +1455,11 @@ static void op_null_grid(reader_t *r) {
         case 29: {
             int n = 0;
             st = dpsm_get_threads(NULL, &n), fn = "dpsm_get_threads";
+            break;
+        }
+        case 30: {
+            double xy[2] = {0.0, 0.0};
+            st = dpsm_get_cell_centres(NULL, xy, h), fn = "dpsm_get_cell_centres";
             break;
         }
         default: {
@@ -1843,11 +1848,19 @@ static int mesh_construct(const mesh_t *m, int defect, prng_t *p, dpsm_grid **gr
                 else fxy[prng_below(p, (unsigned)(2 * nfaces))] = kBadCoordinates[prng_below(p, 4)];
                 break;
             case 7: { /* an edge face with its midpoint at its cell's centre */
-                *what = "an edge face at its cell's centre";
                 int64_t e = -1;
                 for (int64_t k = 0; k < nfaces && e < 0; ++k)
                     if (fc[2 * ((f + k) % nfaces) + 1] < 0) e = (f + k) % nfaces;
                 fxy[2 * e] = cell_xy[2 * fc[2 * e]], fxy[2 * e + 1] = cell_xy[2 * fc[2 * e] + 1];
+                /* A triangle's centre may lie on its face on the domain edge
+                 * (a right triangle's circumcentre, as Delft3D FM writes it):
+                 * made, the face facing the gap its other faces leave; any
+                 * other cell's is refused. */
+                int64_t faces_of_cell = 0;
+                for (int64_t k = 0; k < nfaces; ++k) faces_of_cell += fc[2 * k] == fc[2 * e] || fc[2 * k + 1] == fc[2 * e];
+                *what = faces_of_cell == 3 ? "an edge face at its triangle's centre (accepted)"
+                                           : "an edge face at its cell's centre";
+                if (faces_of_cell == 3) *want = DPSM_OK;
                 break;
             }
             case 8: *what = "a count below 1"; *want = DPSM_ERR_INVALID_SIZE; if (prng_below(p, 2)) ncells = 0; else nfaces = -(int64_t)prng_below(p, 2); break;
@@ -2373,6 +2386,23 @@ static void mesh_operation(mesh_state_t *ms, reader_t *r) {
             MESH_CALL(ms, DPSM_ERR_NOT_APPLICABLE, "dpsm_get_side_outflow", dpsm_get_side_outflow(ms->g, (int)(b % 4), &out));
             MESH_CALL(ms, DPSM_ERR_UNKNOWN_ENUM, "dpsm_get_side_outflow", dpsm_get_side_outflow(ms->g, 5 + (int)(b % 3), &out));
             MESH_CALL(ms, DPSM_ERR_NOT_APPLICABLE, "dpsm_set_side_levels", dpsm_set_side_levels(ms->g, (int)(b % 4), v));
+            /* Where each cell lies: the harness's own centroids (a graph's
+             * centres, the dual's nodes) and areas, in the host's order. */
+            double *xy = xcalloc((size_t)(2 * n), sizeof(double)), *area = xcalloc((size_t)n, sizeof(double));
+            MESH_CALL(ms, DPSM_OK, "dpsm_get_cell_centres",
+                      dpsm_get_cell_centres(ms->g, b & 8 ? NULL : xy, b & 16 ? NULL : area));
+            MESH_CALL(ms, DPSM_ERR_NULL_POINTER, "dpsm_get_cell_centres", dpsm_get_cell_centres(ms->g, NULL, NULL));
+            for (int64_t c = 0; c < n; ++c) {
+                const double scale = fmax(fabs(m->cx[c]) + fabs(m->cy[c]), 1.0);
+                if (!(b & 8) && (fabs(xy[2 * c] - m->cx[c]) > 1e-12 * scale || fabs(xy[2 * c + 1] - m->cy[c]) > 1e-12 * scale))
+                    die("dpsm_get_cell_centres: cell %lld at (%.17g, %.17g), the harness has (%.17g, %.17g)", (long long)c,
+                        xy[2 * c], xy[2 * c + 1], m->cx[c], m->cy[c]);
+                if (!(b & 16) && fabs(area[c] - m->area[c]) > 1e-12 * m->area[c])
+                    die("dpsm_get_cell_centres: cell %lld has area %.17g, the harness %.17g", (long long)c, area[c],
+                        m->area[c]);
+            }
+            free(xy);
+            free(area);
             /* The mesh functions without a mesh. */
             int64_t count = 0;
             static const char *const names[] = {"dpsm_get_face_count", "dpsm_get_mesh_faces", "dpsm_set_edge_kinds"};
@@ -2448,6 +2478,28 @@ static void op_mesh(reader_t *r) {
         return;
     }
     if (*dpsm_last_error(NULL)) die("%s succeeded but left the message \"%s\"", fn, dpsm_last_error(NULL));
+    if (defect >= 0) {
+        /* A planted "defect" the library accepts (a triangle's centre on its
+         * edge face): its geometry is no longer the harness's, so only a
+         * step with the ledger closing and the heights finite. */
+        double dt = 0.0, total = 0.0, sourced = 0.0, external = 0.0, outflow = 0.0;
+        double *h = xcalloc((size_t)m.ncells, sizeof(double));
+        for (int64_t c = 0; c < m.ncells; ++c) h[c] = (double)(c % 3);
+        if (dpsm_stable_dt(g, &dt) != DPSM_OK || !(dt > 0.0) || !isfinite(dt)) die("%s: stable dt %g", what, dt);
+        if (dpsm_set_boundary(g, DPSM_MESH_EDGE, DPSM_OPEN) != DPSM_OK || dpsm_set_heights(g, h) != DPSM_OK ||
+            dpsm_step(g, 10.0 * dt) != DPSM_OK || dpsm_get_heights(g, h) != DPSM_OK)
+            die("%s: a step failed: %s", what, dpsm_last_error(g));
+        for (int64_t c = 0; c < m.ncells; ++c)
+            if (!isfinite(h[c])) die("%s: h[%lld] = %g after a step", what, (long long)c, h[c]);
+        dpsm_get_mass(g, DPSM_MASS_TOTAL, &total), dpsm_get_mass(g, DPSM_MASS_SOURCED, &sourced);
+        dpsm_get_mass(g, DPSM_MASS_EXTERNAL, &external), dpsm_get_mass(g, DPSM_MASS_OUTFLOW, &outflow);
+        if (fabs(total - (sourced + external - outflow)) > 1e-9 * fmax(fabs(external), 1.0))
+            die("%s: the ledger does not close (%g vs %g)", what, total, sourced + external - outflow);
+        free(h);
+        dpsm_destroy(g);
+        mesh_free(&m);
+        return;
+    }
     /* The shape, and the faces the harness expects. */
     int64_t sx = 0, sy = 0, nf = 0;
     if (dpsm_get_shape(g, &sx, &sy) != DPSM_OK || sx != m.ncells || sy != 1)
@@ -2514,6 +2566,208 @@ static void op_mesh(reader_t *r) {
 }
 
 /* ------------------------------------------------------------------------ */
+/* Where cells lie, and meshes in degrees (issue 36)                         */
+/* ------------------------------------------------------------------------ */
+
+/* op_geometry (opcode kGeoOp): its first byte b.
+ *
+ *   b % 2 == 0: dpsm_get_cell_centres on a grid slot (a slot byte, then a
+ *   byte: bit 0 no xy, bit 1 no area, both refused with
+ *   DPSM_ERR_NULL_POINTER and nothing changed), against the harness's own
+ *   cell centres ((i + 1/2) dx, (j + 1/2) dy; 0 for y in 1D) and the areas
+ *   of its ledger, bit for bit.
+ *
+ *   b % 2 == 1: a mesh in longitude and latitude, built, checked and
+ *   destroyed: (b / 2) % 2 quads (dpsm_create_mesh_geographic) or
+ *   triangles (dpsm_create_dual_mesh_geographic), then nx, ny (2 + byte % 6),
+ *   the spacing kGeoSpacings[byte % 5] degrees, the corner's latitude
+ *   kGeoLatitudes[byte % 6] and longitude kGeoLongitudes[byte % 4], the start
+ *   index (byte % 2) and a defect byte (>= 0xc0: (byte & 0x3f) % 4 of: a
+ *   latitude beyond 90, a longitude beyond 540, a NaN coordinate, a node on
+ *   the far side of the globe; each refused with DPSM_ERR_INVALID_VALUE,
+ *   *out NULL and a message naming the function). A made mesh: its cells'
+ *   areas (dpsm_get_cell_centres) are the spherical areas the harness
+ *   computes itself by l'Huilier's theorem, to 1e-6; each centre lies in
+ *   its cell's box of longitudes and latitudes; a stable sub-step finite
+ *   and positive; a step from a pile on a wall edge keeps the ledger closed
+ *   (to 1e-9), makes no new extremum, and a copy through dpsm_save and
+ *   dpsm_load takes the same step to the same heights bit for bit. */
+enum { kGeoOp = 252 };
+static const double kGeoSpacings[] = {1e-3, 0.01, 0.1, 1.0, 5.0};
+static const double kGeoLatitudes[] = {-89.0, -45.0, 0.0, 30.0, 60.0, 84.0};
+static const double kGeoLongitudes[] = {-180.0, 0.0, 179.5, 359.0};
+
+typedef struct {
+    double x, y, z;
+} unit_t;
+
+static unit_t unit_of(double lon, double lat) {
+    const double d = 3.14159265358979323846 / 180.0;
+    return (unit_t){cos(lat * d) * cos(lon * d), cos(lat * d) * sin(lon * d), sin(lat * d)};
+}
+
+static double arc(unit_t a, unit_t b) {
+    const double cx = a.y * b.z - a.z * b.y, cy = a.z * b.x - a.x * b.z, cz = a.x * b.y - a.y * b.x;
+    return atan2(sqrt(cx * cx + cy * cy + cz * cz), a.x * b.x + a.y * b.y + a.z * b.z);
+}
+
+/* The area of a spherical triangle on the Earth's mean sphere, by l'Huilier. */
+static double spherical_triangle(unit_t a, unit_t b, unit_t c) {
+    const double x = arc(b, c), y = arc(c, a), z = arc(a, b), s = 0.5 * (x + y + z);
+    const double t = tan(0.5 * s) * tan(0.5 * (s - x)) * tan(0.5 * (s - y)) * tan(0.5 * (s - z));
+    const double r = 6371008.8;
+    return 4.0 * atan(sqrt(fmax(t, 0.0))) * r * r;
+}
+
+static void op_cell_centres_on_a_grid(reader_t *r) {
+    g_op = "dpsm_get_cell_centres";
+    slot_t *s = pick_slot(r);
+    const unsigned b = u8(r);
+    if (!s) return;
+    const int no_xy = (b & 1) != 0, no_area = (b & 2) != 0;
+    snap_t before;
+    snap(s->g, s, &before);
+    double *xy = xcalloc((size_t)(2 * s->n), sizeof(double)), *area = xcalloc((size_t)s->n, sizeof(double));
+    const int st = dpsm_get_cell_centres(s->g, no_xy ? NULL : xy, no_area ? NULL : area);
+    expect_status(st, no_xy && no_area ? DPSM_ERR_NULL_POINTER : DPSM_OK, g_op, s->g);
+    if (st != DPSM_OK) check_failed(s, s->g, &before, st, g_op);
+    for (int64_t c = 0; st == DPSM_OK && c < s->n; ++c) {
+        const double x = ((double)(c % s->nx) + 0.5) * s->dx;
+        const double y = s->geom == GEOM_2D ? ((double)(c / s->nx) + 0.5) * s->dy : 0.0;
+        if (!no_xy && (xy[2 * c] != x || xy[2 * c + 1] != y))
+            die("dpsm_get_cell_centres: cell %lld at (%.17g, %.17g), expected (%.17g, %.17g)", (long long)c, xy[2 * c],
+                xy[2 * c + 1], x, y);
+        if (!no_area && area[c] != cell_area(s, c))
+            die("dpsm_get_cell_centres: cell %lld has area %.17g, expected %.17g", (long long)c, area[c],
+                cell_area(s, c));
+    }
+    free(xy);
+    free(area);
+    unsnap(&before);
+}
+
+static void op_geographic_mesh(reader_t *r, unsigned b) {
+    const int dual = (b / 2) % 2;
+    const char *fn = dual ? "dpsm_create_dual_mesh_geographic" : "dpsm_create_mesh_geographic";
+    g_op = fn;
+    const int64_t nx = 2 + u8(r) % 6, ny = 2 + u8(r) % 6;
+    const double step = kGeoSpacings[u8(r) % COUNT(kGeoSpacings)];
+    double lat0 = kGeoLatitudes[u8(r) % COUNT(kGeoLatitudes)];
+    const double lon0 = kGeoLongitudes[u8(r) % COUNT(kGeoLongitudes)];
+    const int base = (int)(u8(r) % 2);
+    const unsigned defect_byte = u8(r);
+    if (lat0 + (double)ny * step > 89.9) lat0 = 89.9 - (double)ny * step; /* the lattice stays off the pole */
+    const int64_t nnodes = (nx + 1) * (ny + 1), nquads = nx * ny;
+    double *lonlat = xcalloc((size_t)(2 * nnodes), sizeof(double));
+    for (int64_t j = 0; j <= ny; ++j)
+        for (int64_t i = 0; i <= nx; ++i) {
+            lonlat[2 * (i + (nx + 1) * j)] = lon0 + (double)i * step;
+            lonlat[2 * (i + (nx + 1) * j) + 1] = lat0 + (double)j * step;
+        }
+    int64_t *start = xcalloc((size_t)(nquads + 1), sizeof(int64_t)), *nodes = xcalloc((size_t)(6 * nquads), sizeof(int64_t));
+    for (int64_t q = 0; q < nquads; ++q) {
+        const int64_t i = q % nx, j = q / nx, n0 = i + (nx + 1) * j;
+        const int64_t corner[4] = {n0, n0 + 1, n0 + nx + 2, n0 + nx + 1};
+        start[q + 1] = 4 * (q + 1) + base;
+        if (!dual) {
+            for (int k = 0; k < 4; ++k) nodes[4 * q + k] = corner[k] + base;
+        } else {
+            const int64_t tri[6] = {corner[0], corner[1], corner[2], corner[0], corner[2], corner[3]};
+            for (int k = 0; k < 6; ++k) nodes[6 * q + k] = tri[k] + base;
+        }
+    }
+    start[0] = base;
+    int want = DPSM_OK;
+    const char *what = "none";
+    if ((defect_byte & 0xc0) == 0xc0) {
+        want = DPSM_ERR_INVALID_VALUE;
+        const int64_t k = (int64_t)(defect_byte % (unsigned)nnodes);
+        switch ((defect_byte & 0x3f) % 4) {
+            case 0: what = "a latitude beyond 90"; lonlat[2 * k + 1] = 90.5; break;
+            case 1: what = "a longitude beyond 540"; lonlat[2 * k] = 541.0; break;
+            case 2: what = "a NaN coordinate"; lonlat[2 * k + (defect_byte & 1)] = NAN; break;
+            default: what = "a node on the far side of the globe"; lonlat[2 * k] = lon0 + 180.0, lonlat[2 * k + 1] = -lat0; break;
+        }
+    }
+    dpsm_grid *g = (dpsm_grid *)&g;
+    const int64_t ncells = dual ? nnodes : nquads;
+    const int st = dual ? dpsm_create_dual_mesh_geographic(base, nnodes, lonlat, 2 * nquads, nodes, &g)
+                        : dpsm_create_mesh_geographic(base, nnodes, lonlat, nquads, start, nodes, &g);
+    trace("%s (%lld x %lld at %g, %g by %g degrees, from %d, defect: %s) -> %s", fn, (long long)nx, (long long)ny, lon0,
+          lat0, step, base, what, dpsm_status_string(st));
+    if (st != want) die("%s with %s returned %s, expected %s (%s)", fn, what, dpsm_status_string(st), dpsm_status_string(want), dpsm_last_error(NULL));
+    if (st != DPSM_OK) {
+        check_failed(NULL, NULL, NULL, st, fn);
+        if (g != NULL) die("%s failed (%s) but did not set *out to NULL", fn, what);
+    } else {
+        /* The harness's own areas: each quad two spherical triangles (the
+         * dual: a third of each triangle to each of its nodes). */
+        double *expected = xcalloc((size_t)ncells, sizeof(double)), *xy = xcalloc((size_t)(2 * ncells), sizeof(double));
+        double *area = xcalloc((size_t)ncells, sizeof(double)), *h = xcalloc((size_t)ncells, sizeof(double));
+        double *h2 = xcalloc((size_t)ncells, sizeof(double));
+        for (int64_t q = 0; q < nquads; ++q) {
+            const int64_t *v = nodes + (dual ? 6 : 4) * q;
+            const int64_t t[6] = {v[0], v[1], v[2], v[0], v[2], dual ? v[5] : v[3]};
+            for (int half = 0; half < 2; ++half) {
+                const int64_t a = t[3 * half] - base, bb = t[3 * half + 1] - base, c = t[3 * half + 2] - base;
+                const double e = spherical_triangle(unit_of(lonlat[2 * a], lonlat[2 * a + 1]),
+                                                    unit_of(lonlat[2 * bb], lonlat[2 * bb + 1]),
+                                                    unit_of(lonlat[2 * c], lonlat[2 * c + 1]));
+                if (dual) expected[a] += e / 3.0, expected[bb] += e / 3.0, expected[c] += e / 3.0;
+                else expected[q] += e;
+            }
+        }
+        if (dpsm_get_cell_centres(g, xy, area) != DPSM_OK) die("%s: dpsm_get_cell_centres failed: %s", fn, dpsm_last_error(g));
+        for (int64_t c = 0; c < ncells; ++c) {
+            if (!(fabs(area[c] - expected[c]) <= 1e-6 * expected[c]))
+                die("%s: cell %lld has area %.17g m2, l'Huilier's %.17g", fn, (long long)c, area[c], expected[c]);
+            /* The centre: within the cell's box (a dual's: its node). */
+            const int64_t i = dual ? c % (nx + 1) : c % nx, j = dual ? c / (nx + 1) : c / nx;
+            const double slack = dual ? 1e-9 : 1e-9 + 0.0;
+            const double lo_lon = lon0 + (double)i * step - slack, hi_lon = lon0 + (double)(i + (dual ? 0 : 1)) * step + slack;
+            const double lo_lat = lat0 + (double)j * step - slack, hi_lat = lat0 + (double)(j + (dual ? 0 : 1)) * step + slack;
+            if (!(xy[2 * c] >= lo_lon && xy[2 * c] <= hi_lon && xy[2 * c + 1] >= lo_lat && xy[2 * c + 1] <= hi_lat))
+                die("%s: cell %lld stands at (%.17g, %.17g), outside [%.17g, %.17g] x [%.17g, %.17g]", fn, (long long)c,
+                    xy[2 * c], xy[2 * c + 1], lo_lon, hi_lon, lo_lat, hi_lat);
+            h[c] = c == ncells / 2 ? 1e3 * step : 0.0; /* a pile steep at any spacing */
+        }
+        double dt = 0.0;
+        if (dpsm_stable_dt(g, &dt) != DPSM_OK || !(dt > 0.0) || !isfinite(dt)) die("%s: stable dt %g", fn, dt);
+        char path[64];
+        const char *dir = getenv("TMPDIR");
+        snprintf(path, sizeof path, "%s/dpsm-fuzz-geo-%ld.dpsm", dir && *dir ? dir : "/tmp", (long)getpid());
+        dpsm_grid *copy = NULL;
+        if (dpsm_set_heights(g, h) != DPSM_OK || dpsm_save(g, path) != DPSM_OK || dpsm_load(path, &copy) != DPSM_OK)
+            die("%s: set, save or load failed: %s / %s", fn, dpsm_last_error(g), dpsm_last_error(NULL));
+        remove(path);
+        if (dpsm_step(g, 2.0 * dt) != DPSM_OK || dpsm_step(copy, 2.0 * dt) != DPSM_OK)
+            die("%s: a step failed: %s / %s", fn, dpsm_last_error(g), dpsm_last_error(copy));
+        dpsm_get_heights(g, h);
+        dpsm_get_heights(copy, h2);
+        double total, sourced, external, outflow;
+        dpsm_get_mass(g, DPSM_MASS_TOTAL, &total), dpsm_get_mass(g, DPSM_MASS_SOURCED, &sourced);
+        dpsm_get_mass(g, DPSM_MASS_EXTERNAL, &external), dpsm_get_mass(g, DPSM_MASS_OUTFLOW, &outflow);
+        if (fabs(total - (sourced + external - outflow)) > 1e-9 * fabs(external))
+            die("%s: the ledger does not close: %.17g vs %.17g", fn, total, sourced + external - outflow);
+        for (int64_t c = 0; c < ncells; ++c) {
+            if (!(h[c] >= 0.0 && h[c] <= 1e3 * step)) die("%s: h[%lld] = %.17g left [0, %g]", fn, (long long)c, h[c], 1e3 * step);
+            if (memcmp(&h[c], &h2[c], sizeof(double)) != 0)
+                die("%s: the loaded copy steps cell %lld to %.17g, the mesh to %.17g", fn, (long long)c, h2[c], h[c]);
+        }
+        dpsm_destroy(copy);
+        dpsm_destroy(g);
+        free(expected), free(xy), free(area), free(h), free(h2);
+    }
+    free(lonlat), free(start), free(nodes);
+}
+
+static void op_geometry(reader_t *r) {
+    const unsigned b = u8(r);
+    if (b % 2 == 0) op_cell_centres_on_a_grid(r);
+    else op_geographic_mesh(r, b);
+}
+
+/* ------------------------------------------------------------------------ */
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
     reader_t r = {data, size, 0};
@@ -2524,9 +2778,12 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
         ++g_opcount;
         /* Bytes from kLaterOps on name the operations added later, so that
          * older inputs (the corpus' regression_* files) replay as they did. */
-        const unsigned byte = u8(&r), op = byte == kMeshOp ? 26 : byte >= kLaterOps ? 25 : byte % 25;
+        const unsigned byte = u8(&r),
+                       op = byte == kMeshOp ? 26 : byte == kGeoOp ? 27 : byte >= kLaterOps ? 25 : byte % 25;
         if (op == 26)
             op_mesh(&r);
+        else if (op == 27)
+            op_geometry(&r);
         else if (op < 2)
             op_create(&r);
         else if (op < 9)

@@ -390,6 +390,34 @@ seed("mesh_bad_from_one",
      mesh("polygons", "quads", 3, 3, numbering=1, ops=[m_heights(0, 1.0, plant=0), m_kinds(0xE1),
                                                       m_edge_kinds(0xE2), m_levels(0xE1, 1.0)]))
 
+# Where cells lie and meshes in degrees (op_geometry, byte GEO = 252): b even,
+# then a slot and a byte (bit 0 no xy, bit 1 no area): dpsm_get_cell_centres on
+# a grid; b odd (b / 2 % 2: 0 quads, 1 the dual of triangles), then nx - 2,
+# ny - 2, kGeoSpacings {1e-3, 0.01, 0.1, 1, 5} degrees, kGeoLatitudes {-89,
+# -45, 0, 30, 60, 84}, kGeoLongitudes {-180, 0, 179.5, 359} indices, the start
+# index and a defect byte (0xc0 + k: 0 a latitude beyond 90, 1 a longitude
+# beyond 540, 2 a NaN, 3 a node across the globe; else none).
+GEO = 252
+
+
+def cell_centres(slot, b=0):
+    return [GEO, 0, slot, b]
+
+
+def geographic(dual, nx, ny, spacing, latitude, longitude, start_index=0, defect=None):
+    return [GEO, 1 + 2 * dual, nx - 2, ny - 2, spacing, latitude, longitude, start_index,
+            0 if defect is None else 0xC0 + defect]
+
+
+seed("cell_centres",
+     create(0, "2d", 5, 4, dx=0.5, dy=2.0), cell_centres(0), cell_centres(0, 1), cell_centres(0, 2),
+     cell_centres(0, 3), create(1, "1d", 7, dx=0.25), cell_centres(1), create(2, "axi", 6, dx=3.0),
+     cell_centres(2), cell_centres(2, 1))
+seed("geographic",
+     geographic(0, 4, 3, 2, 4, 1), geographic(1, 5, 4, 1, 3, 2, start_index=1), geographic(0, 3, 3, 4, 5, 0),
+     geographic(1, 2, 2, 0, 0, 3), geographic(0, 6, 2, 3, 1, 2, start_index=1))
+seed("geographic_bad", *[geographic(k % 2, 3, 3, 2, 3, 1, start_index=k // 4, defect=k % 4) for k in range(8)])
+
 rng = random.Random(20240611)
 for k in range(8):
     SEEDS[f"random_{k}"] = bytes(rng.randrange(256) for _ in range(rng.choice((16, 40, 100, 300))))

@@ -1134,5 +1134,55 @@ class TestMesh(LedgerMixin, unittest.TestCase):
         self.assertEqual(e.function, "dpsm_create_mesh")
 
 
+
+class TestMeshesOfHosts(LedgerMixin, unittest.TestCase):
+    """Issue 36: meshes in longitude and latitude, where each cell lies, one prefix per message."""
+
+    RADIUS = 6371008.8
+
+    def test_geographic_octant(self):
+        octant = [(0.0, 0.0), (90.0, 0.0), (0.0, 90.0)]
+        with dpsm.Grid.create_mesh_geographic(octant, [0, 3], [0, 1, 2]) as g:
+            xy, area = g.get_cell_centres()
+            self.assertAlmostEqual(as_list(area)[0], math.pi * self.RADIUS ** 2 / 2, delta=1e-12 * self.RADIUS ** 2)
+            self.assertAlmostEqual(as_list(xy)[0][0], 45.0, delta=1e-9)
+        with dpsm.Grid.create_dual_mesh_geographic([v for p in octant for v in p], [1, 2, 3], start_index=1) as g:
+            xy, area = g.get_cell_centres()
+            self.assertAlmostEqual(sum(as_list(area)), math.pi * self.RADIUS ** 2 / 2, delta=1e-12 * self.RADIUS ** 2)
+            self.assertEqual(as_list(xy), [list(p) for p in octant])
+        e = self.assertFails(dpsm.ERR_INVALID_VALUE, dpsm.Grid.create_mesh_geographic,
+                             [(0.0, 0.0), (1.0, 0.0), (0.0, 91.0)], [0, 3], [0, 1, 2])
+        self.assertIn("node_lonlat[5] (latitude of node 2) = 91 is not within [-90, 90]", str(e))
+        self.assertFails(dpsm.ERR_INVALID_VALUE, dpsm.Grid.create_mesh_geographic, octant, [1, 4], [1, 2, 3],
+                         start_index=2)
+
+    def test_cell_centres(self):
+        with dpsm.Grid.create_mesh([(0, 0), (1, 0), (1, 1), (0, 1), (2, 0)], [0, 4, 7], [0, 1, 2, 3, 1, 4, 2]) as g:
+            xy, area = g.get_cell_centres()
+            xy = as_list(xy)
+            self.assertAlmostEqual(xy[1][0], 4.0 / 3.0, delta=1e-15)
+            self.assertAlmostEqual(xy[1][1], 1.0 / 3.0, delta=1e-15)
+            self.assertEqual(as_list(area), [1.0, 0.5])
+            out_xy, out_area = array.array("d", bytes(32)), array.array("d", bytes(16))
+            same_xy, same_area = g.get_cell_centres(out_xy, out_area)
+            self.assertIs(same_xy, out_xy)
+            self.assertEqual(list(out_area), [1.0, 0.5])
+            self.assertEqual(g.cell_centres()[1] is not None, True)
+        with dpsm.Grid.create_2d(3, 2, 0.5, 2.0) as g:
+            xy, area = g.get_cell_centres()
+            self.assertEqual(as_list(xy)[5], [1.25, 3.0])
+            self.assertEqual(as_list(area), [1.0] * 6)
+        with dpsm.Grid.create_1d(3, 0.5) as g:
+            self.assertRaises(TypeError, g.get_cell_centres, array.array("i", [0] * 6))
+
+    def test_one_prefix_per_message(self):
+        with self.assertRaises(dpsm.Error) as caught:
+            dpsm.Grid.create_mesh([(0, 0), (1, 0), (1, 1)], [0, 3], [0, 1, 5])
+        text = str(caught.exception)
+        self.assertTrue(text.startswith("dpsm_create_mesh: DPSM_ERR_INVALID_VALUE: cell_nodes[2] = 5"), text)
+        self.assertEqual(text.count("dpsm_create_mesh"), 1, text)
+        self.assertTrue(caught.exception.message.startswith("dpsm_create_mesh: "), "the library's message is whole")
+
+
 if __name__ == "__main__":
     unittest.main()

@@ -91,7 +91,9 @@ class Error(Exception):
         ## The name of the status (dpsm_status_string).
         self.status_name = status_string(status)
         where = function + ": " if function else ""
-        super().__init__("%s%s: %s" % (where, self.status_name, message))
+        # The library's messages begin with the function's name already: one prefix is enough.
+        text = message[len(where):] if where and message.startswith(where) else message
+        super().__init__("%s%s: %s" % (where, self.status_name, text))
 
 
 def _c_path(path, function):
@@ -512,7 +514,10 @@ class Grid:
     def _mesh_function(function, start_index):
         """The C constructor and the start index to pass it: the plain one
         from 0, the ``_indexed`` one otherwise (which refuses a start index
-        other than 0 and 1 with its message)."""
+        other than 0 and 1 with its message); a ``_geographic`` one always
+        takes it."""
+        if function.endswith("_geographic"):
+            return function, (_c_int(start_index, "start_index", function, C.DPSM_ERR_INVALID_VALUE),)
         name = function if function.endswith("_indexed") else function + "_indexed"
         start_index = _c_int(start_index, "start_index", name, C.DPSM_ERR_INVALID_VALUE)
         if start_index == 0 and not function.endswith("_indexed"):
@@ -537,9 +542,9 @@ class Grid:
         return cls._polygons("dpsm_create_mesh_indexed", start_index, node_xy, cell_start, cell_nodes)
 
     @classmethod
-    def _polygons(cls, function, start_index, node_xy, cell_start, cell_nodes):
+    def _polygons(cls, function, start_index, node_xy, cell_start, cell_nodes, name="node_xy"):
         f, first = cls._mesh_function(function, start_index)
-        _, xy, nnodes, keep_xy = _table_in(node_xy, 2, "node_xy", f, False)
+        _, xy, nnodes, keep_xy = _table_in(node_xy, 2, name, f, False)
         start, start_p, nstart, keep_start = _table_in(cell_start, 1, "cell_start", f, True)
         _, nodes_p, total, keep_nodes = _table_in(cell_nodes, 1, "cell_nodes", f, True)
         ncells = max(nstart - 1, 0)
@@ -604,13 +609,30 @@ class Grid:
         return cls._dual("dpsm_create_dual_mesh_indexed", start_index, node_xy, triangle_nodes)
 
     @classmethod
-    def _dual(cls, function, start_index, node_xy, triangle_nodes):
+    def _dual(cls, function, start_index, node_xy, triangle_nodes, name="node_xy"):
         f, first = cls._mesh_function(function, start_index)
-        _, xy, nnodes, keep_xy = _table_in(node_xy, 2, "node_xy", f, False)
+        _, xy, nnodes, keep_xy = _table_in(node_xy, 2, name, f, False)
         _, tris, ntriangles, keep_tris = _table_in(triangle_nodes, 3, "triangle_nodes", f, True)
         grid = cls._create(f, "mesh", *first, nnodes, xy, ntriangles, tris)
         del keep_xy, keep_tris
         return grid
+
+    @classmethod
+    def create_mesh_geographic(cls, node_lonlat, cell_start, cell_nodes, start_index=0):
+        """``dpsm_create_mesh_geographic``: ``create_mesh`` with the nodes in
+        longitude and latitude (degrees, ``(nnodes, 2)`` or ``2*nnodes``
+        values): lengths, distances and areas on the sphere, heights in
+        metres. Indices count from ``start_index`` (0 or 1)."""
+        return cls._polygons("dpsm_create_mesh_geographic", start_index, node_lonlat, cell_start, cell_nodes,
+                             name="node_lonlat")
+
+    @classmethod
+    def create_dual_mesh_geographic(cls, node_lonlat, triangle_nodes, start_index=0):
+        """``dpsm_create_dual_mesh_geographic``: ``create_dual_mesh`` with the
+        nodes in longitude and latitude (degrees): the median dual on the
+        sphere. Indices count from ``start_index`` (0 or 1)."""
+        return cls._dual("dpsm_create_dual_mesh_geographic", start_index, node_lonlat, triangle_nodes,
+                         name="node_lonlat")
 
     ## Short name of create_mesh.
     mesh = create_mesh
@@ -1007,6 +1029,26 @@ class Grid:
         self._call(f, buffer)
         return [[buffer[2 * k], buffer[2 * k + 1]] for k in range(nfaces)]
 
+    def get_cell_centres(self, out_xy=None, out_area=None):
+        """``dpsm_get_cell_centres``: ``(xy, area)``, where each cell's height
+        stands and the area that turns it into a volume, in the host's cell
+        order: ``xy`` of shape ``(ncells, 2)`` (a polygon's centroid, a
+        graph's given centre, a dual's node; longitude and latitude in
+        degrees on a geographic mesh; cell centres on a grid, x fastest) and
+        ``area`` of ``ncells`` values (square metres on a geographic mesh;
+        the ledger's weights on a grid). Numpy arrays, or lists (``xy`` a
+        list of ``[x, y]`` pairs) without numpy; ``out_xy`` and ``out_area``
+        (writable float64 buffers of ``2*ncells`` and ``ncells`` values) are
+        filled and returned instead. Also ``cell_centres()``."""
+        f = "dpsm_get_cell_centres"
+        n = self.nx * self.ny
+        xy_pointer, xy_result, xy_finish = self._doubles_out((n, 2), out_xy, "cell_xy", f)
+        area_pointer, area_result, area_finish = self._doubles_out((n,), out_area, "cell_area", f)
+        self._call(f, xy_pointer, area_pointer)
+        return (xy_finish() if xy_finish else xy_result), (area_finish() if area_finish else area_result)
+
+    ## Short name of get_cell_centres.
+    cell_centres = get_cell_centres
     ## Short name of get_face_count.
     face_count = get_face_count
     ## Short name of get_mesh_faces.
