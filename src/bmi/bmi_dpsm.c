@@ -14,24 +14,40 @@ static const double kDegreesPerRadian = 180 / 3.14159265358979323846;
 
 struct variable_info {
     const char *name;
-    const char *units;
+    const char *units; /* as UDUNITS-2 parses them */
     enum place place;
     int input, output;
+    const char *former; /* the name before 0.1's release, still understood (not listed) */
 };
 
+/* The names are CSDMS Standard Names: the registry's own where it has one
+ * (land_surface__elevation, bedrock_surface__elevation), else built by its
+ * rules from quantities and operators its names use (docs/guide_bmi.md
+ * lists which). The bed is an input only: with no bed set there is nothing
+ * to read, and BMI lists as outputs what can be read after initialize. */
 static const struct variable_info kVariables[VAR_COUNT] = {
-    [VAR_ELEVATION] = {"land_surface__elevation", "m", PLACE_CELLS, 1, 1},
-    [VAR_BEDROCK] = {"bedrock_surface__elevation", "m", PLACE_CELLS, 1, 1},
-    [VAR_DEPOSITION_RATE] = {"land_surface__net_deposition_rate", "m s-1", PLACE_CELLS, 1, 0},
-    [VAR_REPOSE_ANGLE] = {"sediment__angle_of_repose", "deg", PLACE_CELLS, 1, 1},
-    [VAR_FLUX_X] = {"land_surface_sediment__x_component_of_avalanche_volume_flux", "m3 s-1", PLACE_FLUX_X, 0, 1},
-    [VAR_FLUX_Y] = {"land_surface_sediment__y_component_of_avalanche_volume_flux", "m3 s-1", PLACE_FLUX_Y, 0, 1},
-    [VAR_FLUX_EDGES] = {"land_surface_sediment__avalanche_volume_flux", "m3 s-1", PLACE_EDGES, 0, 1},
-    [VAR_TOTAL_VOLUME] = {"land_surface_sediment__total_volume", "m3", PLACE_SCALAR, 0, 1},
-    [VAR_SOURCED_VOLUME] = {"land_surface_sediment__sourced_volume", "m3", PLACE_SCALAR, 0, 1},
-    [VAR_OUTFLOW_VOLUME] = {"land_surface_sediment__outflow_volume", "m3", PLACE_SCALAR, 0, 1},
-    [VAR_EXTERNAL_VOLUME] = {"land_surface_sediment__external_volume", "m3", PLACE_SCALAR, 0, 1},
-    [VAR_UNMET_VOLUME] = {"land_surface_sediment__unmet_erosion_volume", "m3", PLACE_SCALAR, 0, 1},
+    [VAR_ELEVATION] = {"land_surface__elevation", "m", PLACE_CELLS, 1, 1, NULL},
+    [VAR_BEDROCK] = {"bedrock_surface__elevation", "m", PLACE_CELLS, 1, 0, NULL},
+    [VAR_DEPOSITION_RATE] = {"land_surface_sediment_deposition__net_volume_flux", "m s-1", PLACE_CELLS, 1, 0,
+                             "land_surface__net_deposition_rate"},
+    [VAR_REPOSE_ANGLE] = {"land_surface_sediment__repose_angle", "degree", PLACE_CELLS, 1, 1,
+                          "sediment__angle_of_repose"},
+    [VAR_FLUX_X] = {"land_surface_sediment_flowing__x_component_of_volume_rate", "m3 s-1", PLACE_FLUX_X, 0, 1,
+                    "land_surface_sediment__x_component_of_avalanche_volume_flux"},
+    [VAR_FLUX_Y] = {"land_surface_sediment_flowing__y_component_of_volume_rate", "m3 s-1", PLACE_FLUX_Y, 0, 1,
+                    "land_surface_sediment__y_component_of_avalanche_volume_flux"},
+    [VAR_FLUX_EDGES] = {"land_surface_sediment_flowing__volume_rate", "m3 s-1", PLACE_EDGES, 0, 1,
+                        "land_surface_sediment__avalanche_volume_flux"},
+    [VAR_TOTAL_VOLUME] = {"land_surface_sediment__volume", "m3", PLACE_SCALAR, 0, 1,
+                          "land_surface_sediment__total_volume"},
+    [VAR_SOURCED_VOLUME] = {"land_surface_sediment_deposition__domain_time_integral_of_net_volume_flux", "m3",
+                            PLACE_SCALAR, 0, 1, "land_surface_sediment__sourced_volume"},
+    [VAR_OUTFLOW_VOLUME] = {"land_surface_sediment_flowing_sink__time_integral_of_volume_rate", "m3", PLACE_SCALAR, 0, 1,
+                            "land_surface_sediment__outflow_volume"},
+    [VAR_EXTERNAL_VOLUME] = {"land_surface_sediment_source__time_integral_of_volume_rate", "m3",
+                             PLACE_SCALAR, 0, 1, "land_surface_sediment__external_volume"},
+    [VAR_UNMET_VOLUME] = {"land_surface_sediment_erosion~unmet__domain_time_integral_of_volume_flux", "m3",
+                          PLACE_SCALAR, 0, 1, "land_surface_sediment__unmet_erosion_volume"},
 };
 
 /* The ledger figure behind each scalar. */
@@ -88,7 +104,9 @@ int component_place_of_grid(const struct component *c, int grid) {
 static int find_variable(const struct component *c, const char *name, const char *function) {
     if (!name) return component_fail(function, "the variable name is NULL"), -1;
     for (int v = 0; v < VAR_COUNT; ++v)
-        if (strcmp(kVariables[v].name, name) == 0 && component_place(c, (enum variable)v) >= 0) return v;
+        if ((strcmp(kVariables[v].name, name) == 0 || (kVariables[v].former && strcmp(kVariables[v].former, name) == 0)) &&
+            component_place(c, (enum variable)v) >= 0)
+            return v;
     component_fail(function, "no variable \"%s\" (get_input_var_names and get_output_var_names list them)", name);
     return -1;
 }
@@ -149,8 +167,8 @@ static int initialize(Bmi *self, const char *config_file) {
         failed = c->values[v] == NULL;
     }
     if (!failed) {
-        c->carried_x = calloc((size_t)(c->scene.has_mesh ? c->sizes[VAR_FLUX_EDGES] : c->sizes[VAR_FLUX_X]),
-                              sizeof(double));
+        /* On a mesh every library face (a dual's halves on the domain edge too); the BMI edges are the first. */
+        c->carried_x = calloc((size_t)(c->scene.has_mesh ? c->scene.face_count : c->sizes[VAR_FLUX_X]), sizeof(double));
         c->carried_y = c->sizes[VAR_FLUX_Y] ? calloc((size_t)c->sizes[VAR_FLUX_Y], sizeof(double)) : NULL;
         failed = !c->carried_x || (c->sizes[VAR_FLUX_Y] && !c->carried_y);
     }
@@ -177,9 +195,12 @@ static int finalize(Bmi *self) {
 
 /* One dpsm_step of `dt`, adding what each face carried to the sums. */
 static int step(struct component *c, double dt, const char *function) {
+    char message[CONFIG_MESSAGE_MAX];
+    if (config_scene_before_step(&c->scene, message, sizeof message))
+        return component_fail(function, "at t = %.17g s: %s", c->time, message);
     if (dpsm_step(c->scene.grid, dt) != DPSM_OK)
         return component_fail(function, "at t = %.17g s: %s", c->time, dpsm_last_error(c->scene.grid));
-    int64_t nx_faces = c->scene.has_mesh ? c->sizes[VAR_FLUX_EDGES] : c->sizes[VAR_FLUX_X];
+    int64_t nx_faces = c->scene.has_mesh ? c->scene.face_count : c->sizes[VAR_FLUX_X];
     double *fx = malloc((size_t)nx_faces * sizeof *fx);
     double *fy = c->carried_y ? malloc((size_t)c->sizes[VAR_FLUX_Y] * sizeof *fy) : NULL;
     if (!fx || (c->carried_y && !fy) || dpsm_get_face_fluxes(c->scene.grid, fx, fy) != DPSM_OK) {
@@ -197,7 +218,7 @@ static int step(struct component *c, double dt, const char *function) {
  * carried over the whole advance divided by its duration. */
 static int advance_to(struct component *c, double then, const char *function) {
     double start = c->time, dt = c->config.time_step;
-    int64_t nx_faces = c->scene.has_mesh ? c->sizes[VAR_FLUX_EDGES] : c->sizes[VAR_FLUX_X];
+    int64_t nx_faces = c->scene.has_mesh ? c->scene.face_count : c->sizes[VAR_FLUX_X];
     memset(c->carried_x, 0, (size_t)nx_faces * sizeof(double));
     if (c->carried_y) memset(c->carried_y, 0, (size_t)c->sizes[VAR_FLUX_Y] * sizeof(double));
     int status = BMI_SUCCESS;
@@ -211,7 +232,7 @@ static int advance_to(struct component *c, double then, const char *function) {
     }
     double duration = c->time - start;
     enum variable fx = c->scene.has_mesh ? VAR_FLUX_EDGES : VAR_FLUX_X;
-    for (int64_t k = 0; k < nx_faces; ++k) c->values[fx][k] = duration > 0 ? c->carried_x[k] / duration : 0;
+    for (int64_t k = 0; k < c->sizes[fx]; ++k) c->values[fx][k] = duration > 0 ? c->carried_x[k] / duration : 0;
     for (int64_t k = 0; c->carried_y && k < c->sizes[VAR_FLUX_Y]; ++k)
         c->values[VAR_FLUX_Y][k] = duration > 0 ? c->carried_y[k] / duration : 0;
     refresh(c);
@@ -326,7 +347,8 @@ static int get_var_location(Bmi *self, const char *name, char *location) {
     struct component *c = lookup(self, name, location, "get_var_location", &v);
     if (!c) return BMI_FAILURE;
     const char *where = "node";
-    if (c->scene.has_mesh && kVariables[v].place == PLACE_CELLS) where = "face";
+    /* On a mesh the cells are its faces; on a dual mesh its nodes. */
+    if (c->scene.has_mesh && !c->scene.cells_at_nodes && kVariables[v].place == PLACE_CELLS) where = "face";
     if (kVariables[v].place == PLACE_EDGES) where = "edge";
     snprintf(location, BMI_MAX_TYPE_NAME, "%s", where);
     return BMI_SUCCESS;
@@ -352,10 +374,12 @@ static int get_time_units(Bmi *self, char *units) {
     return BMI_SUCCESS;
 }
 
-/* The bed has no value until a host sets one: no made-up heights. */
+/* The bed has no value until a host sets one: no made-up heights (it is an
+ * input, not listed as an output). */
 static int readable(const struct component *c, int v, const char *function) {
     if (v == VAR_BEDROCK && !c->has_bedrock)
-        return component_fail(function, "bedrock_surface__elevation has no value: no bed was set (set_value first)");
+        return component_fail(function, "bedrock_surface__elevation has no value: no bed was set (it is an input; "
+                                        "set_value first)");
     return BMI_SUCCESS;
 }
 
@@ -421,9 +445,9 @@ static int apply(struct component *c, int v, const double *field, const char *fu
 static int settable(const struct component *c, int v, const char *function) {
     (void)c;
     if (!kVariables[v].input)
-        return component_fail(function, "%s is an output only; the inputs are land_surface__elevation, "
-                                        "bedrock_surface__elevation, land_surface__net_deposition_rate and "
-                                        "sediment__angle_of_repose", kVariables[v].name);
+        return component_fail(function, "%s is an output only; the inputs are %s, %s, %s and %s", kVariables[v].name,
+                              kVariables[VAR_ELEVATION].name, kVariables[VAR_BEDROCK].name,
+                              kVariables[VAR_DEPOSITION_RATE].name, kVariables[VAR_REPOSE_ANGLE].name);
     return BMI_SUCCESS;
 }
 

@@ -92,6 +92,11 @@ static int advance(struct run *r, double *t, double target, struct progress *p, 
         int last = target - *t <= dt * (1 + 1e-6);
         double this_dt = last ? target - *t : dt;
         memcpy(r->before, r->heights, (size_t)r->scene.cell_count * sizeof *r->before);
+        if (config_scene_before_step(&r->scene, r->message, sizeof r->message)) {
+            if (p->terminal) putchar('\n');
+            fprintf(stderr, "dpsm run: before the step at t = %.17g s: %s\n", *t, r->message);
+            return 1;
+        }
         if (dpsm_step(r->scene.grid, this_dt) != DPSM_OK) {
             if (p->terminal) putchar('\n');
             fprintf(stderr, "dpsm run: the step at t = %.17g s failed: %s\n", *t, dpsm_last_error(r->scene.grid));
@@ -105,6 +110,37 @@ static int advance(struct run *r, double *t, double target, struct progress *p, 
         show(p, *t, *moving, 0);
     }
     return 0;
+}
+
+/* What was read: the mesh file, its cells, its coordinates, its edge. */
+static void describe_mesh(const struct run *r) {
+    const struct config_mesh *m = &r->scene.mesh;
+    const struct config *c = &r->config;
+    printf("mesh: %s (%s%s%s), %lld nodes, %lld faces%s\n", c->mesh_file, m->format, m->topology[0] ? " topology " : "",
+           m->topology, (long long)m->node_count, (long long)m->face_count,
+           m->faces_from_edges ? " built from its edges" : "");
+    printf("cells: %lld (%s), coordinates %s%s%s%s\n", (long long)r->scene.cell_count,
+           r->scene.cells_at_nodes ? "the median dual: one per node" : "one per face",
+           r->scene.geographic ? "geographic (degrees; lengths and areas on the sphere)" : "projected (metres)",
+           c->coordinates != CONFIG_COORDINATES_FROM_FILE ? ", as grid.coordinates says" : "",
+           c->coordinates == CONFIG_COORDINATES_FROM_FILE && m->coordinates != CONFIG_COORDINATES_FROM_FILE ? ", as " : "",
+           c->coordinates == CONFIG_COORDINATES_FROM_FILE && m->coordinates != CONFIG_COORDINATES_FROM_FILE
+               ? m->coordinates_said
+               : "");
+    int64_t edge = 0;
+    for (int64_t f = 0; f < r->scene.face_count; ++f) edge += r->scene.face_cells[2 * f + 1] < 0;
+    static const char *const levels[] = {"0", "a number", "each face's cell's own", "a field of a file"};
+    char named[512] = "";
+    for (int k = 0; k < c->group_count; ++k) {
+        strncat(named, k ? ", " : "", sizeof named - strlen(named) - 1);
+        strncat(named, c->groups[k], sizeof named - strlen(named) - 1);
+    }
+    const int open = c->boundary[DPSM_MESH_EDGE] == DPSM_OPEN;
+    printf("edge: %lld faces on the domain edge (%d groups in the file): %s%s%s%s%s%s\n", (long long)edge,
+           m->group_count, open ? "open" : "walls", c->group_count ? (open ? ", walls: " : ", open: ") : "", named,
+           open || (c->group_count && c->groups_open) ? "; the level beyond open faces: " : "",
+           open || (c->group_count && c->groups_open) ? levels[c->level_kind] : "",
+           c->level_kind == CONFIG_LEVEL_FILE ? " (boundaries.level)" : "");
 }
 
 static void print_balance(const struct run *r) {
@@ -126,6 +162,7 @@ static int run(const char *path) {
     if (config_read(path, &r.config, r.message, sizeof r.message) ||
         config_build(&r.config, &r.scene, r.message, sizeof r.message))
         return fail(&r, NULL);
+    if (r.scene.has_mesh) describe_mesh(&r);
     int64_t n = r.scene.cell_count;
     r.heights = malloc((size_t)n * sizeof *r.heights);
     r.before = malloc((size_t)n * sizeof *r.before);

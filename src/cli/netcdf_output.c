@@ -57,8 +57,9 @@ static int define_grid(struct output *out, const struct config *c, int *space_di
 }
 
 /* The UGRID mesh topology: nodes, faces (the cells) from 0, padded with -1. */
-static int define_mesh(struct output *out, const struct config_mesh *m, int *space_dims, int *ndims, char *message,
+static int define_mesh(struct output *out, const struct config_scene *s, int *space_dims, int *ndims, char *message,
                        size_t size) {
+    const struct config_mesh *m = &s->mesh;
     int node_dim, face_dim, width_dim, topology;
     int64_t width = 0;
     for (int64_t f = 0; f < m->face_count; ++f)
@@ -76,17 +77,25 @@ static int define_mesh(struct output *out, const struct config_mesh *m, int *spa
     TRY(text(out->file, topology, "face_node_connectivity", "mesh_face_nodes"));
     TRY(text(out->file, topology, "face_dimension", "cell"));
     TRY(nc_def_var(out->file, "mesh_node_x", NC_DOUBLE, 1, &node_dim, &out->x_var));
-    TRY(text(out->file, out->x_var, "units", "m"));
-    TRY(text(out->file, out->x_var, "long_name", "x of the mesh nodes"));
     TRY(nc_def_var(out->file, "mesh_node_y", NC_DOUBLE, 1, &node_dim, &out->y_var));
-    TRY(text(out->file, out->y_var, "units", "m"));
+    if (s->geographic) {
+        TRY(text(out->file, out->x_var, "units", "degrees_east"));
+        TRY(text(out->file, out->x_var, "standard_name", "longitude"));
+        TRY(text(out->file, out->y_var, "units", "degrees_north"));
+        TRY(text(out->file, out->y_var, "standard_name", "latitude"));
+    } else {
+        TRY(text(out->file, out->x_var, "units", "m"));
+        TRY(text(out->file, out->y_var, "units", "m"));
+    }
+    TRY(text(out->file, out->x_var, "long_name", "x of the mesh nodes"));
     TRY(text(out->file, out->y_var, "long_name", "y of the mesh nodes"));
     int dims[2] = {face_dim, width_dim};
     TRY(nc_def_var(out->file, "mesh_face_nodes", NC_INT, 2, dims, &out->faces_var));
     TRY(text(out->file, out->faces_var, "cf_role", "face_node_connectivity"));
     TRY(nc_put_att_int(out->file, out->faces_var, "_FillValue", NC_INT, 1, &fill));
     TRY(nc_put_att_int(out->file, out->faces_var, "start_index", NC_INT, 1, &start));
-    space_dims[0] = face_dim;
+    /* The cells: the faces, or the nodes of a dual mesh. */
+    space_dims[0] = s->cells_at_nodes ? node_dim : face_dim;
     *ndims = 1;
     return 0;
 }
@@ -141,7 +150,7 @@ int output_open(struct output *out, const struct config *c, const struct config_
     TRY(text(out->file, out->time_var, "units", "s"));
     TRY(text(out->file, out->time_var, "long_name", "simulated time since the start of the run"));
     TRY(text(out->file, out->time_var, "axis", "T"));
-    if (s->has_mesh ? define_mesh(out, &s->mesh, space_dims, &ndims, message, size)
+    if (s->has_mesh ? define_mesh(out, s, space_dims, &ndims, message, size)
                     : define_grid(out, c, space_dims, &ndims, message, size))
         return 1;
     int dims[3] = {time_dim, space_dims[0], space_dims[1]};
@@ -150,7 +159,7 @@ int output_open(struct output *out, const struct config *c, const struct config_
     TRY(text(out->file, out->h_var, "long_name", "height of the granular surface"));
     if (s->has_mesh) {
         TRY(text(out->file, out->h_var, "mesh", "mesh"));
-        TRY(text(out->file, out->h_var, "location", "face"));
+        TRY(text(out->file, out->h_var, "location", s->cells_at_nodes ? "node" : "face"));
     } else {
         TRY(text(out->file, out->h_var, "coordinates", c->grid_kind == CONFIG_GRID_2D ? "y x" : "x"));
     }

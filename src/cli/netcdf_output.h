@@ -1,5 +1,6 @@
 /* The netCDF file `dpsm run` writes: dims (time, y, x) on 2d grids, (time,
- * x) on 1d and axisymmetric grids, (time, cell) with a UGRID mesh on meshes;
+ * x) on 1d and axisymmetric grids, (time, cell) with a UGRID mesh on meshes
+ * ((time, node) on dual meshes, whose cells are the nodes);
  * the ledger's figures as time series. */
 #ifndef DPSM_CLI_NETCDF_OUTPUT_H
 #define DPSM_CLI_NETCDF_OUTPUT_H

@@ -182,7 +182,7 @@ static int read_grid(struct reader *r, yaml_node_t *grid, struct config *c) {
     static const char *const keys_1d[] = {"kind", "nx", "dx", NULL};
     static const char *const keys_2d[] = {"kind", "nx", "ny", "dx", "dy", NULL};
     static const char *const keys_axisymmetric[] = {"kind", "nr", "dr", NULL};
-    static const char *const keys_mesh[] = {"kind", "file", NULL};
+    static const char *const keys_mesh[] = {"kind", "file", "topology", "coordinates", NULL};
     if (strcmp(kind, "1d") == 0) {
         c->grid_kind = CONFIG_GRID_1D;
         if (check_keys(r, grid, "grid", keys_1d, "a 1d grid") || read_positive_integer(r, grid, "grid", "nx", &c->nx) ||
@@ -203,13 +203,90 @@ static int read_grid(struct reader *r, yaml_node_t *grid, struct config *c) {
             return 1;
         c->ny = 1;
         c->dy = c->dx;
-    } else if (strcmp(kind, "mesh") == 0) {
-        c->grid_kind = CONFIG_GRID_MESH;
-        if (check_keys(r, grid, "grid", keys_mesh, "a mesh") || read_file_name(r, grid, "grid", "file", c->mesh_file))
+    } else if (strcmp(kind, "mesh") == 0 || strcmp(kind, "dual_mesh") == 0) {
+        c->grid_kind = strcmp(kind, "mesh") == 0 ? CONFIG_GRID_MESH : CONFIG_GRID_DUAL_MESH;
+        if (check_keys(r, grid, "grid", keys_mesh, c->grid_kind == CONFIG_GRID_MESH ? "a mesh" : "a dual mesh") ||
+            read_file_name(r, grid, "grid", "file", c->mesh_file))
             return 1;
+        if (lookup(r, grid, "topology") &&
+            read_word(r, grid, "grid", "topology", c->topology, sizeof c->topology, NULL))
+            return 1;
+        if (lookup(r, grid, "coordinates")) {
+            char word[32];
+            yaml_node_t *node;
+            if (read_word(r, grid, "grid", "coordinates", word, sizeof word, &node)) return 1;
+            if (strcmp(word, "geographic") == 0) c->coordinates = CONFIG_COORDINATES_GEOGRAPHIC;
+            else if (strcmp(word, "projected") == 0) c->coordinates = CONFIG_COORDINATES_PROJECTED;
+            else
+                return refuse(r, node, "grid.coordinates",
+                              "expected geographic (longitude and latitude in degrees) or projected (metres), got "
+                              "\"%s\"", word);
+        }
     } else {
-        return refuse(r, kind_node, "grid.kind", "expected 1d, 2d, axisymmetric or mesh, got \"%s\"", kind);
+        return refuse(r, kind_node, "grid.kind", "expected 1d, 2d, axisymmetric, mesh or dual_mesh, got \"%s\"", kind);
     }
+    c->grid_line = line_of(grid);
+    return 0;
+}
+
+/* boundaries.level: 0, cell, a number or {file, variable}. */
+static int read_level(struct reader *r, yaml_node_t *node, struct config *c) {
+    c->level_line = line_of(node);
+    if (node->type == YAML_MAPPING_NODE) {
+        static const char *const keys[] = {"file", "variable", NULL};
+        c->level_kind = CONFIG_LEVEL_FILE;
+        return check_keys(r, node, "boundaries.level", keys, "a field") ||
+               read_file_name(r, node, "boundaries.level", "file", c->level_file) ||
+               read_word(r, node, "boundaries.level", "variable", c->level_variable, sizeof c->level_variable, NULL);
+    }
+    if (node->type == YAML_SCALAR_NODE && strcmp(scalar_text(node), "cell") == 0) {
+        c->level_kind = CONFIG_LEVEL_CELL;
+        return 0;
+    }
+    char got[300];
+    describe(node, got, sizeof got);
+    if (node->type != YAML_SCALAR_NODE)
+        return refuse(r, node, "boundaries.level", "expected 0, cell, a number or {file, variable}, got %s", got);
+    const char *text = scalar_text(node);
+    char *end;
+    double value = strtod(text, &end);
+    if (end == text || *end != '\0' || !isfinite(value) || fabs(value) > 1e50)
+        return refuse(r, node, "boundaries.level", "expected 0, cell, a number or {file, variable}, got %s", got);
+    c->level_kind = CONFIG_LEVEL_NUMBER;
+    c->level = value;
+    return 0;
+}
+
+/* boundaries.open or .wall: a list of group names or numbers. */
+static int read_groups(struct reader *r, yaml_node_t *node, const char *key, struct config *c) {
+    char key_path[64], got[300];
+    snprintf(key_path, sizeof key_path, "boundaries.%s", key);
+    describe(node, got, sizeof got);
+    if (node->type == YAML_SCALAR_NODE) { /* one name alone: a list of one */
+        if (!scalar_text(node)[0]) return refuse(r, node, key_path, "expected a list of group names or numbers");
+        snprintf(c->groups[0], CONFIG_NAME_MAX, "%s", scalar_text(node));
+        c->group_lines[0] = line_of(node);
+        c->group_count = 1;
+        return 0;
+    }
+    if (node->type != YAML_SEQUENCE_NODE)
+        return refuse(r, node, key_path, "expected a list of group names or numbers (gmsh physical groups, UGRID "
+                                         "boundary tags), got %s", got);
+    int n = 0;
+    for (yaml_node_item_t *item = node->data.sequence.items.start; item < node->data.sequence.items.top; ++item) {
+        yaml_node_t *entry = yaml_document_get_node(r->document, *item);
+        char entry_path[96];
+        snprintf(entry_path, sizeof entry_path, "%s[%d]", key_path, n);
+        if (!entry || entry->type != YAML_SCALAR_NODE || !scalar_text(entry)[0])
+            return refuse(r, entry ? entry : node, entry_path, "expected a group's name or number");
+        if (n == CONFIG_GROUPS_MAX) return refuse(r, entry, entry_path, "more than %d groups", CONFIG_GROUPS_MAX);
+        if (strlen(scalar_text(entry)) >= CONFIG_NAME_MAX)
+            return refuse(r, entry, entry_path, "longer than %d characters", CONFIG_NAME_MAX - 1);
+        snprintf(c->groups[n], CONFIG_NAME_MAX, "%s", scalar_text(entry));
+        c->group_lines[n++] = line_of(entry);
+    }
+    if (n == 0) return refuse(r, node, key_path, "an empty list: name the groups, or leave the key out");
+    c->group_count = n;
     return 0;
 }
 
@@ -219,13 +296,14 @@ static int read_boundaries(struct reader *r, yaml_node_t *sides, struct config *
     static const char *const keys_1d[] = {"xmin", "xmax", NULL};
     static const char *const keys_2d[] = {"xmin", "xmax", "ymin", "ymax", NULL};
     static const char *const keys_axisymmetric[] = {"xmax", NULL};
-    static const char *const keys_mesh[] = {"edge", NULL};
+    static const char *const keys_mesh[] = {"edge", "level", "open", "wall", NULL};
     const char *const *allowed = c->grid_kind == CONFIG_GRID_1D             ? keys_1d
                                  : c->grid_kind == CONFIG_GRID_2D           ? keys_2d
                                  : c->grid_kind == CONFIG_GRID_AXISYMMETRIC ? keys_axisymmetric
                                                                             : keys_mesh;
     static const char *const kind_names[] = {"a 1d grid", "a 2d grid", "an axisymmetric grid (its xmin is the axis)",
-                                             "a mesh"};
+                                             "a mesh", "a dual mesh"};
+    c->boundaries_line = line_of(sides);
     if (check_keys(r, sides, "boundaries", allowed, kind_names[c->grid_kind])) return 1;
     for (int side = 0; side < CONFIG_SIDES; ++side) {
         if (!lookup(r, sides, names[side])) continue;
@@ -240,6 +318,29 @@ static int read_boundaries(struct reader *r, yaml_node_t *sides, struct config *
             return refuse(r, node, key_path, "expected wall or open, got \"%s\"", word);
         }
     }
+    yaml_node_t *node;
+    if ((node = lookup(r, sides, "level")) && read_level(r, node, c)) return 1;
+    yaml_node_t *open = lookup(r, sides, "open"), *wall = lookup(r, sides, "wall");
+    int edge_open = c->boundary[DPSM_MESH_EDGE] == DPSM_OPEN;
+    if (open && wall)
+        return refuse(r, wall, "boundaries.wall", "give boundaries.open (with edge: wall, the default) or "
+                                                  "boundaries.wall (with edge: open), not both");
+    if (open && edge_open)
+        return refuse(r, open, "boundaries.open", "the edge is open already (edge: open); name the groups that are "
+                                                  "walls with boundaries.wall, or say edge: wall");
+    if (wall && !edge_open)
+        return refuse(r, wall, "boundaries.wall", "the edge is a wall already (edge: %s); say edge: open and name "
+                                                  "the groups that are walls, or name the open ones with "
+                                                  "boundaries.open",
+                      c->boundary[DPSM_MESH_EDGE] == DPSM_WALL ? "wall" : "wall, the default");
+    if (open || wall) {
+        c->groups_open = open != NULL;
+        if (read_groups(r, open ? open : wall, open ? "open" : "wall", c)) return 1;
+    }
+    if (node && !edge_open && !open)
+        return refuse(r, node, "boundaries.level", "no edge is open (edge: wall%s): say edge: open, or open groups of "
+                                                   "edges with boundaries.open, or leave the level out",
+                      c->boundary[DPSM_MESH_EDGE] == DPSM_WALL ? "" : ", the default");
     return 0;
 }
 
@@ -248,7 +349,7 @@ static int read_boundaries(struct reader *r, yaml_node_t *sides, struct config *
 static int read_field(struct reader *r, yaml_node_t *node, const char *name, int scenes_allowed,
                       struct config_field *field) {
     if (expect_mapping(r, node, name)) return 1;
-    static const char *const keys_scene[] = {"scene", "radius", "height", NULL};
+    static const char *const keys_scene[] = {"scene", "radius", "height", "centre", NULL};
     static const char *const keys_constant[] = {"constant", NULL};
     static const char *const keys_file[] = {"file", "variable", NULL};
     if (scenes_allowed && lookup(r, node, "scene")) {
@@ -262,6 +363,23 @@ static int read_field(struct reader *r, yaml_node_t *node, const char *name, int
         if (strcmp(scene, "column") == 0) field->kind = CONFIG_FIELD_COLUMN;
         else if (strcmp(scene, "cone") == 0) field->kind = CONFIG_FIELD_CONE;
         else return refuse(r, scene_node, key_path, "expected column or cone, got \"%s\"", scene);
+        field->line = line_of(node);
+        yaml_node_t *centre = lookup(r, node, "centre");
+        if (centre) {
+            char centre_path[64], got[300];
+            join_key(centre_path, sizeof centre_path, name, "centre");
+            describe(centre, got, sizeof got);
+            if (centre->type != YAML_SEQUENCE_NODE ||
+                centre->data.sequence.items.top - centre->data.sequence.items.start != 2)
+                return refuse(r, centre, centre_path, "expected [x, y], got %s", got);
+            for (int k = 0; k < 2; ++k) {
+                yaml_node_t *v = yaml_document_get_node(r->document, centre->data.sequence.items.start[k]);
+                char item_path[80];
+                snprintf(item_path, sizeof item_path, "%s[%d]", centre_path, k);
+                if (parse_number(r, v, item_path, 0, &field->centre[k])) return 1;
+            }
+            field->has_centre = 1;
+        }
         return read_number(r, node, name, "radius", 1, &field->radius) ||
                read_number(r, node, name, "height", 0, &field->height);
     }
@@ -272,6 +390,7 @@ static int read_field(struct reader *r, yaml_node_t *node, const char *name, int
     }
     if (lookup(r, node, "file")) {
         field->kind = CONFIG_FIELD_FILE;
+        field->line = line_of(node);
         return check_keys(r, node, name, keys_file, "a file") || read_file_name(r, node, name, "file", field->file) ||
                read_word(r, node, name, "variable", field->variable, sizeof field->variable, NULL);
     }

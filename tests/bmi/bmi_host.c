@@ -23,7 +23,12 @@
 
 #include <dpsm/bmi.h>
 
+#include "mesh_files.h"
 #include "ugrid_file.h"
+
+#if defined(DPSM_TEST_UDUNITS)
+#include <udunits2.h>
+#endif
 
 static const char *library_path;
 static void *library;
@@ -69,17 +74,17 @@ static const char kGrid2d[] = "grid: {kind: 2d, nx: 8, ny: 6, dx: 0.5, dy: 0.25}
 #define NY 6
 
 static const char *const kInputs[] = {"land_surface__elevation", "bedrock_surface__elevation",
-                                      "land_surface__net_deposition_rate", "sediment__angle_of_repose"};
+                                      "land_surface_sediment_deposition__net_volume_flux", "land_surface_sediment__repose_angle"};
+/* The bed is an input only: with no bed set there is nothing to read. */
 static const char *const kOutputs2d[] = {"land_surface__elevation",
-                                         "bedrock_surface__elevation",
-                                         "sediment__angle_of_repose",
-                                         "land_surface_sediment__x_component_of_avalanche_volume_flux",
-                                         "land_surface_sediment__y_component_of_avalanche_volume_flux",
-                                         "land_surface_sediment__total_volume",
-                                         "land_surface_sediment__sourced_volume",
-                                         "land_surface_sediment__outflow_volume",
-                                         "land_surface_sediment__external_volume",
-                                         "land_surface_sediment__unmet_erosion_volume"};
+                                         "land_surface_sediment__repose_angle",
+                                         "land_surface_sediment_flowing__x_component_of_volume_rate",
+                                         "land_surface_sediment_flowing__y_component_of_volume_rate",
+                                         "land_surface_sediment__volume",
+                                         "land_surface_sediment_deposition__domain_time_integral_of_net_volume_flux",
+                                         "land_surface_sediment_flowing_sink__time_integral_of_volume_rate",
+                                         "land_surface_sediment_source__time_integral_of_volume_rate",
+                                         "land_surface_sediment_erosion~unmet__domain_time_integral_of_volume_flux"};
 
 struct expected_variable {
     const char *name, *units, *location;
@@ -89,15 +94,15 @@ struct expected_variable {
 static const struct expected_variable kVariables2d[] = {
     {"land_surface__elevation", "m", "node", 0},
     {"bedrock_surface__elevation", "m", "node", 0},
-    {"land_surface__net_deposition_rate", "m s-1", "node", 0},
-    {"sediment__angle_of_repose", "deg", "node", 0},
-    {"land_surface_sediment__x_component_of_avalanche_volume_flux", "m3 s-1", "node", 1},
-    {"land_surface_sediment__y_component_of_avalanche_volume_flux", "m3 s-1", "node", 2},
-    {"land_surface_sediment__total_volume", "m3", "node", 3},
-    {"land_surface_sediment__sourced_volume", "m3", "node", 3},
-    {"land_surface_sediment__outflow_volume", "m3", "node", 3},
-    {"land_surface_sediment__external_volume", "m3", "node", 3},
-    {"land_surface_sediment__unmet_erosion_volume", "m3", "node", 3},
+    {"land_surface_sediment_deposition__net_volume_flux", "m s-1", "node", 0},
+    {"land_surface_sediment__repose_angle", "degree", "node", 0},
+    {"land_surface_sediment_flowing__x_component_of_volume_rate", "m3 s-1", "node", 1},
+    {"land_surface_sediment_flowing__y_component_of_volume_rate", "m3 s-1", "node", 2},
+    {"land_surface_sediment__volume", "m3", "node", 3},
+    {"land_surface_sediment_deposition__domain_time_integral_of_net_volume_flux", "m3", "node", 3},
+    {"land_surface_sediment_flowing_sink__time_integral_of_volume_rate", "m3", "node", 3},
+    {"land_surface_sediment_source__time_integral_of_volume_rate", "m3", "node", 3},
+    {"land_surface_sediment_erosion~unmet__domain_time_integral_of_volume_flux", "m3", "node", 3},
 };
 
 static void check_names(Bmi *m, int inputs, const char *const *expected, int n) {
@@ -131,6 +136,67 @@ static void check_variable(Bmi *m, const struct expected_variable *v, int values
     assert_int_equal(itemsize, (int)sizeof(double));
     assert_int_equal(m->get_var_nbytes(m, v->name, &nbytes), BMI_SUCCESS);
     assert_int_equal(nbytes, itemsize * values);
+}
+
+/* Every variable the component lists: its name in tests/bmi/standard_names.txt
+ * (which test_bmi.py checks against the CSDMS registry's rules) with the
+ * units given there, which UDUNITS-2 parses; every output readable. */
+static void check_conventions(Bmi *m) {
+    FILE *f = fopen(DPSM_STANDARD_NAMES_FILE, "r");
+    assert_non_null(f);
+    char known[32][BMI_MAX_VAR_NAME], known_units[32][BMI_MAX_UNITS_NAME], line[512];
+    int nknown = 0;
+    while (fgets(line, sizeof line, f) && nknown < 32) {
+        char name[BMI_MAX_VAR_NAME], units[BMI_MAX_UNITS_NAME];
+        if (sscanf(line, "variable %255s | %63[^|]|", name, units) == 2) {
+            size_t n = strlen(units);
+            while (n > 0 && units[n - 1] == ' ') units[--n] = '\0';
+            snprintf(known[nknown], BMI_MAX_VAR_NAME, "%s", name);
+            snprintf(known_units[nknown++], BMI_MAX_UNITS_NAME, "%s", units);
+        }
+    }
+    fclose(f);
+    assert_true(nknown >= 12);
+#if defined(DPSM_TEST_UDUNITS)
+    ut_set_error_message_handler(ut_ignore);
+    ut_system *units_system = ut_read_xml(NULL);
+    assert_non_null(units_system);
+#endif
+    for (int inputs = 0; inputs < 2; ++inputs) {
+        int count = 0;
+        assert_int_equal((inputs ? m->get_input_item_count : m->get_output_item_count)(m, &count), BMI_SUCCESS);
+        char **names = malloc((size_t)count * sizeof *names);
+        for (int k = 0; k < count; ++k) names[k] = calloc(BMI_MAX_VAR_NAME, 1);
+        assert_int_equal((inputs ? m->get_input_var_names : m->get_output_var_names)(m, names), BMI_SUCCESS);
+        for (int k = 0; k < count; ++k) {
+            char units[BMI_MAX_UNITS_NAME];
+            assert_int_equal(m->get_var_units(m, names[k], units), BMI_SUCCESS);
+            int found = -1;
+            for (int j = 0; j < nknown; ++j)
+                if (strcmp(known[j], names[k]) == 0) found = j;
+            if (found < 0) fail_msg("%s is not in tests/bmi/standard_names.txt", names[k]);
+            assert_string_equal(units, known_units[found]);
+#if defined(DPSM_TEST_UDUNITS)
+            ut_unit *unit = ut_parse(units_system, units, UT_ASCII);
+            if (!unit) fail_msg("UDUNITS-2 does not parse the units \"%s\" of %s", units, names[k]);
+            ut_free(unit);
+#endif
+            if (!inputs) { /* every output readable after initialize */
+                int nbytes = 0;
+                assert_int_equal(m->get_var_nbytes(m, names[k], &nbytes), BMI_SUCCESS);
+                double *values = malloc((size_t)nbytes);
+                void *ptr = NULL;
+                if (m->get_value(m, names[k], values) != BMI_SUCCESS || m->get_value_ptr(m, names[k], &ptr) != BMI_SUCCESS)
+                    fail_msg("the output %s cannot be read after initialize", names[k]);
+                free(values);
+            }
+            free(names[k]);
+        }
+        free(names);
+    }
+#if defined(DPSM_TEST_UDUNITS)
+    ut_free_system(units_system);
+#endif
 }
 
 static void check_rectilinear(Bmi *m, int grid, int rank, const int *shape, const double *spacing,
@@ -206,7 +272,8 @@ static void registration_and_information_2d(void **state) {
     assert_int_equal(m->get_component_name(m, name), BMI_SUCCESS);
     assert_string_equal(name, "dpsm");
     check_names(m, 1, kInputs, 4);
-    check_names(m, 0, kOutputs2d, 10);
+    check_names(m, 0, kOutputs2d, 9);
+    check_conventions(m);
     int sizes[] = {NX * NY, NX * NY, NX * NY, NX * NY, (NX + 1) * NY, NX * (NY + 1), 1, 1, 1, 1, 1};
     for (size_t v = 0; v < sizeof kVariables2d / sizeof kVariables2d[0]; ++v) {
         check_variable(m, &kVariables2d[v], sizes[v]);
@@ -276,14 +343,14 @@ static void values_in_and_out_2d(void **state) {
     double volume = 0;
     for (int k = 0; k < NX * NY; ++k) volume += h[k] * 0.5 * 0.25;
     assert_true(volume > 0);
-    assert_true(fabs(scalar(m, "land_surface_sediment__total_volume") - volume) < 1e-12);
+    assert_true(fabs(scalar(m, "land_surface_sediment__volume") - volume) < 1e-12);
     assert_int_equal(m->get_value_ptr(m, "land_surface__elevation", (void **)&ptr), BMI_SUCCESS);
     assert_memory_equal(ptr, h, sizeof h);
 
     /* Fluxes read 0 before the first update. */
     double fx[(NX + 1) * NY], fy[NX * (NY + 1)];
-    assert_int_equal(m->get_value(m, "land_surface_sediment__x_component_of_avalanche_volume_flux", fx), BMI_SUCCESS);
-    assert_int_equal(m->get_value(m, "land_surface_sediment__y_component_of_avalanche_volume_flux", fy), BMI_SUCCESS);
+    assert_int_equal(m->get_value(m, "land_surface_sediment_flowing__x_component_of_volume_rate", fx), BMI_SUCCESS);
+    assert_int_equal(m->get_value(m, "land_surface_sediment_flowing__y_component_of_volume_rate", fy), BMI_SUCCESS);
     for (int k = 0; k < (NX + 1) * NY; ++k) assert_true(fx[k] == 0);
 
     /* One update of the collapsing column: what the faces carried, times the
@@ -292,8 +359,8 @@ static void values_in_and_out_2d(void **state) {
     assert_int_equal(m->update(m), BMI_SUCCESS);
     assert_int_equal(m->get_value(m, "land_surface__elevation", h2), BMI_SUCCESS);
     assert_memory_equal(ptr, h2, sizeof h2);
-    assert_int_equal(m->get_value(m, "land_surface_sediment__x_component_of_avalanche_volume_flux", fx), BMI_SUCCESS);
-    assert_int_equal(m->get_value(m, "land_surface_sediment__y_component_of_avalanche_volume_flux", fy), BMI_SUCCESS);
+    assert_int_equal(m->get_value(m, "land_surface_sediment_flowing__x_component_of_volume_rate", fx), BMI_SUCCESS);
+    assert_int_equal(m->get_value(m, "land_surface_sediment_flowing__y_component_of_volume_rate", fy), BMI_SUCCESS);
     double moved = 0;
     for (int j = 0; j < NY; ++j)
         for (int i = 0; i < NX; ++i) {
@@ -303,7 +370,7 @@ static void values_in_and_out_2d(void **state) {
             moved += fabs(change);
         }
     assert_true(moved > 1e-3);
-    assert_true(fabs(scalar(m, "land_surface_sediment__total_volume") - volume) < 1e-12);
+    assert_true(fabs(scalar(m, "land_surface_sediment__volume") - volume) < 1e-12);
 
     /* set_value then get_value; get_value_at_indices; set_value_at_indices. */
     for (int k = 0; k < NX * NY; ++k) h[k] = 0.01 * k;
@@ -334,35 +401,35 @@ static void values_in_and_out_2d(void **state) {
 
     /* The angle: uniform 30 degrees until a field is set. */
     double angle[NX * NY];
-    assert_int_equal(m->get_value(m, "sediment__angle_of_repose", angle), BMI_SUCCESS);
+    assert_int_equal(m->get_value(m, "land_surface_sediment__repose_angle", angle), BMI_SUCCESS);
     for (int k = 0; k < NX * NY; ++k) assert_true(fabs(angle[k] - 30) < 1e-12);
     for (int k = 0; k < NX * NY; ++k) angle[k] = 20 + 0.2 * k;
-    assert_int_equal(m->set_value(m, "sediment__angle_of_repose", angle), BMI_SUCCESS);
+    assert_int_equal(m->set_value(m, "land_surface_sediment__repose_angle", angle), BMI_SUCCESS);
     double angle2[NX * NY];
-    m->get_value(m, "sediment__angle_of_repose", angle2);
+    m->get_value(m, "land_surface_sediment__repose_angle", angle2);
     assert_memory_equal(angle, angle2, sizeof angle);
     angle[3] = 95; /* refused as a whole: nothing changes */
-    assert_int_equal(m->set_value(m, "sediment__angle_of_repose", angle), BMI_FAILURE);
-    m->get_value(m, "sediment__angle_of_repose", angle);
+    assert_int_equal(m->set_value(m, "land_surface_sediment__repose_angle", angle), BMI_FAILURE);
+    m->get_value(m, "land_surface_sediment__repose_angle", angle);
     assert_memory_equal(angle, angle2, sizeof angle);
 
     /* The source: deposits over the next update, booked as sourced volume. */
     double q[NX * NY], q2[NX * NY];
     for (int k = 0; k < NX * NY; ++k) q[k] = 0.02;
-    assert_int_equal(m->set_value(m, "land_surface__net_deposition_rate", q), BMI_SUCCESS);
-    m->get_value(m, "land_surface__net_deposition_rate", q2);
+    assert_int_equal(m->set_value(m, "land_surface_sediment_deposition__net_volume_flux", q), BMI_SUCCESS);
+    m->get_value(m, "land_surface_sediment_deposition__net_volume_flux", q2);
     assert_memory_equal(q, q2, sizeof q);
-    double sourced = scalar(m, "land_surface_sediment__sourced_volume");
+    double sourced = scalar(m, "land_surface_sediment_deposition__domain_time_integral_of_net_volume_flux");
     assert_int_equal(m->update(m), BMI_SUCCESS);
-    assert_true(fabs(scalar(m, "land_surface_sediment__sourced_volume") - sourced - 0.02 * 0.1 * NX * NY * 0.125) < 1e-12);
-    double total = scalar(m, "land_surface_sediment__total_volume");
-    double ledger = scalar(m, "land_surface_sediment__sourced_volume") +
-                    scalar(m, "land_surface_sediment__external_volume") -
-                    scalar(m, "land_surface_sediment__outflow_volume");
+    assert_true(fabs(scalar(m, "land_surface_sediment_deposition__domain_time_integral_of_net_volume_flux") - sourced - 0.02 * 0.1 * NX * NY * 0.125) < 1e-12);
+    double total = scalar(m, "land_surface_sediment__volume");
+    double ledger = scalar(m, "land_surface_sediment_deposition__domain_time_integral_of_net_volume_flux") +
+                    scalar(m, "land_surface_sediment_source__time_integral_of_volume_rate") -
+                    scalar(m, "land_surface_sediment_flowing_sink__time_integral_of_volume_rate");
     assert_true(fabs(total - ledger) < 1e-10);
-    assert_true(scalar(m, "land_surface_sediment__unmet_erosion_volume") == 0);
+    assert_true(scalar(m, "land_surface_sediment_erosion~unmet__domain_time_integral_of_volume_flux") == 0);
     double *total_ptr;
-    assert_int_equal(m->get_value_ptr(m, "land_surface_sediment__total_volume", (void **)&total_ptr), BMI_SUCCESS);
+    assert_int_equal(m->get_value_ptr(m, "land_surface_sediment__volume", (void **)&total_ptr), BMI_SUCCESS);
     assert_true(*total_ptr == total);
     stop(m);
 }
@@ -405,7 +472,7 @@ static void bad_input_fails_without_harm(void **state) {
     assert_int_equal(m->get_value(m, "land_surface__elevation", NULL), BMI_FAILURE);
     assert_int_equal(m->get_value_ptr(m, "nothing", &ptr), BMI_FAILURE);
     assert_int_equal(m->get_value_ptr(m, "land_surface__elevation", NULL), BMI_FAILURE);
-    assert_int_equal(m->get_var_grid(m, "land_surface_sediment__avalanche_volume_flux", &grid), BMI_FAILURE);
+    assert_int_equal(m->get_var_grid(m, "land_surface_sediment_flowing__volume_rate", &grid), BMI_FAILURE);
     int outside[] = {0, NX * NY}, negative[] = {-1};
     assert_int_equal(m->get_value_at_indices(m, "land_surface__elevation", v, outside, 2), BMI_FAILURE);
     assert_int_equal(m->get_value_at_indices(m, "land_surface__elevation", v, negative, 1), BMI_FAILURE);
@@ -414,12 +481,12 @@ static void bad_input_fails_without_harm(void **state) {
     double put[] = {5, 5};
     assert_int_equal(m->set_value_at_indices(m, "land_surface__elevation", outside, 2, put), BMI_FAILURE);
     assert_int_equal(m->set_value(m, "land_surface__elevation", NULL), BMI_FAILURE);
-    assert_int_equal(m->set_value(m, "land_surface_sediment__total_volume", put), BMI_FAILURE); /* an output */
+    assert_int_equal(m->set_value(m, "land_surface_sediment__volume", put), BMI_FAILURE); /* an output */
     for (int k = 0; k < NX * NY; ++k) h[k] = 1;
     h[5] = NAN;
     assert_int_equal(m->set_value(m, "land_surface__elevation", h), BMI_FAILURE);
     h[5] = INFINITY;
-    assert_int_equal(m->set_value(m, "land_surface__net_deposition_rate", h), BMI_FAILURE);
+    assert_int_equal(m->set_value(m, "land_surface_sediment_deposition__net_volume_flux", h), BMI_FAILURE);
     assert_int_equal(m->set_value_at_indices(m, "bedrock_surface__elevation", negative + 0, 0, put), BMI_FAILURE);
     double after[NX * NY];
     m->get_value(m, "land_surface__elevation", after);
@@ -442,21 +509,22 @@ static void grids_of_a_1d_grid(void **state) {
                                   "time: {step: 0.5, end: 1.2}\n");
     int count;
     assert_int_equal(m->get_output_item_count(m, &count), BMI_SUCCESS);
-    assert_int_equal(count, 9);
+    assert_int_equal(count, 8);
+    check_conventions(m);
     check_variable(m, &(struct expected_variable){"land_surface__elevation", "m", "node", 0}, 10);
     check_variable(
-        m, &(struct expected_variable){"land_surface_sediment__x_component_of_avalanche_volume_flux", "m3 s-1", "node", 1},
+        m, &(struct expected_variable){"land_surface_sediment_flowing__x_component_of_volume_rate", "m3 s-1", "node", 1},
         11);
-    check_variable(m, &(struct expected_variable){"land_surface_sediment__total_volume", "m3", "node", 2}, 1);
+    check_variable(m, &(struct expected_variable){"land_surface_sediment__volume", "m3", "node", 2}, 1);
     int grid;
-    assert_int_equal(m->get_var_grid(m, "land_surface_sediment__y_component_of_avalanche_volume_flux", &grid),
+    assert_int_equal(m->get_var_grid(m, "land_surface_sediment_flowing__y_component_of_volume_rate", &grid),
                      BMI_FAILURE);
     check_rectilinear(m, 0, 1, (int[]){10}, (double[]){0.2}, (double[]){0.1});
     check_rectilinear(m, 1, 1, (int[]){11}, (double[]){0.2}, (double[]){0});
     check_scalar_grid(m, 2);
     check_no_grid(m, 3);
     double q[10];
-    assert_int_equal(m->get_value(m, "land_surface__net_deposition_rate", q), BMI_SUCCESS);
+    assert_int_equal(m->get_value(m, "land_surface_sediment_deposition__net_volume_flux", q), BMI_SUCCESS);
     assert_true(q[0] == 0.001 && q[9] == 0.001);
     double t;
     assert_int_equal(m->update_until(m, 1.2), BMI_SUCCESS);
@@ -479,14 +547,15 @@ static void mesh_grid_and_values(void **state) {
     Bmi *m = start("mesh.yaml", kMesh);
     int count;
     assert_int_equal(m->get_output_item_count(m, &count), BMI_SUCCESS);
-    assert_int_equal(count, 9);
-    const char *flux = "land_surface_sediment__avalanche_volume_flux";
+    assert_int_equal(count, 8);
+    check_conventions(m);
+    const char *flux = "land_surface_sediment_flowing__volume_rate";
     check_variable(m, &(struct expected_variable){"land_surface__elevation", "m", "face", 0}, UGRID_TEST_FACES);
-    check_variable(m, &(struct expected_variable){"sediment__angle_of_repose", "deg", "face", 0}, UGRID_TEST_FACES);
+    check_variable(m, &(struct expected_variable){"land_surface_sediment__repose_angle", "degree", "face", 0}, UGRID_TEST_FACES);
     check_variable(m, &(struct expected_variable){flux, "m3 s-1", "edge", 1}, UGRID_TEST_EDGES);
-    check_variable(m, &(struct expected_variable){"land_surface_sediment__outflow_volume", "m3", "node", 2}, 1);
+    check_variable(m, &(struct expected_variable){"land_surface_sediment_flowing_sink__time_integral_of_volume_rate", "m3", "node", 2}, 1);
     int grid;
-    assert_int_equal(m->get_var_grid(m, "land_surface_sediment__x_component_of_avalanche_volume_flux", &grid),
+    assert_int_equal(m->get_var_grid(m, "land_surface_sediment_flowing__x_component_of_volume_rate", &grid),
                      BMI_FAILURE);
     check_scalar_grid(m, 2);
     check_no_grid(m, 3);
@@ -583,6 +652,47 @@ static void mesh_grid_and_values(void **state) {
     stop(m);
 }
 
+/* ---- a dual mesh: TELEMAC's bed at the nodes ----------------------- */
+
+/* grid.kind: dual_mesh over a Selafin geometry: the cells are the file's
+ * nodes (location node on the triangle mesh), the flux lies on the
+ * triangles' edges, and the bed comes from the file by its name. */
+static void dual_mesh_from_selafin(void **state) {
+    (void)state;
+    char file[512];
+    snprintf(file, sizeof file, "%s/geo.slf", folder);
+    assert_int_equal(write_selafin(file, 0), 0);
+    Bmi *m = start("dual.yaml", "grid: {kind: dual_mesh, file: geo.slf}\n"
+                                "initial: {file: geo.slf, variable: BOTTOM}\n"
+                                "boundaries: {edge: open, level: cell}\n"
+                                "time: {step: 10, end: 30}\n");
+    check_conventions(m);
+    const char *flux = "land_surface_sediment_flowing__volume_rate";
+    /* 16 nodes, 18 triangles, 33 edges (9 squares: 12 + 12 sides, 9 diagonals). */
+    check_variable(m, &(struct expected_variable){"land_surface__elevation", "m", "node", 0}, SELAFIN_NODES);
+    check_variable(m, &(struct expected_variable){flux, "m3 s-1", "edge", 1}, 33);
+    int nodes = 0, faces = 0, edges = 0;
+    assert_int_equal(m->get_grid_node_count(m, 0, &nodes), BMI_SUCCESS);
+    assert_int_equal(m->get_grid_face_count(m, 0, &faces), BMI_SUCCESS);
+    assert_int_equal(m->get_grid_edge_count(m, 1, &edges), BMI_SUCCESS);
+    assert_true(nodes == SELAFIN_NODES && faces == SELAFIN_TRIANGLES && edges == 33);
+    double h[SELAFIN_NODES], x[SELAFIN_NODES];
+    assert_int_equal(m->get_value(m, "land_surface__elevation", h), BMI_SUCCESS);
+    assert_int_equal(m->get_grid_x(m, 0, x), BMI_SUCCESS);
+    for (int n = 0; n < SELAFIN_NODES; ++n) assert_true(h[n] == 2.0 + n && x[n] == 1000.0 + 10.0 * (n % 4));
+    /* A steep pile on node 5: it slides to its neighbours across the edges. */
+    h[5] = 40.0;
+    assert_int_equal(m->set_value(m, "land_surface__elevation", h), BMI_SUCCESS);
+    assert_int_equal(m->update(m), BMI_SUCCESS);
+    double f[33], after[SELAFIN_NODES];
+    assert_int_equal(m->get_value(m, flux, f), BMI_SUCCESS);
+    assert_int_equal(m->get_value(m, "land_surface__elevation", after), BMI_SUCCESS);
+    double carried = 0;
+    for (int e = 0; e < 33; ++e) assert_true(isfinite(f[e])), carried += fabs(f[e]);
+    assert_true(after[5] < 40.0 && carried > 0);
+    stop(m);
+}
+
 static int setup(void **state) {
     (void)state;
     snprintf(folder, sizeof folder, "%s/dpsm-bmi-host-XXXXXX", getenv("TMPDIR") ? getenv("TMPDIR") : "/tmp");
@@ -621,6 +731,7 @@ int main(int argc, char **argv) {
         cmocka_unit_test(bad_input_fails_without_harm),
         cmocka_unit_test(grids_of_a_1d_grid),
         cmocka_unit_test(mesh_grid_and_values),
+        cmocka_unit_test(dual_mesh_from_selafin),
     };
     int failed = cmocka_run_group_tests(tests, setup, teardown);
     registration = own; /* the same table through the component's own name */

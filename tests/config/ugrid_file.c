@@ -30,6 +30,9 @@ int write_ugrid_test_mesh(const char *path, int start_index) {
     TRY(nc_put_att_text(file, mesh, "face_node_connectivity", strlen("Mesh2_face_nodes"), "Mesh2_face_nodes"));
     TRY(nc_def_var(file, "Mesh2_node_x", NC_DOUBLE, 1, &node_dim, &x));
     TRY(nc_def_var(file, "Mesh2_node_y", NC_DOUBLE, 1, &node_dim, &y));
+    /* Projected coordinates say so: without units, numbers within +-90 would be taken for degrees. */
+    TRY(nc_put_att_text(file, x, "units", 1, "m"));
+    TRY(nc_put_att_text(file, y, "units", 1, "m"));
     int dims[2] = {face_dim, width_dim};
     TRY(nc_def_var(file, "Mesh2_face_nodes", NC_INT, 2, dims, &faces));
     int fill = -999;

@@ -8,7 +8,7 @@
 /* The test mesh: nodes on a 3 x 3 lattice of spacing 1 (node i + 3 j at
  * (i, j)), three unit squares and two triangles over the top right square,
  * written with node indices from `start_index` (0 or 1) and the triangles
- * padded with _FillValue. */
+ * padded with _FillValue; the coordinates have units "m". */
 #define UGRID_TEST_NODES 9
 #define UGRID_TEST_FACES 5
 #define UGRID_TEST_EDGES 13
