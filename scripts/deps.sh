@@ -34,6 +34,7 @@ DPSM_APT_PACKAGES=(
     libyaml-dev        # the run configuration (src/config): libdpsm_bmi and dpsm run read YAML with libyaml
     libnetcdf-dev      # the run configuration's netCDF inputs and UGRID meshes, dpsm run's output
     netcdf-bin         # the dpsm_run test: ncgen makes its mesh, ncdump reads the output back
+    libudunits2-dev    # the BMI tests: every variable's units parsed by UDUNITS-2 (C and Python), as frameworks parse them
 )
 
 DPSM_ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)

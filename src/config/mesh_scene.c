@@ -53,8 +53,8 @@ static int decide_coordinates(const struct config *c, const struct config_mesh *
             *geographic ? CONFIG_COORDINATES_PROJECTED : CONFIG_COORDINATES_GEOGRAPHIC;
         if (m->coordinates == other)
             return scene_refuse(c, c->grid_line, "grid.coordinates", message, size,
-                                "%s says %s, and the file says its nodes are %s (%s): which is it?",
-                                *geographic ? "geographic" : "projected", file,
+                                "%s: grid.coordinates says %s, and the file says its nodes are %s (%s): which is it?",
+                                file, *geographic ? "geographic" : "projected",
                                 *geographic ? "projected" : "in degrees", m->coordinates_said);
         return 0;
     }

@@ -102,7 +102,7 @@ static int field_from_scene(const struct config *c, const struct config_scene *s
                                     : hypot(xy[2 * k] - centre[0], xy[2 * k + 1] - centre[1]);
         if (field->kind == CONFIG_FIELD_COLUMN) values[k] = r <= field->radius ? field->height : 0;
         else values[k] = r < field->radius ? field->height * (1 - r / field->radius) : 0;
-        sanded += values[k] != 0;
+        sanded += field->kind == CONFIG_FIELD_COLUMN ? r <= field->radius : r < field->radius;
         if (r < nearest_r) nearest_r = r, nearest = k;
     }
     int failed = 0;
@@ -112,12 +112,10 @@ static int field_from_scene(const struct config *c, const struct config_scene *s
             for (int a = 0; a < 2; ++a) low[a] = fmin(low[a], xy[2 * k + a]), high[a] = fmax(high[a], xy[2 * k + a]);
         failed = scene_refuse(
             c, field->line, key, message, size,
-            "the %s puts sand on no cell: %s; its centre (%g, %g)%s lies %g%s from the nearest cell's centre (%g, %g), "
-            "and the cells' centres span [%g, %g] x [%g, %g]; give %s.centre: [x, y] where the sand should stand, a "
-            "larger radius or a height",
-            field->kind == CONFIG_FIELD_COLUMN ? "column" : "cone",
-            field->height == 0 ? "its height is 0" : "no cell's centre lies within its radius",
-            centre[0], centre[1], field->has_centre ? "" : " (the domain's centre)", nearest_r,
+            "the %s puts sand on no cell: no cell's centre lies within its radius; its centre (%g, %g)%s lies %g%s "
+            "from the nearest cell's centre (%g, %g), and the cells' centres span [%g, %g] x [%g, %g]; give "
+            "%s.centre: [x, y] where the sand should stand, or a larger radius",
+            field->kind == CONFIG_FIELD_COLUMN ? "column" : "cone", centre[0], centre[1], field->has_centre ? "" : " (the domain's centre)", nearest_r,
             geographic ? " m" : "", xy[2 * nearest], xy[2 * nearest + 1], low[0], high[0], low[1], high[1], key);
     }
     free(xy);

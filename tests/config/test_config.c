@@ -755,8 +755,8 @@ static void meshes_in_degrees(void **state) {
     config_scene_free(&s);
     REFUSED("grid: {kind: dual_mesh, file: adcirc.nc, coordinates: projected}\ninitial: {constant: 0}\n"
             "time: {step: 1, end: 1}\n",
-            "grid.coordinates: projected says", "and the file says its nodes are in degrees (lon:standard_name = "
-                                                "\"longitude\"): which is it?");
+            "dpsm.yaml:1: grid.coordinates: ", "adcirc.nc: grid.coordinates says projected, and the file says its "
+                                                "nodes are in degrees (lon:standard_name = \"longitude\"): which is it?");
 }
 
 int main(void) {

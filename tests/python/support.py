@@ -56,6 +56,7 @@ def write_ugrid(path, start_index=1, fill=-999, fields=None):
         mesh.face_dimension = "face"
         x = ds.createVariable("node_x", "f8", ("node",))
         y = ds.createVariable("node_y", "f8", ("node",))
+        x.units = y.units = "m"  # projected: without units, numbers within +-90 look like degrees
         x[:] = [p[0] for p in MESH_NODES]
         y[:] = [p[1] for p in MESH_NODES]
         faces = ds.createVariable("face_nodes", "i4", ("face", "max_face_nodes"), fill_value=fill)

@@ -37,15 +37,17 @@ BMI_FUNCTIONS = {
 
 ELEVATION = "land_surface__elevation"
 BEDROCK = "bedrock_surface__elevation"
-SOURCE = "land_surface__net_deposition_rate"
-ANGLE = "sediment__angle_of_repose"
-FLUX_X = "land_surface_sediment__x_component_of_avalanche_volume_flux"
-FLUX_Y = "land_surface_sediment__y_component_of_avalanche_volume_flux"
-FLUX_MESH = "land_surface_sediment__avalanche_volume_flux"
-MASSES = ["land_surface_sediment__total_volume", "land_surface_sediment__sourced_volume",
-          "land_surface_sediment__outflow_volume", "land_surface_sediment__external_volume",
-          "land_surface_sediment__unmet_erosion_volume"]
-UNITS = dict([(ELEVATION, "m"), (BEDROCK, "m"), (SOURCE, "m s-1"), (ANGLE, "deg"), (FLUX_X, "m3 s-1"),
+SOURCE = "land_surface_sediment_deposition__net_volume_flux"
+ANGLE = "land_surface_sediment__repose_angle"
+FLUX_X = "land_surface_sediment_flowing__x_component_of_volume_rate"
+FLUX_Y = "land_surface_sediment_flowing__y_component_of_volume_rate"
+FLUX_MESH = "land_surface_sediment_flowing__volume_rate"
+MASSES = ["land_surface_sediment__volume",
+          "land_surface_sediment_deposition__domain_time_integral_of_net_volume_flux",
+          "land_surface_sediment_flowing_sink__time_integral_of_volume_rate",
+          "land_surface_sediment_source__time_integral_of_volume_rate",
+          "land_surface_sediment_erosion~unmet__domain_time_integral_of_volume_flux"]
+UNITS = dict([(ELEVATION, "m"), (BEDROCK, "m"), (SOURCE, "m s-1"), (ANGLE, "degree"), (FLUX_X, "m3 s-1"),
               (FLUX_Y, "m3 s-1"), (FLUX_MESH, "m3 s-1")] + [(name, "m3") for name in MASSES])
 
 # nx != ny and dx != dy, so that a swapped axis shows.
@@ -150,9 +152,9 @@ class TestInformation(BmiCase):
         m = self.model
         self.assertEqual(m.get_component_name(), "dpsm")
         self.assertEqual(m.get_input_var_names(), (ELEVATION, BEDROCK, SOURCE, ANGLE))
-        self.assertEqual(m.get_output_var_names(), (ELEVATION, BEDROCK, ANGLE, FLUX_X, FLUX_Y) + tuple(MASSES))
+        self.assertEqual(m.get_output_var_names(), (ELEVATION, ANGLE, FLUX_X, FLUX_Y) + tuple(MASSES))
         self.assertEqual(m.get_input_item_count(), 4)
-        self.assertEqual(m.get_output_item_count(), 10)
+        self.assertEqual(m.get_output_item_count(), 9)
         grids = {ELEVATION: 0, BEDROCK: 0, SOURCE: 0, ANGLE: 0, FLUX_X: 1, FLUX_Y: 2}
         for name in set(m.get_input_var_names()) | set(m.get_output_var_names()):
             self.assertEqual(m.get_var_grid(name), grids.get(name, 3), name)
@@ -217,7 +219,7 @@ class TestInformation(BmiCase):
             m.set_value("sand__height", doubles(1))
         with self.assertRaisesRegex(ValueError, "set_value: name = '%s' is an output only" % FLUX_X):
             m.set_value(FLUX_X, doubles(NY * (NX + 1)))
-        with self.assertRaisesRegex(ValueError, "name = 'land_surface_sediment__total_volume' is an output only"):
+        with self.assertRaisesRegex(ValueError, "name = '%s' is an output only" % MASSES[0]):
             m.set_value_at_indices(MASSES[0], [0], [1.0])
 
 
@@ -392,7 +394,7 @@ class TestValues(BmiCase):
             m.set_value(ELEVATION, [1.0, "2"] + [0.0] * (NX * NY - 2))
         with self.assertRaises(dpsm.Error):  # the library refuses a NaN
             m.set_value(ELEVATION, [math.nan] * (NX * NY))
-        with self.assertRaisesRegex(ValueError, r"set_value: sediment__angle_of_repose\[0\] = 95.0; an angle of "
+        with self.assertRaisesRegex(ValueError, r"set_value: land_surface_sediment__repose_angle\[0\] = 95.0; an angle of "
                                                 "repose lies strictly between 0 and 90 degrees"):
             m.set_value(ANGLE, [95.0] * (NX * NY))
         with self.assertRaisesRegex(ValueError, r"set_value_at_indices: inds\[1\] = 70 lies outside 0..69"):
@@ -438,7 +440,7 @@ class TestOneD(BmiCase):
 
     def test_grids(self):
         m = self.model
-        self.assertEqual(m.get_output_var_names(), (ELEVATION, BEDROCK, ANGLE, FLUX_X) + tuple(MASSES))
+        self.assertEqual(m.get_output_var_names(), (ELEVATION, ANGLE, FLUX_X) + tuple(MASSES))
         self.assertEqual([m.get_var_grid(name) for name in (ELEVATION, FLUX_X, MASSES[0])], [0, 1, 2])
         self.assertEqual((m.get_grid_rank(0), m.get_grid_size(0), m.get_grid_size(1)), (1, 12, 13))
         self.assertEqual(list(m.get_grid_shape(1, integers(1))), [13])
@@ -489,7 +491,7 @@ class TestMesh(BmiCase):
 
     def test_variables(self):
         m = self.model
-        self.assertEqual(m.get_output_var_names(), (ELEVATION, BEDROCK, ANGLE, FLUX_MESH) + tuple(MASSES))
+        self.assertEqual(m.get_output_var_names(), (ELEVATION, ANGLE, FLUX_MESH) + tuple(MASSES))
         self.assertEqual([m.get_var_grid(name) for name in (ELEVATION, SOURCE, FLUX_MESH, MASSES[0])], [0, 0, 1, 2])
         self.assertEqual([m.get_var_location(name) for name in (ELEVATION, FLUX_MESH, MASSES[0])],
                          ["face", "edge", "none"])

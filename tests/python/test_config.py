@@ -159,7 +159,7 @@ time: {step: 0.1, end: 1.0}
             write_ugrid(str(self.dir / "bed.nc"), start_index=start_index, fields={"h0": [float(f) for f in range(10)]})
             config = read_config(self.write("""\
 grid: {kind: mesh, file: bed.nc}
-boundaries: {edge: open}
+boundaries: {edge: open, level: 0}
 initial: {file: bed.nc, variable: h0}
 time: {step: 0.1, end: 1.0}
 """))
@@ -215,7 +215,7 @@ time: {step: 0.05, end: 1.0}
 
     def test_values(self):
         self.refused(GOOD_2D.replace("kind: 2d", "kind: 3d"),
-                     "1: grid.kind: expected one of 1d, 2d, axisymmetric, mesh, got '3d'")
+                     "1: grid.kind: expected one of 1d, 2d, axisymmetric, mesh, dual_mesh, got '3d'")
         self.refused(GOOD_2D.replace("nx: 8", "nx: -8"), "1: grid.nx: expected a positive integer, got -8")
         self.refused(GOOD_2D.replace("nx: 8", "nx: 8.0"), "1: grid.nx: expected a positive integer, got 8.0")
         self.refused(GOOD_2D.replace("nx: 8", "nx: true"), "1: grid.nx: expected a positive integer, got True")

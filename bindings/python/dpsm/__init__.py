@@ -14,6 +14,9 @@ A ctypes binding of the C library (no compiled extension)::
             h = g.get_heights()          # numpy (ny, nx) when numpy is present
         total = g.get_mass(dpsm.MASS_TOTAL)
 
+- Mesh files: ``dpsm.read_mesh(path, topology=None, dual=False,
+  coordinates=None)`` reads a UGRID netCDF, gmsh or TELEMAC Selafin file
+  into a ``Grid`` (``dpsm.meshfile``; no meshio needed).
 - Meshes: ``Grid.create_mesh(node_xy, cell_start, cell_nodes)`` (``Grid.mesh``),
   ``Grid.create_graph(...)`` (``Grid.graph``), ``Grid.create_dual_mesh(node_xy,
   triangle_nodes)`` (``Grid.dual_mesh``) and ``Grid.from_meshio(mesh)``, indices
@@ -59,6 +62,8 @@ from ._core import (  # noqa: F401
     version_string,
 )
 
+from .meshfile import read_mesh  # noqa: E402
+
 for _name in _constants.NAMES:
     globals()[_name[len("DPSM_"):]] = getattr(_constants, _name)
 del _name
@@ -66,7 +71,8 @@ del _name
 __version__ = version_string()
 
 __all__ = (
-    ["Error", "Grid", "HAVE_NUMPY", "LIBRARY", "last_error", "status_string", "version_number", "version_string"]
+    ["Error", "Grid", "HAVE_NUMPY", "LIBRARY", "last_error", "read_mesh", "status_string", "version_number",
+     "version_string"]
     + list(_constants.NAMES)
     + [name[len("DPSM_"):] for name in _constants.NAMES]
 )

@@ -414,6 +414,68 @@ def _meshio_blocks(cells):
     return blocks
 
 
+def _meshio_edge_groups(mesh, grid):
+    """{name or number: [face, ...]} from the physical tags of a meshio mesh's
+    line blocks (``cell_data["gmsh:physical"]``), named by ``field_data``
+    ({name: [tag, dimension]}): the faces of the domain edge on those lines."""
+    physical = getattr(mesh, "cell_data", {}) or {}
+    physical = physical.get("gmsh:physical") if hasattr(physical, "get") else None
+    if not physical:
+        return {}
+    blocks = _meshio_blocks(mesh.cells)
+    tagged = {}
+    for (kind, data), tags in zip(blocks, physical):
+        if not str(kind).startswith("line"):
+            continue
+        rows = data.tolist() if hasattr(data, "tolist") else [list(row) for row in data]
+        tags = tags.tolist() if hasattr(tags, "tolist") else list(tags)
+        for row, tag in zip(rows, tags):
+            a, b = int(row[0]), int(row[1])
+            tagged.setdefault(int(tag), []).append((min(a, b), max(a, b)))
+    if not tagged:
+        return {}
+    names = {}
+    for name, value in (getattr(mesh, "field_data", {}) or {}).items():
+        value = value.tolist() if hasattr(value, "tolist") else list(value)
+        if len(value) >= 2 and int(value[1]) == 1:
+            names[int(value[0])] = str(name)
+    # The faces of the edge by node pair: a polygon mesh's faces in the
+    # order they first appear, cell by cell (create_mesh's numbering).
+    faces = grid.get_mesh_faces()
+    faces = faces.tolist() if hasattr(faces, "tolist") else faces
+    pairs, seen = [], set()
+    for nodes in _meshio_cell_rows(mesh):
+        for a, b in zip(nodes, nodes[1:] + nodes[:1]):
+            key = (min(a, b), max(a, b))
+            if key not in seen:
+                seen.add(key)
+                pairs.append(key)
+    where = {}
+    for f, (pair, (a, b)) in enumerate(zip(pairs, faces)):
+        if b < 0:
+            where.setdefault(pair, []).append(f)
+    groups = {}
+    for tag, edges in sorted(tagged.items()):
+        chosen = sorted({f for pair in edges for f in where.get(pair, [])})
+        for key in ([names[tag]] if tag in names else []) + [tag]:
+            groups[key] = chosen
+    return groups
+
+
+def _meshio_cell_rows(mesh):
+    """The corner nodes of each 2D cell of a meshio mesh, as from_meshio takes them."""
+    rows = []
+    for kind, data in _meshio_blocks(mesh.cells):
+        kind = str(kind)
+        if kind.startswith(_MESHIO_SKIPPED):
+            continue
+        corners = _MESHIO_CELLS.get(kind)
+        for row in (data.tolist() if hasattr(data, "tolist") else data):
+            row = [int(n) for n in row]
+            rows.append(row[:corners] if corners else row)
+    return rows
+
+
 class Grid:
     """A dpsm grid (``dpsm_grid *``): create one with ``Grid.create_1d``,
     ``Grid.create_2d`` or ``Grid.create_axisymmetric``, a mesh with
@@ -446,6 +508,9 @@ class Grid:
     def __init__(self, _handle=None, _kind=None, _lib=None):
         """Not for hosts: a Grid is made by one of the ``create_*`` class methods (or by ``dpsm.mpi``,
         which passes ``_lib``, the library that made the handle: only its functions may take it)."""
+        ## {name or number: [face, ...]}: the faces of the domain edge in each group of edges its
+        ## file named (dpsm.read_mesh, from_meshio); empty otherwise. For set_edge_groups.
+        self.edge_groups = {}
         if not isinstance(_handle, GridPtr) or not _handle:
             raise TypeError("make a Grid with Grid.create_1d, Grid.create_2d, Grid.create_axisymmetric, "
                             "Grid.create_mesh, Grid.create_graph, Grid.create_dual_mesh or Grid.from_meshio")
@@ -654,9 +719,24 @@ class Grid:
         dropped) and ``.cells``, blocks with ``.type`` and ``.data`` (meshio's
         CellBlock; ``(type, data)`` pairs and an old meshio's dict of them are
         taken too). The cells are those of its 2D blocks ("triangle", "quad",
-        "polygon"; of "triangle6", "quad8"... the corners), in block order;
-        "vertex" and "line" blocks are skipped, other (3D) cells refused.
-        meshio itself is not imported."""
+        "polygon"; of "triangle6", "quad8"... the corners), in the order of
+        the blocks and of the rows in each: the file's order, as meshio (5 and
+        later) keeps it in blocks (an old meshio's dict, one block per type,
+        has lost it). "vertex" and "line" blocks are skipped, other (3D) cells
+        refused. The physical groups of the lines (``cell_data["gmsh:physical"]``,
+        named by ``field_data``) become ``edge_groups``, {name or number:
+        [face, ...]} of the domain edge, for ``set_edge_groups``. meshio
+        itself is not imported."""
+        grid = cls._from_meshio(mesh)
+        try:
+            grid.edge_groups = _meshio_edge_groups(mesh, grid)
+        except BaseException:
+            grid.close()
+            raise
+        return grid
+
+    @classmethod
+    def _from_meshio(cls, mesh):
         f = "Grid.from_meshio"
         blocks = []
         for kind, data in _meshio_blocks(mesh.cells):
@@ -1067,6 +1147,37 @@ class Grid:
         pointer, keep = self._kinds_in(kinds, (self.get_face_count(),), f, "OPEN or WALL")
         self._call(f, pointer)
         del keep
+
+    def set_edge_groups(self, open=(), wall=(), edge=None):
+        """Opens the faces of the domain edge in the groups ``open``, or closes
+        those in ``wall`` (names or numbers of ``edge_groups``: gmsh physical
+        curves, UGRID boundary tags), the rest of the edge ``edge`` (``WALL``
+        when ``open`` names groups, ``OPEN`` when ``wall`` does): a call of
+        ``set_edge_kinds``. An unknown group raises ValueError naming the
+        groups there are."""
+        f = "set_edge_groups"
+        if open and wall:
+            raise ValueError("%s: give open= (the rest a wall) or wall= (the rest open), not both" % f)
+        if edge is None:
+            edge = C.DPSM_OPEN if wall else C.DPSM_WALL
+        named = list(open) if open else list(wall)
+        if isinstance(open, (str, int)) or isinstance(wall, (str, int)):
+            named = [open or wall]
+        kinds = [edge] * self.get_face_count()
+        for key in named:
+            faces = self.edge_groups.get(key)
+            if faces is None and isinstance(key, str):
+                try:
+                    faces = self.edge_groups.get(int(key))
+                except ValueError:
+                    faces = None
+            if faces is None:
+                raise ValueError("%s: no group %r; this mesh has %s" % (
+                    f, key, ", ".join(str(k) for k in self.edge_groups) or "no groups of edges (read it with "
+                    "dpsm.read_mesh or Grid.from_meshio)"))
+            for face in faces:
+                kinds[face] = C.DPSM_OPEN if open else C.DPSM_WALL
+        self.set_edge_kinds(kinds)
 
     def set_heights(self, h):
         """``dpsm_set_heights``: the height of every cell, an array of ``shape``."""

@@ -50,29 +50,48 @@ except ImportError:  # bmipy is optional: the same methods without its base clas
 ## True when BmiDpsm subclasses bmipy.Bmi.
 HAVE_BMIPY = _BmiBase is not object
 
+# The names are CSDMS Standard Names: the registry's own where it has one
+# (land_surface__elevation, bedrock_surface__elevation), else built by its
+# grammar from quantities and operators its names use (tests/bmi/
+# standard_names.txt, docs/guide_bmi_python.md). The C component has the same.
+
 ## The name of the surface heights h (m).
 ELEVATION = "land_surface__elevation"
-## The name of the non-erodible bed (m).
+## The name of the non-erodible bed (m): an input only (with no bed set there is nothing to read).
 BEDROCK = "bedrock_surface__elevation"
 ## The name of the source q (m/s, positive deposits).
-DEPOSITION_RATE = "land_surface__net_deposition_rate"
+DEPOSITION_RATE = "land_surface_sediment_deposition__net_volume_flux"
 ## The name of the angle of repose per cell (degrees).
-REPOSE_ANGLE = "sediment__angle_of_repose"
+REPOSE_ANGLE = "land_surface_sediment__repose_angle"
 ## The name of the flux across x faces of a grid (m3/s).
-FLUX_X = "land_surface_sediment__x_component_of_avalanche_volume_flux"
+FLUX_X = "land_surface_sediment_flowing__x_component_of_volume_rate"
 ## The name of the flux across y faces of a 2D grid (m3/s).
-FLUX_Y = "land_surface_sediment__y_component_of_avalanche_volume_flux"
+FLUX_Y = "land_surface_sediment_flowing__y_component_of_volume_rate"
 ## The name of the flux across the faces (BMI edges) of a mesh (m3/s).
-FLUX_MESH = "land_surface_sediment__avalanche_volume_flux"
+FLUX_MESH = "land_surface_sediment_flowing__volume_rate"
 
 ## The scalar outputs: (name, the dpsm mass quantity), all in m3.
 MASS_VARIABLES = (
-    ("land_surface_sediment__total_volume", C.DPSM_MASS_TOTAL),
-    ("land_surface_sediment__sourced_volume", C.DPSM_MASS_SOURCED),
-    ("land_surface_sediment__outflow_volume", C.DPSM_MASS_OUTFLOW),
-    ("land_surface_sediment__external_volume", C.DPSM_MASS_EXTERNAL),
-    ("land_surface_sediment__unmet_erosion_volume", C.DPSM_MASS_UNMET),
+    ("land_surface_sediment__volume", C.DPSM_MASS_TOTAL),
+    ("land_surface_sediment_deposition__domain_time_integral_of_net_volume_flux", C.DPSM_MASS_SOURCED),
+    ("land_surface_sediment_flowing_sink__time_integral_of_volume_rate", C.DPSM_MASS_OUTFLOW),
+    ("land_surface_sediment_source__time_integral_of_volume_rate", C.DPSM_MASS_EXTERNAL),
+    ("land_surface_sediment_erosion~unmet__domain_time_integral_of_volume_flux", C.DPSM_MASS_UNMET),
 )
+
+## The names before 0.1's release, still understood (not listed): {former: name}.
+FORMER_NAMES = {
+    "land_surface__net_deposition_rate": DEPOSITION_RATE,
+    "sediment__angle_of_repose": REPOSE_ANGLE,
+    "land_surface_sediment__x_component_of_avalanche_volume_flux": FLUX_X,
+    "land_surface_sediment__y_component_of_avalanche_volume_flux": FLUX_Y,
+    "land_surface_sediment__avalanche_volume_flux": FLUX_MESH,
+    "land_surface_sediment__total_volume": MASS_VARIABLES[0][0],
+    "land_surface_sediment__sourced_volume": MASS_VARIABLES[1][0],
+    "land_surface_sediment__outflow_volume": MASS_VARIABLES[2][0],
+    "land_surface_sediment__external_volume": MASS_VARIABLES[3][0],
+    "land_surface_sediment__unmet_erosion_volume": MASS_VARIABLES[4][0],
+}
 
 ## The library's default angle of repose in degrees (DPSM_DEFAULT_REPOSE_ANGLE is pi/6 radians).
 DEFAULT_REPOSE_ANGLE = round(math.degrees(C.DPSM_DEFAULT_REPOSE_ANGLE), 9)
@@ -150,14 +169,16 @@ class BmiDpsm(_BmiBase):
         self._grids = []
         cells = self._cell_grid(config)
         self._grids.append(cells)
+        self._config = config
+        # On a mesh the cells are its faces; on a dual mesh its nodes.
         location = "face" if config.kind == "mesh" else "node"
         self._add(ELEVATION, "m", 0, location, True, True)
-        self._add(BEDROCK, "m", 0, location, True, True)
+        self._add(BEDROCK, "m", 0, location, True, False)
         self._add(DEPOSITION_RATE, "m s-1", 0, location, True, False)
-        self._add(REPOSE_ANGLE, "deg", 0, location, True, True)
+        self._add(REPOSE_ANGLE, "degree", 0, location, True, True)
         nx, ny, dx, dy = config.nx, config.ny, config.dx, config.dy
-        if config.kind == "mesh":
-            self._mesh = _MeshEdges(config.mesh, grid)
+        if config.kind in ("mesh", "dual_mesh"):
+            self._mesh = _MeshEdges(config.mesh, grid, config.kind == "dual_mesh")
             self._grids.append(_GridInfo("unstructured", self._mesh.edge_count))
             self._add(FLUX_MESH, "m3 s-1", 1, "edge", False, True)
         elif config.kind == "2d":
@@ -185,7 +206,7 @@ class BmiDpsm(_BmiBase):
 
     @staticmethod
     def _cell_grid(config):
-        if config.kind == "mesh":
+        if config.kind in ("mesh", "dual_mesh"):
             return _GridInfo("unstructured", config.ncells)
         if config.kind == "2d":
             return _GridInfo("uniform_rectilinear", config.ncells, (config.ny, config.nx), (config.dy, config.dx),
@@ -236,6 +257,7 @@ class BmiDpsm(_BmiBase):
         start, done = self._time, 0
         try:
             for dt, t in zip(dts, times):
+                self._config.before_step(grid)
                 grid.step(dt)
                 self._time = t
                 done += 1
@@ -250,13 +272,20 @@ class BmiDpsm(_BmiBase):
             self._refresh_state()
 
     def _add_fluxes(self, grid):
+        # On a mesh every library face; the BMI edges are the first (a dual's halves on the edge follow).
         if np is not None:
             fx, fy = grid.get_face_fluxes()
             fluxes = {FLUX_MESH if FLUX_MESH in self._carried else FLUX_X: fx, FLUX_Y: fy}
             for name, carried in self._carried.items():
-                carried += fluxes[name].reshape(-1)
+                carried += fluxes[name].reshape(-1)[:len(carried)]
             return
         x_name = FLUX_MESH if FLUX_MESH in self._carried else FLUX_X
+        if x_name == FLUX_MESH:
+            values = grid.get_face_fluxes()[0]
+            carried = self._carried[x_name]
+            for k in range(len(carried)):
+                carried[k] += values[k]
+            return
         out_x = _doubles(len(self._carried[x_name]))
         out_y = _doubles(len(self._carried[FLUX_Y])) if FLUX_Y in self._carried else None
         grid.get_face_fluxes(out_x, out_y)
@@ -311,6 +340,7 @@ class BmiDpsm(_BmiBase):
 
     def _variable(self, name, function):
         self._live(function)
+        name = FORMER_NAMES.get(name, name) if isinstance(name, str) else name
         variable = self._variables.get(name) if isinstance(name, str) else None
         if variable is None:
             raise ValueError("%s: name = %r is not a variable of this component; it has %s"
@@ -327,7 +357,7 @@ class BmiDpsm(_BmiBase):
         return "float64"
 
     def get_var_units(self, name):
-        """The units of ``name``, UDUNITS spelling (``m``, ``m s-1``, ``deg``, ``m3 s-1``, ``m3``)."""
+        """The units of ``name`` as UDUNITS-2 spells them (``m``, ``m s-1``, ``degree``, ``m3 s-1``, ``m3``)."""
         return self._variable(name, "get_var_units").units
 
     def get_var_itemsize(self, name):
@@ -342,7 +372,7 @@ class BmiDpsm(_BmiBase):
 
     def get_var_location(self, name):
         """``"node"`` on rectilinear grids, ``"face"`` (cells) or ``"edge"`` (faces) on a mesh,
-        ``"none"`` for scalars."""
+        ``"node"`` (cells) or ``"edge"`` on a dual mesh, ``"none"`` for scalars."""
         return self._variable(name, "get_var_location").location
 
     # ---- time ------------------------------------------------------------------
@@ -375,27 +405,25 @@ class BmiDpsm(_BmiBase):
 
     def _readable(self, name, function):
         variable = self._variable(name, function)
-        if name == BEDROCK and not self._has_bedrock:
-            raise Error(C.DPSM_ERR_NOT_APPLICABLE, "%s: no bed has been set (set_value it first)" % BEDROCK, function)
+        if variable.name == BEDROCK and not self._has_bedrock:
+            raise Error(C.DPSM_ERR_NOT_APPLICABLE, "%s: no bed has been set (it is an input; set_value it first)"
+                        % BEDROCK, function)
         return variable
 
     def get_value_ptr(self, name):
         """A read-only view of the values of ``name`` that the component refreshes after every update
         and set (a numpy array, or a memoryview of doubles without numpy)."""
-        self._readable(name, "get_value_ptr")
-        return self._views[name]
+        return self._views[self._readable(name, "get_value_ptr").name]
 
     def get_value(self, name, dest=None):
         """Copies the values of ``name`` into ``dest`` (a flat numpy float64 array, a list or an
         ``array.array('d')`` of the grid's size) and returns it; a new array when ``dest`` is None."""
-        self._readable(name, "get_value")
-        return _fill(dest, self._values[name], "get_value")
+        return _fill(dest, self._values[self._readable(name, "get_value").name], "get_value")
 
     def get_value_at_indices(self, name, dest, inds):
         """Copies the values of ``name`` at the flat indices ``inds`` into ``dest`` (as many values)
         and returns it."""
-        self._readable(name, "get_value_at_indices")
-        source = self._values[name]
+        source = self._values[self._readable(name, "get_value_at_indices").name]
         picked = [source[k] for k in _indices(inds, len(source), "get_value_at_indices")]
         return _fill(dest, picked, "get_value_at_indices")
 
@@ -409,6 +437,7 @@ class BmiDpsm(_BmiBase):
         """Sets the values of ``name`` at the flat indices ``inds`` from ``src`` (as many values)."""
         f = "set_value_at_indices"
         variable = self._settable(name, f)
+        name = variable.name
         size = self._grids[variable.grid].size
         where = _indices(inds, size, f)
         values = _reals_in(src, len(where), "src", f)
@@ -572,13 +601,16 @@ class BmiDpsm(_BmiBase):
 class _MeshEdges:
     """The BMI topology of a mesh: its edges are dpsm's faces, numbered as
     the library numbers them (as they first appear, cell by cell, edge by
-    edge in each cell's node order), so that edge k carries face k's flux."""
+    edge in each cell's node order), so that edge k carries face k's flux.
+    On a dual mesh the topology is the file's triangle mesh, whose nodes are
+    the cells, and its edges the triangles' edges by node pair: the
+    library's first faces (the halves on the domain edge follow them)."""
 
-    def __init__(self, topology, grid):
-        """The edges of ``topology`` (a dpsm.config.MeshTopology), checked against ``grid``'s faces."""
+    def __init__(self, topology, grid, dual=False):
+        """The edges of ``topology`` (a dpsm.meshfile.MeshFile), checked against ``grid``'s faces."""
         ## (x of each node, y of each node).
         self.node_xy = (topology.node_x, topology.node_y)
-        ## The nodes of each face (dpsm's cells), from 0.
+        ## The nodes of each face (dpsm's cells, or a dual's triangles), from 0.
         self.face_nodes = topology.face_nodes
         ## The two nodes of each edge (dpsm's faces).
         self.edge_nodes = []
@@ -587,19 +619,28 @@ class _MeshEdges:
         number = {}
         first_cell = []
         for cell, nodes in enumerate(topology.face_nodes):
-            edges = []
             for a, b in zip(nodes, nodes[1:] + nodes[:1]):
                 key = (min(a, b), max(a, b))
                 if key not in number:
                     number[key] = len(self.edge_nodes)
                     self.edge_nodes.append((a, b))
                     first_cell.append(cell)
-                edges.append(number[key])
-            self.face_edges.append(edges)
+        if dual:  # by node pair, lower node first
+            self.edge_nodes = sorted(number)
+            number = {key: k for k, key in enumerate(self.edge_nodes)}
+        for nodes in topology.face_nodes:
+            self.face_edges.append([number[(min(a, b), max(a, b))] for a, b in zip(nodes, nodes[1:] + nodes[:1])])
         ## The number of edges.
         self.edge_count = len(self.edge_nodes)
         faces = grid.get_mesh_faces()
-        if len(faces) != self.edge_count or any(int(faces[k][0]) != first_cell[k] for k in range(self.edge_count)):
+        faces = faces.tolist() if hasattr(faces, "tolist") else faces
+        if dual:
+            same = len(faces) >= self.edge_count and all(tuple(faces[k]) == tuple(self.edge_nodes[k])
+                                                         for k in range(self.edge_count))
+        else:
+            same = len(faces) == self.edge_count and all(int(faces[k][0]) == first_cell[k]
+                                                         for k in range(self.edge_count))
+        if not same:
             raise Error(C.DPSM_ERR_INTERNAL, "the mesh's edges (%d) do not match the library's faces (%d)"
                         % (self.edge_count, len(faces)), "initialize")
 
