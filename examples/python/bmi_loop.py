@@ -58,7 +58,7 @@ def main():
     t = model.get_start_time()
     while True:
         model.get_value(ELEVATION, h)
-        model.get_value("land_surface_sediment__total_volume", volume)
+        model.get_value("land_surface_sediment__volume", volume)
         print("%8.3f %10.4f %10.4f %12.6f" % (t, max(h), foot_along_x(model, h), volume[0]))
         if t >= model.get_end_time():
             break
@@ -68,14 +68,17 @@ def main():
     # The exact deposit of an axisymmetric column that stays a truncated cone
     # (aspect ratio a = h0/r0 <= sqrt(3) tan(theta)), docs/validation.
     r0, h0 = 0.6, 0.5
-    alpha = math.tan(math.radians(model.get_value("sediment__angle_of_repose", [0.0] * size)[0]))
+    alpha = math.tan(math.radians(model.get_value("land_surface_sediment__repose_angle", [0.0] * size)[0]))
     a = h0 / r0
     exact_foot = r0 * (a + math.sqrt(4 * alpha**2 - a**2 / 3)) / (2 * alpha)
     print("foot of the deposit along x: %.4f m, exact %.4f m (cells of %.3f m)"
           % (foot_along_x(model, h), exact_foot, model.get_grid_spacing(0, [0.0, 0.0])[1]))
     ledger = {}
-    for name in ("total", "sourced", "external", "outflow"):
-        ledger[name] = model.get_value("land_surface_sediment__%s_volume" % name, [0.0])[0]
+    for name, variable in (("total", "land_surface_sediment__volume"),
+                           ("sourced", "land_surface_sediment_deposition__domain_time_integral_of_net_volume_flux"),
+                           ("external", "land_surface_sediment_source__time_integral_of_volume_rate"),
+                           ("outflow", "land_surface_sediment_flowing_sink__time_integral_of_volume_rate")):
+        ledger[name] = model.get_value(variable, [0.0])[0]
     print("mass balance: total %.9g = sourced %.9g + external %.9g - outflow %.9g (closes to %.1e)"
           % (ledger["total"], ledger["sourced"], ledger["external"], ledger["outflow"],
              ledger["total"] - (ledger["sourced"] + ledger["external"] - ledger["outflow"])))

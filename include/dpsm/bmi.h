@@ -91,7 +91,7 @@ typedef struct Bmi {
     int (*get_var_grid)(struct Bmi *self, const char *name, int *grid);
     /** Writes "double". */
     int (*get_var_type)(struct Bmi *self, const char *name, char *type);
-    /** Writes the variable's units ("m", "m s-1", "deg", "m3 s-1", "m3"). */
+    /** Writes the variable's units ("m", "m s-1", "degree", "m3 s-1", "m3": UDUNITS-2 names). */
     int (*get_var_units)(struct Bmi *self, const char *name, char *units);
     /** Bytes per value: 8. */
     int (*get_var_itemsize)(struct Bmi *self, const char *name, int *size);

@@ -310,7 +310,9 @@ DPSM_API int dpsm_create_axisymmetric(int64_t nr, double dr, dpsm_grid **out);
  * @return ::DPSM_OK, ::DPSM_ERR_NULL_POINTER, ::DPSM_ERR_INVALID_SIZE,
  *         ::DPSM_ERR_INVALID_VALUE (the message names the cell, node or edge:
  *         an index out of range, fewer than 3 distinct nodes, zero area, an
- *         edge of three or more cells, non-finite coordinates) or
+ *         edge of three or more cells, non-finite coordinates, two nodes of
+ *         the cells at the same point: their edges would not join, and sand
+ *         could leave through an open edge in the middle of the domain) or
  *         ::DPSM_ERR_OUT_OF_MEMORY; read the message with `dpsm_last_error(NULL)`.
  */
 DPSM_API int dpsm_create_mesh(int64_t nnodes, const double *node_xy, int64_t ncells, const int64_t *cell_start,
@@ -329,6 +331,16 @@ DPSM_API int dpsm_create_mesh(int64_t nnodes, const double *node_xy, int64_t nce
  * keep the host's order. Indices count from 0; dpsm_create_graph_indexed()
  * takes them from 1.
  *
+ * A cell's centre may lie on the midpoint of one of its domain-edge faces:
+ * that is the circumcentre of a right triangle, which Delft3D FM writes as
+ * `mesh2d_face_x/y`. That face's outward normal is then taken towards the
+ * gap the cell's two other faces leave, and the distance across it as
+ * twice the one from the face to the triangle's centroid (`4 area / (3
+ * length)`), instead of the zero between the centre and the face; on a face
+ * between two cells the direction is the one towards the other cell's
+ * centre. A centre on the midpoint of a domain-edge face of a cell that is
+ * not a triangle is refused.
+ *
  * @param ncells       number of cells, at least 1.
  * @param cell_xy      `2*ncells` centres.
  * @param cell_area    `ncells` positive areas.
@@ -339,7 +351,9 @@ DPSM_API int dpsm_create_mesh(int64_t nnodes, const double *node_xy, int64_t nce
  * @param out          receives the new mesh, or NULL on failure.
  * @return as dpsm_create_mesh(); also ::DPSM_ERR_INVALID_VALUE for a face
  *         whose cells coincide and for a cell whose faces do not close it
- *         (their midpoints leave half a turn or more around its centre).
+ *         (their midpoints leave half a turn or more around its centre: the
+ *         message gives the cell, its faces and the directions, counter-
+ *         clockwise from +x, between which a face is missing).
  */
 DPSM_API int dpsm_create_graph(int64_t ncells, const double *cell_xy, const double *cell_area, int64_t nfaces,
                                const int64_t *face_cells, const double *face_xy, const double *face_length,

@@ -229,15 +229,34 @@ static int read_grid(struct reader *r, yaml_node_t *grid, struct config *c) {
     return 0;
 }
 
+/* The optional `positive: up | down` of a field read from a file: whether
+ * its values are elevations or depths (below a datum, which dpsm negates). */
+static int read_positive(struct reader *r, yaml_node_t *mapping, const char *parent, int *positive) {
+    *positive = 0;
+    if (!lookup(r, mapping, "positive")) return 0;
+    char word[32], key_path[64];
+    yaml_node_t *node;
+    if (read_word(r, mapping, parent, "positive", word, sizeof word, &node)) return 1;
+    join_key(key_path, sizeof key_path, parent, "positive");
+    if (strcmp(word, "up") == 0) *positive = 1;
+    else if (strcmp(word, "down") == 0) *positive = -1;
+    else
+        return refuse(r, node, key_path,
+                      "expected up (the values are elevations) or down (they are depths: dpsm takes their negative), "
+                      "got \"%s\"", word);
+    return 0;
+}
+
 /* boundaries.level: 0, cell, a number or {file, variable}. */
 static int read_level(struct reader *r, yaml_node_t *node, struct config *c) {
     c->level_line = line_of(node);
     if (node->type == YAML_MAPPING_NODE) {
-        static const char *const keys[] = {"file", "variable", NULL};
+        static const char *const keys[] = {"file", "variable", "positive", NULL};
         c->level_kind = CONFIG_LEVEL_FILE;
         return check_keys(r, node, "boundaries.level", keys, "a field") ||
                read_file_name(r, node, "boundaries.level", "file", c->level_file) ||
-               read_word(r, node, "boundaries.level", "variable", c->level_variable, sizeof c->level_variable, NULL);
+               read_word(r, node, "boundaries.level", "variable", c->level_variable, sizeof c->level_variable, NULL) ||
+               read_positive(r, node, "boundaries.level", &c->level_positive);
     }
     if (node->type == YAML_SCALAR_NODE && strcmp(scalar_text(node), "cell") == 0) {
         c->level_kind = CONFIG_LEVEL_CELL;
@@ -352,6 +371,7 @@ static int read_field(struct reader *r, yaml_node_t *node, const char *name, int
     static const char *const keys_scene[] = {"scene", "radius", "height", "centre", NULL};
     static const char *const keys_constant[] = {"constant", NULL};
     static const char *const keys_file[] = {"file", "variable", NULL};
+    static const char *const keys_heights_file[] = {"file", "variable", "positive", NULL};
     if (scenes_allowed && lookup(r, node, "scene")) {
         char scene[32];
         yaml_node_t *scene_node;
@@ -391,8 +411,11 @@ static int read_field(struct reader *r, yaml_node_t *node, const char *name, int
     if (lookup(r, node, "file")) {
         field->kind = CONFIG_FIELD_FILE;
         field->line = line_of(node);
-        return check_keys(r, node, name, keys_file, "a file") || read_file_name(r, node, name, "file", field->file) ||
-               read_word(r, node, name, "variable", field->variable, sizeof field->variable, NULL);
+        /* Heights (initial) may be stored as depths; a source is a rate. */
+        return check_keys(r, node, name, scenes_allowed ? keys_heights_file : keys_file, "a file") ||
+               read_file_name(r, node, name, "file", field->file) ||
+               read_word(r, node, name, "variable", field->variable, sizeof field->variable, NULL) ||
+               (scenes_allowed && read_positive(r, node, name, &field->positive));
     }
     return refuse(r, node, name, scenes_allowed ? "expected a scene (column or cone), a constant or a file"
                                                 : "expected a constant or a file");

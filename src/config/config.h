@@ -53,6 +53,7 @@ struct config_field {
     unsigned long line; /* where the field is, for refusals found later */
     char file[CONFIG_PATH_MAX]; /* CONFIG_FIELD_FILE: resolved against the configuration's folder */
     char variable[CONFIG_NAME_MAX];
+    int positive; /* the file's `positive:` key: 1 up (an elevation), -1 down (a depth: negated), 0 not given */
 };
 
 struct config {
@@ -76,6 +77,7 @@ struct config {
     enum config_level_kind level_kind;
     double level;
     char level_file[CONFIG_PATH_MAX], level_variable[CONFIG_NAME_MAX];
+    int level_positive; /* as config_field.positive */
     unsigned long level_line;
     int group_count, groups_open;
     char groups[CONFIG_GROUPS_MAX][CONFIG_NAME_MAX];

@@ -205,7 +205,9 @@ int scene_set_edges(const struct config *c, struct config_scene *s, char *messag
                 failed = config_scene_before_step(s, message, size);
                 break;
             case CONFIG_LEVEL_FILE:
-                failed = levels_from_file(c, s, pairs, triangle, s->levels, message, size);
+                failed = levels_from_file(c, s, pairs, triangle, s->levels, message, size) ||
+                         scene_heights_sign(c, c->level_file, c->level_variable, c->level_positive, c->level_line,
+                                            "boundaries.level", s->levels, n, message, size);
                 if (!failed && dpsm_set_side_levels(s->grid, DPSM_MESH_EDGE, s->levels) != DPSM_OK)
                     failed = scene_refuse(c, c->level_line, "boundaries.level", message, size, "%s: \"%s\": %s",
                                           c->level_file, c->level_variable, dpsm_last_error(s->grid));

@@ -10,6 +10,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 
 static int nc_refuse(char *message, size_t size, const char *path, const char *what, int status) {
     snprintf(message, size, "%s: %s: %s", path, what, nc_strerror(status));
@@ -29,6 +30,30 @@ static void text_attribute(int file, int variable, const char *name, char *out, 
 static int open_file(const char *path, int *file, char *message, size_t size) {
     int status = nc_open(path, NC_NOWRITE, file);
     return status == NC_NOERR ? 0 : nc_refuse(message, size, path, "cannot open as netCDF", status);
+}
+
+int netcdf_field_sign(const char *path, const char *variable, char *said, size_t size) {
+    int file, id, sign = 0;
+    said[0] = '\0';
+    if (nc_open(path, NC_NOWRITE, &file) != NC_NOERR) return 0;
+    if (nc_inq_varid(file, variable, &id) == NC_NOERR) {
+        char positive[64], standard_name[256];
+        text_attribute(file, id, "positive", positive, sizeof positive);
+        text_attribute(file, id, "standard_name", standard_name, sizeof standard_name);
+        if (strcasecmp(positive, "down") == 0 || strcasecmp(positive, "up") == 0) {
+            sign = strcasecmp(positive, "down") == 0 ? -1 : 1;
+            snprintf(said, size, "%.100s:positive = \"%.60s\"", variable, positive);
+        } else if (strstr(standard_name, "depth")) {
+            sign = -1;
+            snprintf(said, size, "%.100s:standard_name = \"%.200s\"", variable, standard_name);
+        } else if (strstr(standard_name, "elevation") || strstr(standard_name, "altitude") ||
+                   strstr(standard_name, "height")) {
+            sign = 1;
+            snprintf(said, size, "%.100s:standard_name = \"%.200s\"", variable, standard_name);
+        }
+    }
+    nc_close(file);
+    return sign;
 }
 
 int netcdf_read_field(const char *path, const char *variable, int rank, size_t length0, size_t length1, double *values,

@@ -36,6 +36,25 @@ static void domain_centre(const struct config *c, const struct config_scene *s, 
     centre[1] = 0.5 * (low[1] + high[1]);
 }
 
+int scene_heights_sign(const struct config *c, const char *file, const char *variable, int positive,
+                       unsigned long line, const char *key, double *values, int64_t count, char *message, size_t size) {
+    char said[400], key_path[64];
+    const int sign = netcdf_field_sign(file, variable, said, sizeof said);
+    snprintf(key_path, sizeof key_path, "%s.positive", key);
+    if (positive == 0 && sign < 0)
+        return scene_refuse(c, line, key, message, size,
+                            "%s: \"%s\" holds depths, positive down (%s), and dpsm's heights are elevations, "
+                            "positive up: say %s: down to take their negative, or give an elevation",
+                            file, variable, said, key_path);
+    if (positive != 0 && sign != 0 && positive != sign)
+        return scene_refuse(c, line, key_path, message, size,
+                            "%s says %s, and %s says \"%s\" is positive %s (%s): which is it?", key_path,
+                            positive > 0 ? "up" : "down", file, variable, sign > 0 ? "up" : "down", said);
+    if (positive < 0)
+        for (int64_t k = 0; k < count; ++k) values[k] = -values[k];
+    return 0;
+}
+
 /* A field's values from a file: a grid's netCDF variable, or a mesh file's
  * variable where the cells are (faces of a mesh, nodes of a dual mesh). */
 static int field_from_file(const struct config *c, const struct config_scene *s, const struct config_field *field,
@@ -128,7 +147,11 @@ static int fill_field(const struct config *c, const struct config_scene *s, cons
         for (int64_t k = 0; k < s->cell_count; ++k) values[k] = field->value;
         return 0;
     }
-    if (field->kind == CONFIG_FIELD_FILE) return field_from_file(c, s, field, key, values, message, size);
+    /* Heights (not a source's rates) may come as depths. */
+    if (field->kind == CONFIG_FIELD_FILE)
+        return field_from_file(c, s, field, key, values, message, size) ||
+               (field == &c->initial && scene_heights_sign(c, field->file, field->variable, field->positive,
+                                                           field->line, key, values, s->cell_count, message, size));
     return field_from_scene(c, s, field, key, values, message, size);
 }
 

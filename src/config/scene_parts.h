@@ -22,6 +22,13 @@ int scene_create_mesh(const struct config *c, struct config_scene *s, char *mess
 /* The great-circle distance in metres between two points in degrees. */
 double scene_sphere_distance(double lon0, double lat0, double lon1, double lat1);
 
+/* Heights read from `file` for `key` (initial, boundaries.level): refuses
+ * a variable whose attributes say it is a depth unless `<key>.positive:
+ * down` says so too (and then negates the values), and a `positive` the
+ * attributes contradict. */
+int scene_heights_sign(const struct config *c, const char *file, const char *variable, int positive,
+                       unsigned long line, const char *key, double *values, int64_t count, char *message, size_t size);
+
 /* The mesh's edge after the heights are set: kinds (boundaries.edge, .open,
  * .wall) and levels (boundaries.level). */
 int scene_set_edges(const struct config *c, struct config_scene *s, char *message, size_t size);

@@ -356,7 +356,7 @@ int write_gmsh(const char *path, int version) {
 }
 
 int write_lonlat(const char *path, int attributes) {
-    int file, node_dim, face_dim, three_dim, topology, x, y, faces, bed;
+    int file, node_dim, face_dim, three_dim, topology, x, y, faces, bed, depth = -1;
     int status = nc_create(path, NC_CLOBBER, &file);
     if (status != NC_NOERR) return status;
     TRY(nc_def_dim(file, "nMesh2_node", LONLAT_NODES, &node_dim));
@@ -382,6 +382,12 @@ int write_lonlat(const char *path, int attributes) {
     TRY(nc_def_var(file, "depth_bed", NC_DOUBLE, 1, &node_dim, &bed));
     TRY(text(file, bed, "location", "node"));
     TRY(text(file, bed, "units", "m"));
+    if (attributes) {
+        TRY(nc_def_var(file, "depth", NC_DOUBLE, 1, &node_dim, &depth));
+        TRY(text(file, depth, "location", "node"));
+        TRY(text(file, depth, "standard_name", "depth_below_geoid"));
+        TRY(text(file, depth, "units", "m"));
+    }
     TRY(nc_enddef(file));
     double lon[LONLAT_NODES], lat[LONLAT_NODES], z[LONLAT_NODES];
     for (int n = 0; n < LONLAT_NODES; ++n) lon[n] = -80.0 + 0.01 * (n % 5), lat[n] = 30.0 + 0.01 * (n / 5), z[n] = -10.0 - n;
@@ -396,5 +402,7 @@ int write_lonlat(const char *path, int attributes) {
     TRY(nc_put_var_double(file, y, lat));
     TRY(nc_put_var_int(file, faces, &table[0][0]));
     TRY(nc_put_var_double(file, bed, z));
+    for (int n = 0; n < LONLAT_NODES; ++n) z[n] = -z[n];
+    if (attributes) TRY(nc_put_var_double(file, depth, z));
     return nc_close(file);
 }

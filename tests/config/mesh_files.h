@@ -42,8 +42,9 @@ int write_gmsh(const char *path, int version);
 /* An ADCIRC-like mesh in longitude and latitude: 25 nodes on a 5 x 5
  * lattice of 0.01 degrees from (-80, 30), 32 triangles, node variable
  * depth_bed = -10 - node (location node). With `attributes`,
- * standard_name longitude/latitude and units degrees_east/north; without,
- * none. */
+ * standard_name longitude/latitude and units degrees_east/north, and
+ * ADCIRC's depth = 10 + node (standard_name depth_below_geoid: positive
+ * down); without, none of these. */
 #define LONLAT_NODES 25
 #define LONLAT_TRIANGLES 32
 int write_lonlat(const char *path, int attributes);

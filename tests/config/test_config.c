@@ -753,6 +753,32 @@ static void meshes_in_degrees(void **state) {
     assert_true(h[12] == 800.0); /* the node at the centre */
     assert_true(h[0] == 0.0);    /* 3 km away */
     config_scene_free(&s);
+    /* ADCIRC's depth is positive down: refused as heights unless said, then negated. */
+    REFUSED("grid: {kind: dual_mesh, file: adcirc.nc}\ninitial: {file: adcirc.nc, variable: depth}\n"
+            "time: {step: 1, end: 1}\n",
+            "dpsm.yaml:2: initial: ", "adcirc.nc: \"depth\" holds depths, positive down (depth:standard_name = "
+            "\"depth_below_geoid\"), and dpsm's heights are elevations, positive up: say initial.positive: down");
+    build("grid: {kind: dual_mesh, file: adcirc.nc}\n"
+          "initial: {file: adcirc.nc, variable: depth, positive: down}\n"
+          "boundaries: {edge: open, level: {file: adcirc.nc, variable: depth, positive: down}}\n"
+          "time: {step: 60, end: 60}\n", &c, &s);
+    dpsm_get_heights(s.grid, h);
+    for (int n = 0; n < LONLAT_NODES; ++n) assert_true(h[n] == -10.0 - n);
+    int64_t faces = 0;
+    dpsm_get_face_count(s.grid, &faces);
+    for (int64_t f = 0; f < faces; ++f)
+        if (s.face_cells[2 * f + 1] < 0) assert_true(s.levels[f] == h[s.face_cells[2 * f]]);
+    config_scene_free(&s);
+    REFUSED("grid: {kind: dual_mesh, file: adcirc.nc}\ninitial: {file: adcirc.nc, variable: depth, positive: up}\n"
+            "time: {step: 1, end: 1}\n",
+            "dpsm.yaml:2: initial.positive: initial.positive says up, and ",
+            "adcirc.nc says \"depth\" is positive down (depth:standard_name = \"depth_below_geoid\"): which is it?");
+    REFUSED("grid: {kind: dual_mesh, file: adcirc.nc}\ninitial: {constant: 0}\n"
+            "boundaries: {edge: open, level: {file: adcirc.nc, variable: depth}}\ntime: {step: 1, end: 1}\n",
+            "boundaries.level: ", "say boundaries.level.positive: down");
+    expect_refusal("grid: {kind: dual_mesh, file: adcirc.nc}\ninitial: {file: adcirc.nc, variable: depth, positive: "
+                   "downwards}\n",
+                   2, "initial.positive: expected up (the values are elevations) or down");
     REFUSED("grid: {kind: dual_mesh, file: adcirc.nc, coordinates: projected}\ninitial: {constant: 0}\n"
             "time: {step: 1, end: 1}\n",
             "dpsm.yaml:1: grid.coordinates: ", "adcirc.nc: grid.coordinates says projected, and the file says its "

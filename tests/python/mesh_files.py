@@ -220,3 +220,7 @@ def write_lonlat(path, attributes=True):
         bed = ds.createVariable("depth_bed", "f8", ("nMesh2_node",))
         bed.location, bed.units = "node", "m"
         bed[:] = [-10.0 - n for n in range(25)]
+        if attributes:  # ADCIRC's depth: positive down, said by its standard_name only
+            depth = ds.createVariable("depth", "f8", ("nMesh2_node",))
+            depth.location, depth.units, depth.standard_name = "node", "m", "depth_below_geoid"
+            depth[:] = [10.0 + n for n in range(25)]

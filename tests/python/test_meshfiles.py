@@ -327,6 +327,43 @@ class TestConfiguration(Folder):
             """))
         self.assertTrue(config.geographic)
         self.assertEqual((config.initial[12], config.initial[0]), (800.0, 0.0))
+        # ADCIRC's depth is positive down: refused as heights unless said, then negated.
+        self.refused("""\
+            grid: {kind: dual_mesh, file: adcirc.nc}
+            initial: {file: adcirc.nc, variable: depth}
+            time: {step: 1, end: 1}
+            """, ":2: initial: ", 'adcirc.nc: "depth" holds depths, positive down (depth:standard_name = '
+                     '"depth_below_geoid"), and dpsm\'s heights are elevations, positive up: say initial.positive: '
+                     'down')
+        config = read_config(self.config("""\
+            grid: {kind: dual_mesh, file: adcirc.nc}
+            initial: {file: adcirc.nc, variable: depth, positive: down}
+            boundaries: {edge: open, level: {file: adcirc.nc, variable: depth, positive: down}}
+            time: {step: 60, end: 60}
+            """))
+        self.assertEqual(config.initial, [-10.0 - n for n in range(25)])
+        with config.create_grid() as g:
+            faces = g.get_mesh_faces()
+            faces = faces.tolist() if hasattr(faces, "tolist") else faces
+            edge = [f for f, (a, b) in enumerate(faces) if b < 0]
+            self.assertEqual([config.level[1][f] for f in edge], [config.initial[faces[f][0]] for f in edge])
+        self.refused("""\
+            grid: {kind: dual_mesh, file: adcirc.nc}
+            initial: {file: adcirc.nc, variable: depth, positive: up}
+            time: {step: 1, end: 1}
+            """, ":2: initial.positive: initial.positive says up, and ",
+                     'adcirc.nc says "depth" is positive down (depth:standard_name = "depth_below_geoid"): which is it?')
+        self.refused("""\
+            grid: {kind: dual_mesh, file: adcirc.nc}
+            initial: {constant: 0}
+            boundaries: {edge: open, level: {file: adcirc.nc, variable: depth}}
+            time: {step: 1, end: 1}
+            """, "boundaries.level: ", "say boundaries.level.positive: down")
+        self.refused("""\
+            grid: {kind: dual_mesh, file: adcirc.nc}
+            initial: {file: adcirc.nc, variable: depth, positive: downwards}
+            time: {step: 1, end: 1}
+            """, ":2: initial.positive: expected up (the values are elevations) or down")
 
 
 class TestBmiConventions(Folder):

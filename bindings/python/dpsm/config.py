@@ -446,7 +446,8 @@ def _read_field(reader, node, key, config, scenes):
     """One value per cell (x fastest) from {constant}, {file, variable} or, for
     the initial heights, {scene, radius, height}."""
     forms = (("scene", "radius", "height", "centre"),) if scenes else ()
-    forms += (("constant",), ("file", "variable"))
+    # Heights (initial, not a source's rates) may be stored as depths: positive: down.
+    forms += (("constant",), ("file", "variable", "positive") if scenes else ("file", "variable"))
     allowed = tuple(name for form in forms for name in form)
     entries = reader.mapping(node, key, allowed)
     chosen = [form for form in forms if form[0] in entries]
@@ -458,12 +459,17 @@ def _read_field(reader, node, key, config, scenes):
         if name not in form:
             reader.fail(key_node, "%s.%s" % (key, name), "does not go with '%s'" % form[0])
     for name in form:
-        if name not in entries and name != "centre":
+        if name not in entries and name not in ("centre", "positive"):
             reader.fail(node, key, "missing key '%s' (with '%s')" % (name, form[0]))
     if form[0] == "constant":
         return [reader.real(entries["constant"][1], key + ".constant")] * config.ncells
     if form[0] == "file":
-        return _read_netcdf_field(reader, entries, key, config)
+        values = _read_netcdf_field(reader, entries, key, config)
+        if scenes:
+            positive = _read_positive(reader, entries, key)
+            _heights_sign(reader, node, key, reader.file(entries["file"][1], key + ".file"),
+                          reader.text(entries["variable"][1], key + ".variable"), positive, values)
+        return values
     scene = reader.text(entries["scene"][1], key + ".scene", _SCENES)
     radius = reader.positive(entries["radius"][1], key + ".radius")
     height = reader.real(entries["height"][1], key + ".height")
@@ -496,6 +502,32 @@ def _read_field(reader, node, key, config, scenes):
                        " m" if config.geographic else "", nearest[1], nearest[2], min(xs), max(xs), min(ys), max(ys),
                        key))
     return values
+
+
+def _read_positive(reader, entries, key):
+    """The optional ``positive: up | down`` of heights from a file: 1, -1, or 0 when not given."""
+    if "positive" not in entries:
+        return 0
+    word = reader.scalar(entries["positive"][1], key + ".positive")
+    if word not in ("up", "down"):
+        reader.fail(entries["positive"][1], key + ".positive", "expected up (the values are elevations) or down (they "
+                    "are depths: dpsm takes their negative), got %s" % reader.got(entries["positive"][1]))
+    return 1 if word == "up" else -1
+
+
+def _heights_sign(reader, node, key, path, name, positive, values):
+    """Refuses depths taken as heights unless ``<key>.positive: down`` says so (then negates them in
+    place), and a ``positive`` the file's attributes contradict."""
+    sign, said = meshfile.field_sign(path, name)
+    if positive == 0 and sign < 0:
+        reader.fail(node, key, '%s: "%s" holds depths, positive down (%s), and dpsm\'s heights are elevations, '
+                    'positive up: say %s.positive: down to take their negative, or give an elevation'
+                    % (path, name, said, key))
+    if positive and sign and positive != sign:
+        reader.fail(node, key + ".positive", '%s.positive says %s, and %s says "%s" is positive %s (%s): which is '
+                    'it?' % (key, "up" if positive > 0 else "down", path, name, "up" if sign > 0 else "down", said))
+    if positive < 0:
+        values[:] = [-v for v in values]
 
 
 def meshfile_distance(lon0, lat0, lon1, lat1):
@@ -614,9 +646,11 @@ def _read_edge(reader, node, entries, config):
                         "open groups of edges with boundaries.open, or leave the level out"
                         % ("" if C.DPSM_MESH_EDGE in config.boundaries else ", the default"))
         if isinstance(level, reader.yaml.MappingNode):
-            fields = reader.mapping(level, "boundaries.level", ("file", "variable"), ("file", "variable"))
+            fields = reader.mapping(level, "boundaries.level", ("file", "variable", "positive"),
+                                    ("file", "variable"))
             config.level = ("file", reader.file(fields["file"][1], "boundaries.level.file"),
-                            reader.text(fields["variable"][1], "boundaries.level.variable"), level)
+                            reader.text(fields["variable"][1], "boundaries.level.variable"), level,
+                            _read_positive(reader, fields, "boundaries.level"))
         else:
             value = reader.scalar(level, "boundaries.level")
             if value == "cell":
@@ -664,7 +698,7 @@ def _check_edge(reader, node, entries, config):
     if not open_faces:
         return
     if isinstance(config.level, tuple):
-        _, path, name, level_node = config.level
+        _, path, name, level_node, positive = config.level
         cells_at = "node" if dual else "face"
         try:
             values, where = mesh.variable(name, path, cells_at)
@@ -690,6 +724,7 @@ def _check_edge(reader, node, entries, config):
                     reader.fail(level_node, "boundaries.level", '%s: "%s" lies on the file\'s edges, and none is the '
                                 'edge between nodes %d and %d (from 0), on the domain edge' % (path, name, *pair))
                 levels.append(edge_values[pair])
+        _heights_sign(reader, level_node, "boundaries.level", path, name, positive, levels)
         config.level = ("file", levels)
     elif config.level is None:
         worst = max(open_faces, key=lambda f: abs(config.initial[faces[f][0]]))

@@ -521,6 +521,32 @@ def _read_ugrid(path, wanted):
     return mesh
 
 
+def field_sign(path, name):
+    """What a netCDF variable's attributes say about the sign of its values:
+    ``(-1, said)`` for a depth (CF ``positive = "down"``, or a
+    ``standard_name`` that names a depth, as sea_floor_depth_below_geoid and
+    ADCIRC's depth_below_geoid), ``(1, said)`` for an elevation (``positive =
+    "up"``, a ``standard_name`` of an elevation, altitude or height), ``(0,
+    "")`` when they say neither or the file is not netCDF; ``said`` is the
+    attribute that says it."""
+    path = os.fspath(path)
+    if _format_of(path) != "netCDF":
+        return 0, ""
+    with _open_netcdf(path) as dataset:
+        if name not in dataset.variables:
+            return 0, ""
+        variable = dataset.variables[name]
+        positive = str(getattr(variable, "positive", ""))
+        standard_name = str(getattr(variable, "standard_name", ""))
+    if positive.lower() in ("up", "down"):
+        return (-1 if positive.lower() == "down" else 1), '%s:positive = "%s"' % (name, positive)
+    if "depth" in standard_name:
+        return -1, '%s:standard_name = "%s"' % (name, standard_name)
+    if any(word in standard_name for word in ("elevation", "altitude", "height")):
+        return 1, '%s:standard_name = "%s"' % (name, standard_name)
+    return 0, ""
+
+
 def _ugrid_variable(mesh, path, name, cells_at):
     cells = mesh.node_count if cells_at == "node" else len(mesh.face_nodes)
     with _open_netcdf(path) as dataset:
