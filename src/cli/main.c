@@ -129,18 +129,23 @@ static void describe_mesh(const struct run *r) {
                : "");
     int64_t edge = 0;
     for (int64_t f = 0; f < r->scene.face_count; ++f) edge += r->scene.face_cells[2 * f + 1] < 0;
-    static const char *const levels[] = {"0", "a number", "each face's cell's own", "a field of a file"};
+    char level[CONFIG_PATH_MAX + CONFIG_NAME_MAX + 64];
+    if (c->level_kind == CONFIG_LEVEL_NUMBER) snprintf(level, sizeof level, "%g m", c->level);
+    else if (c->level_kind == CONFIG_LEVEL_CELL) snprintf(level, sizeof level, "each face's cell's own, before every step");
+    else if (c->level_kind == CONFIG_LEVEL_FILE)
+        snprintf(level, sizeof level, "\"%s\" of %s%s", c->level_variable, c->level_file,
+                 c->level_positive < 0 ? " (depths, negated)" : "");
+    else snprintf(level, sizeof level, "0 m");
     char named[512] = "";
     for (int k = 0; k < c->group_count; ++k) {
         strncat(named, k ? ", " : "", sizeof named - strlen(named) - 1);
         strncat(named, c->groups[k], sizeof named - strlen(named) - 1);
     }
     const int open = c->boundary[DPSM_MESH_EDGE] == DPSM_OPEN;
-    printf("edge: %lld faces on the domain edge (%d groups in the file): %s%s%s%s%s%s\n", (long long)edge,
+    printf("edge: %lld faces on the domain edge (%d groups in the file): %s%s%s%s%s\n", (long long)edge,
            m->group_count, open ? "open" : "walls", c->group_count ? (open ? ", walls: " : ", open: ") : "", named,
            open || (c->group_count && c->groups_open) ? "; the level beyond open faces: " : "",
-           open || (c->group_count && c->groups_open) ? levels[c->level_kind] : "",
-           c->level_kind == CONFIG_LEVEL_FILE ? " (boundaries.level)" : "");
+           open || (c->group_count && c->groups_open) ? level : "");
 }
 
 static void print_balance(const struct run *r) {

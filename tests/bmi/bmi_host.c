@@ -690,6 +690,18 @@ static void dual_mesh_from_selafin(void **state) {
     double carried = 0;
     for (int e = 0; e < 33; ++e) assert_true(isfinite(f[e])), carried += fabs(f[e]);
     assert_true(after[5] < 40.0 && carried > 0);
+    /* Edges by node pair, lower node first, in increasing order; the flux
+     * runs from the lower node's cell to the higher's: out of node 5 along
+     * each of its 6 edges. */
+    int pairs[66], around = 0;
+    assert_int_equal(m->get_grid_edge_nodes(m, 1, pairs), BMI_SUCCESS);
+    for (int e = 0; e < 33; ++e) {
+        assert_true(pairs[2 * e] < pairs[2 * e + 1]);
+        if (e) assert_true(pairs[2 * e - 2] < pairs[2 * e] || (pairs[2 * e - 2] == pairs[2 * e] && pairs[2 * e - 1] < pairs[2 * e + 1]));
+        if (pairs[2 * e] == 5) assert_true(f[e] > 0), ++around;
+        if (pairs[2 * e + 1] == 5) assert_true(f[e] < 0), ++around;
+    }
+    assert_int_equal(around, 6);
     stop(m);
 }
 

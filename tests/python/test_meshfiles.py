@@ -479,6 +479,16 @@ class TestBmiConventions(Folder):
             carried = flat_list(model.get_value(flux))
             self.assertLess(after[5], 40.0)
             self.assertGreater(sum(abs(v) for v in carried), 0.0)
+            # Edges by node pair, lower node first, in increasing order; the flux runs from the lower
+            # node's cell to the higher's: out of the raised node 5 along every edge of it.
+            pairs = flat_list(model.get_grid_edge_nodes(1, [0] * (2 * 33)))
+            pairs = list(zip(pairs[0::2], pairs[1::2]))
+            self.assertEqual(pairs, sorted(pairs))
+            self.assertTrue(all(a < b for a, b in pairs))
+            around = [(k, a == 5) for k, (a, b) in enumerate(pairs) if 5 in (a, b)]
+            self.assertEqual(len(around), 6)
+            for k, lower in around:
+                self.assertGreater(carried[k] if lower else -carried[k], 0.0, "edge %d %s" % (k, pairs[k]))
             # The names before 0.1's release still work, unlisted.
             self.assertEqual(model.get_var_units("sediment__angle_of_repose"), "degree")
             self.assertNotIn("sediment__angle_of_repose", model.get_output_var_names())

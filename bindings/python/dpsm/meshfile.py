@@ -125,8 +125,12 @@ class MeshFile:
         self.coordinates_said = ""
         ## The groups of edges (EdgeGroup), in the order of their numbers.
         self.groups = []
-        ## UGRID: the names of the node, face and edge dimensions.
-        self.node_dimension = self.face_dimension = self.edge_dimension = ""
+        ## UGRID: the name of the node dimension.
+        self.node_dimension = ""
+        ## UGRID: the name of the face dimension.
+        self.face_dimension = ""
+        ## UGRID: the name of the edge dimension.
+        self.edge_dimension = ""
         ## UGRID: the edges as the file lists them, node pairs from 0.
         self.file_edges = []
         ## UGRID: the start_index of its face_node_connectivity (0 or 1); 0 for the other formats.
@@ -606,18 +610,24 @@ class _Lines:
     """A text file's non-blank lines with their numbers, for messages."""
 
     def __init__(self, path):
+        """Reads the whole file; MeshFileError when it cannot be opened."""
+        ## The file, for messages.
         self.path = path
         try:
             with open(path, "r", encoding="latin-1") as f:
+                ## Every line of the file.
                 self.lines = f.read().splitlines()
         except OSError as e:
             raise MeshFileError("%s: cannot open: %s" % (path, e.strerror or e), C.DPSM_ERR_IO) from None
+        ## The number of the last line read (from 1), 0 before the first.
         self.at = 0
 
     def fail(self, problem):
+        """Raises MeshFileError naming the file and the line last read."""
         raise MeshFileError("%s:%d: %s" % (self.path, self.at, problem))
 
     def next(self):
+        """The next non-blank line, stripped, or None at the end."""
         while self.at < len(self.lines):
             line = self.lines[self.at].strip()
             self.at += 1
@@ -626,6 +636,7 @@ class _Lines:
         return None
 
     def integers(self, what, count=None):
+        """The integers of the next line (at least ``count``); ``what`` names them in the message."""
         line = self.next()
         try:
             values = [int(v) for v in (line or "").split()]
@@ -636,6 +647,7 @@ class _Lines:
         return values
 
     def end(self, name):
+        """Requires the next line to close section ``name`` ($End<name>)."""
         line = self.next()
         if line is None or not line.startswith("$End" + name):
             self.fail("expected $End%s" % name)
@@ -785,22 +797,28 @@ class _Selafin:
     length before and after), big- or little-endian, reals of 4 or 8 bytes."""
 
     def __init__(self, path):
+        """Reads the header records (title to Y); MeshFileError for what is not a 2D Selafin file."""
+        ## The file, for messages.
         self.path = path
         try:
             with open(path, "rb") as f:
+                ## The file's bytes.
                 self.data = f.read()
         except OSError as e:
             raise MeshFileError("%s: cannot open: %s" % (path, e.strerror or e), C.DPSM_ERR_IO) from None
         if len(self.data) < 88:
             self.fail("not a Selafin file: shorter than its title record")
+        ## The byte order of the records: ">" (TELEMAC's) or "<".
         self.order = ">" if struct.unpack(">i", self.data[:4])[0] == 80 else "<"
         if struct.unpack(self.order + "i", self.data[:4])[0] != 80:
             self.fail("not a Selafin file: its first record is not an 80-character title")
+        ## Where the next record begins.
         self.at = 0
         self.record("the title")
         counts = self.integers("the numbers of variables", 2)
         if counts[0] < 0 or counts[1] < 0 or counts[0] + counts[1] > 256:
             self.fail("its numbers of variables are not those of a Selafin file")
+        ## The names of the variables, as the file spells them (16 characters, stripped).
         self.names = []
         for k in range(counts[0] + counts[1]):
             raw = self.record("a variable's name")
@@ -809,30 +827,39 @@ class _Selafin:
         iparam = self.integers("IPARAM", 10)
         if iparam[6] > 1:
             self.fail("a 3D file (IPARAM(7) = %d planes): dpsm reads 2D Selafin files" % iparam[6])
+        ## IPARAM(3), IPARAM(4): the origin added to the coordinates.
         self.origin = (iparam[2], iparam[3])
         if iparam[9] == 1:
             self.record("the date")
+        ## NELEM, NPOIN and NDP: elements, points and nodes per element.
         self.elements, self.points, self.per_element, _ = self.integers("NELEM NPOIN NDP", 4)
         if self.elements < 1 or self.points < 1 or self.per_element not in (3, 4):
             self.fail("NELEM = %d, NPOIN = %d, NDP = %d: dpsm reads 2D meshes of triangles (NDP = 3) or quadrangles "
                       "(NDP = 4)" % (self.elements, self.points, self.per_element))
+        ## IKLE: the nodes of every element, from 1.
         self.ikle = self.integers("IKLE", self.elements * self.per_element)
         self.record("IPOBO")
         raw_x = self.record("X")
         if len(raw_x) not in (4 * self.points, 8 * self.points):
             self.fail("X does not hold NPOIN reals")
+        ## "f" (single precision) or "d" (double), told by the length of X's record.
         self.real = "f" if len(raw_x) == 4 * self.points else "d"
+        ## x of each point, without the origin.
         self.x = list(struct.unpack("%s%d%s" % (self.order, self.points, self.real), raw_x))
         raw_y = self.record("Y")
         if len(raw_y) != len(raw_x):
             self.fail("Y does not hold NPOIN reals as X does")
+        ## y of each point, without the origin.
         self.y = list(struct.unpack("%s%d%s" % (self.order, self.points, self.real), raw_y))
+        ## Where the first time frame begins.
         self.frame = self.at
 
     def fail(self, problem):
+        """Raises MeshFileError naming the file."""
         raise MeshFileError("%s: %s" % (self.path, problem))
 
     def record(self, what):
+        """The bytes of the next record, its length marks checked; ``what`` names it in messages."""
         if self.at + 4 > len(self.data):
             self.fail("the file ends before the record of %s (not a complete Selafin file)" % what)
         n = struct.unpack(self.order + "i", self.data[self.at:self.at + 4])[0]
@@ -845,12 +872,14 @@ class _Selafin:
         return raw
 
     def integers(self, what, count):
+        """The next record as ``count`` integers."""
         raw = self.record(what)
         if len(raw) != 4 * count:
             self.fail("the record of %s is not %d integers" % (what, count))
         return list(struct.unpack("%s%di" % (self.order, count), raw))
 
     def mesh(self):
+        """The MeshFile of the points and elements (the origin added, IKLE counted from 0)."""
         mesh = MeshFile(self.path, "Selafin")
         mesh.node_x = [v + self.origin[0] for v in self.x]
         mesh.node_y = [v + self.origin[1] for v in self.y]
@@ -863,6 +892,7 @@ class _Selafin:
         return mesh
 
     def variable(self, name):
+        """The values at the points of variable ``name`` (case and trailing blanks aside) in the first frame."""
         wanted = name.rstrip().upper()
         matches = [k for k, n in enumerate(self.names) if n.upper() == wanted]
         if not matches:
