@@ -7,7 +7,8 @@
 
 #include "model/flux_law.hpp"
 #include "model/ledger.hpp"
-#include "structured/tiled_sweep.hpp"
+#include "structured/lazy_sources.hpp"
+#include "structured/structured_state.hpp"
 
 namespace dpsm {
 
@@ -211,7 +212,7 @@ void apply_source_1d(Grid &grid, double substeps, double dt) {
 SubstepSummary slide_rates_1d(Grid &grid, double dt, bool record) {
     const Geometry &geo = grid.geometry();
     const std::int64_t nx = geo.nx;
-    std::vector<double> &rate = grid.rate_workspace();
+    std::vector<double> &rate = structured_state(grid).rates;
     std::fill(rate.begin(), rate.end(), 0.0);
     FaceSweep sweep(grid, rate, dt, record);
     // Along a line or a radius: weights are face length over cell area.
@@ -230,12 +231,9 @@ SubstepSummary slide_rates_1d(Grid &grid, double dt, bool record) {
 }
 
 void apply_rates(Grid &grid, double dt) {
-    const std::vector<double> &rate = grid.rate_workspace();
+    const std::vector<double> &rate = structured_state(grid).rates;
     std::vector<double> &h = grid.heights_for_stepping();
     std::vector<float> &residual = grid.residuals_for_stepping();
-    CellBox all;
-    all.add(0, grid.geometry().nx, 0, grid.geometry().ny);
-    grid.residuals_written(all);
     const std::vector<std::uint8_t> &kind = grid.kinds();
     const std::vector<double> &q = grid.source();
     const std::vector<double> &zb = grid.bed();

@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "model/grid.hpp"
-#include "stepping/engine.hpp"
+#include "model/engine.hpp"
 
 namespace dpsm {
 
