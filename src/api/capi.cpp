@@ -651,6 +651,19 @@ int dpsm_get_shape(const dpsm_grid *g, int64_t *nx, int64_t *ny) {
     });
 }
 
+int dpsm_get_grid_kind(const dpsm_grid *g, int *kind) {
+    const char *fn = "dpsm_get_grid_kind";
+    return guarded(g, fn, [&] {
+        require_grid(g, fn);
+        require_pointer(kind, fn, "kind");
+        const dpsm::Geometry &geo = g->core.geometry();
+        *kind = geo.is_mesh() ? DPSM_GRID_MESH
+                : geo.dim == 2 ? DPSM_GRID_2D
+                : geo.axisymmetric ? DPSM_GRID_AXISYMMETRIC
+                : DPSM_GRID_1D;
+    });
+}
+
 int dpsm_set_rest_tolerance(dpsm_grid *g, double tol) {
     const char *fn = "dpsm_set_rest_tolerance";
     return guarded(g, fn, [&] {

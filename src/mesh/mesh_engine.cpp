@@ -10,7 +10,7 @@
 #include "mesh/mesh_state.hpp"
 #include "model/distribution.hpp"
 #include "model/engine.hpp"
-#include "model/flux_law.hpp"
+#include "model/face_law.hpp"
 #include "model/grid.hpp"
 #include "model/ledger.hpp"
 
@@ -35,7 +35,7 @@ struct FaceLaw {
     const double *edge_level;       // per face; null: 0
     const double *tan_field;        // null: uniform
     const std::uint8_t *moving;     // hysteresis: null when off
-    const double *available;        // bed: null when none
+    const double *available;        // bed: the sand each cell may give, as a volume; null when none
     double nu, tan_theta, tolerance, tan_static, p, dt;
     bool isotropic;
 
@@ -58,14 +58,11 @@ struct FaceLaw {
             if (isotropic) tangential = gx[a] * m.tangent_x[f] + gy[a] * m.tangent_y[f];
         }
         const double normal = (h[a] - hb) / m.distance[f];
-        double tan_face = tan_theta;
-        if (tan_field) {
-            const double ta = ka == kSand ? tan_field[a] : tan_field[b];
-            const double tb = kb == kSand ? tan_field[b] : ta;
-            tan_face = 0.5 * (ta + tb);
-        }
+        const double tan_face =
+            tan_field ? law::face_tan(tan_field[a], b >= 0 ? tan_field[b] : tan_field[a], ka == kSand, kb == kSand)
+                      : tan_theta;
         double threshold = tan_face * (1.0 + tolerance);
-        if (moving && !moving[a] && !(b >= 0 && moving[b])) threshold = std::max(threshold, tan_static);
+        if (moving) threshold = law::threshold(threshold, !moving[a] && !(b >= 0 && moving[b]), tan_static);
         const double s = std::sqrt(normal * normal + tangential * tangential);
         if (!(s > threshold)) return 0.0;
         const double abs_normal = std::fabs(normal);
@@ -91,11 +88,12 @@ struct FaceLaw {
         double flux = slide_flux(nu, tan_face, s, p) / s * factor * normal;
         if (available) {
             // A face takes from its sand cell at most its share of the sand there.
-            const std::int64_t up = flux > 0.0 ? a : b;
-            if (up >= 0 && kind[up] == kSand) {
-                const double cap = available[up] * m.area[up] / (m.face_count[up] * dt);
-                flux = flux > 0.0 ? std::min(flux, cap) : std::max(flux, -cap);
-            }
+            const double unlimited = std::numeric_limits<double>::infinity();
+            const auto share = [&](std::int64_t c) {
+                return c >= 0 && kind[c] == kSand ? law::share_of_sand(available[c], m.face_count[c], dt, 1.0)
+                                                  : unlimited;
+            };
+            flux = law::capped(flux, share(a), -share(b));
         }
         return flux;
     }
@@ -531,7 +529,7 @@ private:
                 sand += applied;
             }
             if (c < m.owned) sourced.add(applied * m.area[c]);  // a ghost's owner books it
-            s.available[c] = sand > film ? sand : 0.0;
+            s.available[c] = sand > film ? sand * m.area[c] : 0.0;
         }
         did.unmet_mass = unmet.value();
         did.sourced_mass = sourced.value();

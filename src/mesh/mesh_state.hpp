@@ -69,7 +69,7 @@ struct MeshState final : EngineState {
     std::uint32_t stamp = 0;
     std::vector<std::int64_t> faces, gradient_cells, update_cells;
     std::vector<std::int64_t> changed_ghosts;  // a part's ghosts whose owners sent new values
-    std::vector<double> available;         // bed: the sand a face may take
+    std::vector<double> available;         // bed: the sand (a volume) a cell's faces may take
     std::vector<std::uint8_t> carried;     // dense: per cell, a face of it carried sand
     bool flux_clean = true;
     // A part that takes several sub-steps per exchange: the owned cells

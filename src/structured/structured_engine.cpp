@@ -5,7 +5,7 @@
 #include <vector>
 
 #include "model/distribution.hpp"
-#include "model/flux_law.hpp"
+#include "model/face_law.hpp"
 #include "model/grid.hpp"
 #include "structured/halo.hpp"
 #include "structured/lazy_sources.hpp"

@@ -1,7 +1,7 @@
 // The 2D sweep on one tile: a private copy of the tile and a halo of `levels`
 // cells (plus one ring of ghosts) is advanced `levels` sub-steps in cache,
 // shrinking by one cell a level, and only the tile itself is kept. Faces are
-// computed once per level; the flux law is the dead-zone form of model/flux_law.hpp
+// computed once per level; the flux law is the dead-zone form of model/face_law.hpp
 // (no flux up to the rest threshold tan(theta) (1 + tol)), so a tile whose
 // faces are all below it is exactly at rest and may be skipped.
 //
