@@ -21,7 +21,7 @@
  * time over their class's sub-step, summed over the calls (a lower bound:
  * the class interfaces' bookkeeping is left out). A cell's own bound is its
  * area over the sum of its faces' length over centre distance (the
- * two-point part of what the engine uses, mesh/mesh.cpp); the mesh's
+ * two-point part of what the engine uses, model/mesh.cpp); the mesh's
  * smallest such bound is printed against dpsm_stable_dt to show how close
  * that is. The counts are machine-independent; seconds are the library's
  * (1 thread), beside those of the uniform mesh in the same run. */

@@ -24,6 +24,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include <cmocka.h>
 
@@ -2188,6 +2189,41 @@ static void test_side_outflow_reader(void **state) {
 
 /* Levels set and then returned to 0 with NULL leave the grid as one that
  * never had them, on every side of every kind of grid. */
+/* dpsm_get_grid_kind names the constructor of every kind of grid, and a
+ * loaded grid's is the saved one's. */
+static void test_grid_kind(void **state) {
+    (void)state;
+    const double xy[8] = {0.0, 0.0, 1.0, 0.0, 1.0, 1.0, 0.0, 1.0};
+    const int64_t start[3] = {0, 3, 6}, nodes[6] = {0, 1, 2, 0, 2, 3};
+    dpsm_grid *made[4] = {NULL, NULL, NULL, NULL};
+    const int want[4] = {DPSM_GRID_1D, DPSM_GRID_AXISYMMETRIC, DPSM_GRID_2D, DPSM_GRID_MESH};
+    CHECK_OK(NULL, dpsm_create_1d(6, 0.5, &made[0]));
+    CHECK_OK(NULL, dpsm_create_axisymmetric(6, 0.5, &made[1]));
+    CHECK_OK(NULL, dpsm_create_2d(6, 1, 0.5, 0.5, &made[2])); /* one row: a shape alone cannot tell it from a line */
+    CHECK_OK(NULL, dpsm_create_mesh(4, xy, 2, start, nodes, &made[3]));
+    char path[512];
+    const char *tmp = getenv("TMPDIR");
+    snprintf(path, sizeof path, "%s/dpsm_test_api_grid_kind_%ld.dpsm", tmp && *tmp ? tmp : "/tmp", (long)getpid());
+    for (int k = 0; k < 4; ++k) {
+        int kind = -1;
+        CHECK_OK(made[k], dpsm_get_grid_kind(made[k], &kind));
+        REQUIRE(kind == want[k], "grid %d: dpsm_get_grid_kind says %d, not %d", k, kind, want[k]);
+        dpsm_grid *loaded = NULL;
+        CHECK_OK(made[k], dpsm_save(made[k], path));
+        CHECK_OK(NULL, dpsm_load(path, &loaded));
+        kind = -1;
+        CHECK_OK(loaded, dpsm_get_grid_kind(loaded, &kind));
+        REQUIRE(kind == want[k], "grid %d loaded: dpsm_get_grid_kind says %d, not %d", k, kind, want[k]);
+        /* A NULL kind is refused, names the argument and leaves the grid as it was. */
+        REQUIRE(dpsm_get_grid_kind(loaded, NULL) == DPSM_ERR_NULL_POINTER, "a NULL kind is not refused");
+        REQUIRE(strstr(dpsm_last_error(loaded), "dpsm_get_grid_kind") && strstr(dpsm_last_error(loaded), "kind is NULL"),
+                "message \"%s\"", dpsm_last_error(loaded));
+        dpsm_destroy(loaded);
+        dpsm_destroy(made[k]);
+    }
+    remove(path);
+}
+
 static void test_side_levels_null_returns_to_zero(void **state) {
     (void)state;
     const double levels[8] = {0.4, 0.5, 0.6, 0.7, 0.8, 0.9, 1.0, 1.1};
@@ -2256,6 +2292,9 @@ static void test_null_grid_every_function(void **state) {
     EXPECT_NULL_GRID(dpsm_get_step_info(NULL, 77, NULL), "dpsm_get_step_info");
     EXPECT_NULL_GRID(dpsm_get_shape(NULL, &nx, &ny), "dpsm_get_shape");
     EXPECT_NULL_GRID(dpsm_get_shape(NULL, NULL, NULL), "dpsm_get_shape");
+    int kind = 0;
+    EXPECT_NULL_GRID(dpsm_get_grid_kind(NULL, &kind), "dpsm_get_grid_kind");
+    EXPECT_NULL_GRID(dpsm_get_grid_kind(NULL, NULL), "dpsm_get_grid_kind");
     EXPECT_NULL_GRID(dpsm_set_rest_tolerance(NULL, 1e-3), "dpsm_set_rest_tolerance");
     EXPECT_NULL_GRID(dpsm_set_max_substeps(NULL, 10), "dpsm_set_max_substeps");
     EXPECT_NULL_GRID(dpsm_set_max_substeps(NULL, 0), "dpsm_set_max_substeps");
@@ -2563,6 +2602,15 @@ static void test_bad_get_shape(void **state) {
     REQUIRE(nx == fx->nx && ny == fx->ny, "shape %lldx%lld", (long long)nx, (long long)ny);
 }
 
+static void test_bad_get_grid_kind(void **state) {
+    fixture_t *fx = *state;
+    EXPECT_FAIL(fx, dpsm_get_grid_kind(fx->g, NULL), DPSM_ERR_NULL_POINTER, "dpsm_get_grid_kind", "kind");
+    int kind = -1;
+    CHECK_OK(fx->g, dpsm_get_grid_kind(fx->g, &kind));
+    const int want = fx->dim == 2 ? DPSM_GRID_2D : fx->axi ? DPSM_GRID_AXISYMMETRIC : DPSM_GRID_1D;
+    REQUIRE(kind == want, "the fixture's kind is %d, not %d", kind, want);
+}
+
 static void test_bad_rest_tolerance(void **state) {
     fixture_t *fx = *state;
     const double bad[] = {0.0, -0.0, -1e-6, -DBL_MIN, NAN, INFINITY, -INFINITY};
@@ -2771,6 +2819,7 @@ int main(int argc, char **argv) {
         cmocka_unit_test(test_face_fluxes_after_relaxation_to_rest),
         cmocka_unit_test(test_side_outflow_reader),
         cmocka_unit_test(test_side_levels_null_returns_to_zero),
+        cmocka_unit_test(test_grid_kind),
     };
 #define BAD_INPUT_TESTS                                                                                       \
     cmocka_unit_test(test_null_grid_every_function), cmocka_unit_test(test_bad_repose_angle),                 \
@@ -2781,6 +2830,7 @@ int main(int argc, char **argv) {
         cmocka_unit_test(test_bad_get_heights), cmocka_unit_test(test_bad_source),                            \
         cmocka_unit_test(test_bad_stable_dt), cmocka_unit_test(test_bad_step), cmocka_unit_test(test_bad_get_mass), \
         cmocka_unit_test(test_bad_get_step_info), cmocka_unit_test(test_bad_get_shape),                       \
+        cmocka_unit_test(test_bad_get_grid_kind),                                                             \
         cmocka_unit_test(test_bad_rest_tolerance), cmocka_unit_test(test_bad_max_substeps),                   \
         cmocka_unit_test(test_bad_threads), cmocka_unit_test(test_bad_index_base),                            \
         cmocka_unit_test(test_bad_bedrock),                                                                   \

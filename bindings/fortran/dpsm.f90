@@ -82,6 +82,15 @@ module dpsm
   integer(c_int), parameter, public :: DPSM_YMAX = 3
   !> Sides of the domain: DPSM_MESH_EDGE, as in dpsm.h.
   integer(c_int), parameter, public :: DPSM_MESH_EDGE = 4
+  ! Grid kinds (dpsm_get_grid_kind).
+  !> Grid kinds (dpsm_get_grid_kind): DPSM_GRID_1D, as in dpsm.h.
+  integer(c_int), parameter, public :: DPSM_GRID_1D = 1
+  !> Grid kinds (dpsm_get_grid_kind): DPSM_GRID_AXISYMMETRIC, as in dpsm.h.
+  integer(c_int), parameter, public :: DPSM_GRID_AXISYMMETRIC = 2
+  !> Grid kinds (dpsm_get_grid_kind): DPSM_GRID_2D, as in dpsm.h.
+  integer(c_int), parameter, public :: DPSM_GRID_2D = 3
+  !> Grid kinds (dpsm_get_grid_kind): DPSM_GRID_MESH, as in dpsm.h.
+  integer(c_int), parameter, public :: DPSM_GRID_MESH = 4
   ! Boundary kinds.
   !> Boundary kinds: DPSM_OPEN, as in dpsm.h.
   integer(c_int), parameter, public :: DPSM_OPEN = 0
@@ -188,7 +197,8 @@ module dpsm
   public :: dpsm_set_cell_kinds, dpsm_set_heights, dpsm_get_heights
   public :: dpsm_set_heights_region, dpsm_add_heights_region, dpsm_get_heights_region
   public :: dpsm_set_source, dpsm_stable_dt, dpsm_step, dpsm_get_mass, dpsm_get_step_info
-  public :: dpsm_get_shape, dpsm_set_rest_tolerance, dpsm_set_max_substeps, dpsm_set_threads, dpsm_get_threads
+  public :: dpsm_get_shape, dpsm_get_grid_kind, dpsm_set_rest_tolerance, dpsm_set_max_substeps, dpsm_set_threads
+  public :: dpsm_get_threads
   public :: dpsm_set_index_base
   public :: dpsm_set_bedrock, dpsm_set_repose_angle_field, dpsm_set_flux_exponent, dpsm_set_static_angle
   public :: dpsm_set_side_levels, dpsm_get_side_outflow, dpsm_set_face_flux_recording, dpsm_get_face_fluxes
@@ -552,6 +562,12 @@ module dpsm
       type(c_ptr), value :: g
       integer(c_int), intent(out) :: n
     end function c_dpsm_get_threads
+
+    integer(c_int) function c_dpsm_get_grid_kind(g, kind) bind(C, name='dpsm_get_grid_kind')
+      import :: c_int, c_ptr
+      type(c_ptr), value :: g
+      integer(c_int), intent(out) :: kind
+    end function c_dpsm_get_grid_kind
 
     integer(c_int) function c_dpsm_set_index_base(g, base) bind(C, name='dpsm_set_index_base')
       import :: c_int, c_ptr
@@ -1621,6 +1637,17 @@ contains
     call clear_message(g)
     call finish(c_dpsm_get_threads(g%ptr, n), ierr, 'dpsm_get_threads', g)
   end subroutine dpsm_get_threads
+
+  !> dpsm_get_grid_kind(g, kind[, ierr]): DPSM_GRID_1D, DPSM_GRID_AXISYMMETRIC,
+  !> DPSM_GRID_2D or DPSM_GRID_MESH, the constructor that made g (through
+  !> dpsm_load, the one that made the grid saved).
+  subroutine dpsm_get_grid_kind(g, kind, ierr)
+    type(dpsm_grid), intent(in) :: g
+    integer(c_int), intent(out) :: kind
+    integer, intent(out), optional :: ierr
+    call clear_message(g)
+    call finish(c_dpsm_get_grid_kind(g%ptr, kind), ierr, 'dpsm_get_grid_kind', g)
+  end subroutine dpsm_get_grid_kind
 
   ! ==== cell kinds ===========================================================
 

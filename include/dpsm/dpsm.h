@@ -93,6 +93,17 @@ typedef struct dpsm_grid dpsm_grid;
 #define DPSM_MESH_EDGE 4
 /** @} */
 
+/** @name Grid kinds
+ *  What dpsm_get_grid_kind() says a grid is: the constructor that made it
+ *  (through dpsm_load(), the one that made the grid saved). None is 0. @{ */
+#define DPSM_GRID_1D 1           /**< dpsm_create_1d(): a line of nx cells. */
+#define DPSM_GRID_AXISYMMETRIC 2 /**< dpsm_create_axisymmetric(): nr rings about an axis. */
+#define DPSM_GRID_2D 3           /**< dpsm_create_2d(): nx by ny cells. */
+/** dpsm_create_mesh(), dpsm_create_graph(), dpsm_create_dual_mesh() (and
+ *  their _indexed forms): an unstructured mesh of ncells cells. */
+#define DPSM_GRID_MESH 4
+/** @} */
+
 /** @name Boundary kinds
  *  For dpsm_set_boundary(). @{ */
 /** Sand that reaches the side leaves the domain and is counted as outflow.
@@ -981,6 +992,22 @@ DPSM_API int dpsm_get_face_fluxes(const dpsm_grid *g, double *fx, double *fy);
  * @return ::DPSM_OK or ::DPSM_ERR_NULL_POINTER.
  */
 DPSM_API int dpsm_get_shape(const dpsm_grid *g, int64_t *nx, int64_t *ny);
+
+/**
+ * @brief Says what kind of grid this is: which constructor made it.
+ *
+ * A host (or a binding) that holds a grid it did not make, one dpsm_load()
+ * or dpsm_load_mpi() returned, learns here how to read its shape: nx cells
+ * on a line, nr rings, nx by ny cells, or ncells cells of a mesh (with
+ * dpsm_get_face_count() faces). On a rank's part of a distributed grid the
+ * kind of the whole.
+ *
+ * @param g     the grid.
+ * @param kind  receives ::DPSM_GRID_1D, ::DPSM_GRID_AXISYMMETRIC,
+ *              ::DPSM_GRID_2D or ::DPSM_GRID_MESH.
+ * @return ::DPSM_OK or ::DPSM_ERR_NULL_POINTER.
+ */
+DPSM_API int dpsm_get_grid_kind(const dpsm_grid *g, int *kind);
 
 /**
  * @brief Sets how close to the angle of repose counts as rest.

@@ -12,14 +12,16 @@
 #include <utility>
 #include <vector>
 
-#include "mpi/decomposition.hpp"
-#include "dpsm/dpsm.h"
-#include "model/error.hpp"
-#include "model/limits.hpp"
-#include "model/grid.hpp"
-#include "io/restart.hpp"
-#include "mesh/mesh.hpp"
+#include "api/guarded.hpp"
 #include "api/handle.hpp"
+#include "dpsm/dpsm.h"
+#include "io/distributed_save.hpp"
+#include "io/restart.hpp"
+#include "model/distribution.hpp"
+#include "model/error.hpp"
+#include "model/grid.hpp"
+#include "model/limits.hpp"
+#include "model/mesh.hpp"
 #include "stepping/stepper.hpp"
 
 namespace {
@@ -29,42 +31,9 @@ using dpsm::fail;
 using dpsm::kMaxCells;
 using dpsm::kMaxMagnitude;
 
+using dpsm::guarded;
+
 thread_local std::string error_without_grid;
-
-void record_error(const dpsm_grid *g, const char *message) noexcept {
-    try {
-        if (g)
-            g->last_error = message;
-        else
-            error_without_grid = message;
-    } catch (...) {
-        // Out of memory for the message itself: keep the old one.
-    }
-}
-
-template <class Body>
-int guarded(const dpsm_grid *g, const char *function, Body &&body) noexcept {
-    try {
-        body();
-        if (g)
-            g->last_error.clear();
-        else
-            error_without_grid.clear();
-        return DPSM_OK;
-    } catch (const Error &e) {
-        record_error(g, e.what());
-        return e.status();
-    } catch (const std::bad_alloc &) {
-        record_error(g, (std::string(function) + ": out of memory").c_str());
-        return DPSM_ERR_OUT_OF_MEMORY;
-    } catch (const std::exception &e) {
-        record_error(g, e.what());
-        return DPSM_ERR_INTERNAL;
-    } catch (...) {
-        record_error(g, "dpsm: internal error of unknown kind");
-        return DPSM_ERR_INTERNAL;
-    }
-}
 
 void require_grid(const dpsm_grid *g, const char *function) {
     if (!g) fail(DPSM_ERR_NULL_POINTER, function, "the grid is NULL");
@@ -151,7 +120,7 @@ void require_finite_array(const dpsm_grid *g, const double *values, const char *
 }
 
 // On a mesh the library keeps its cells in an order of its own
-// (mesh/mesh.hpp): a host's array goes through `buffer` into it, and comes
+// (model/mesh.hpp): a host's array goes through `buffer` into it, and comes
 // back out in the host's order. On a grid the orders agree.
 template <class T>
 const T *in_library_order(const dpsm_grid *g, const T *host, std::vector<T> &buffer) {
@@ -247,55 +216,13 @@ void require_above_bed(const dpsm_grid *g, const dpsm::Grid::Block &b, const dou
     }
 }
 
-// dpsm_save on a distributed grid: every rank writes its own block to its own
-// path, all with the same mark, and every rank fails when any rank did. A rank
-// whose own path is refused still takes part, so that no rank waits for it.
-void save_block(const dpsm::Grid &grid, const dpsm::Decomposition &d, const char *path, const char *fn) {
-    dpsm::RestartBlock block;
-    block.present = true;
-    block.save_mark = d.shared_mark();
-    block.global_nx = d.halo().global_nx;
-    block.global_ny = d.halo().global_ny;
-    block.i0 = d.halo().i0;
-    block.j0 = d.halo().j0;
-    block.rank = d.rank();
-    block.ranks = d.ranks();
-    int status = DPSM_OK;
-    std::string reason;
-    // This rank's part, its failure kept for after the ranks have agreed.
-    const auto attempt = [&](auto &&body) {
-        try {
-            body();
-        } catch (const Error &e) {
-            status = e.status();
-            reason = e.what();
-        } catch (const std::bad_alloc &) {
-            status = DPSM_ERR_OUT_OF_MEMORY;
-            reason = std::string(fn) + ": out of memory";
-        }
-    };
-    attempt([&] {
-        require_pointer(path, fn, "path");
-        dpsm::save_restart(grid, path, fn, block);
-    });
-    int failed_rank = -1, failed_status = DPSM_OK;
-    d.first_failure(status, failed_rank, failed_status);
-    // Once every rank has written, each file must still hold its own block:
-    // ranks given the same path on a shared file system write over each other.
-    if (failed_rank < 0) {
-        attempt([&] {
-            const dpsm::RestartBlock back = dpsm::written_block(path, fn);
-            if (!back.present || back.rank != block.rank || back.save_mark != block.save_mark)
-                fail(DPSM_ERR_IO, fn, path, " no longer holds this rank's block once every rank has saved: another "
-                     "rank saved to the same file; give each rank its own path");
-        });
-        d.first_failure(status, failed_rank, failed_status);
-    }
-    if (status != DPSM_OK) throw Error(status, reason);
-    if (failed_rank >= 0)
-        fail(failed_status, fn, "rank ", failed_rank, " of the distributed grid could not save its block (",
-             dpsm_status_string(failed_status), "; its dpsm_last_error says why), so this save is not a complete set "
-             "of files; this rank's block went to ", path);
+// A figure of a distributed grid is global: every rank takes part in the
+// sum, one that refused its arguments too, so that none waits for ever. On
+// a serial grid, the grid's own. False on every rank when any refused.
+bool global_figure(const dpsm_grid *g, double local, bool refused, double &total) {
+    total = local;
+    const dpsm::Distribution *distribution = g->core.distribution();
+    return !distribution || distribution->sum_unless_refused(local, refused, total);
 }
 
 const char *side_name(int side) {
@@ -346,7 +273,7 @@ int create(int dim, bool axisymmetric, std::int64_t nx, std::int64_t ny, double 
     });
 }
 
-// A mesh from a builder of mesh/mesh.hpp, the host's arrays counting from
+// A mesh from a builder of model/mesh.hpp, the host's arrays counting from
 // start_index.
 template <class Build>
 int create_mesh(dpsm_grid **out, int start_index, const char *function, Build &&build) {
@@ -364,7 +291,16 @@ int create_mesh(dpsm_grid **out, int start_index, const char *function, Build &&
 
 }  // namespace
 
-void dpsm::set_error_without_grid(const char *message) noexcept { record_error(nullptr, message); }
+void dpsm::record_error(const dpsm_grid *g, const char *message) noexcept {
+    try {
+        if (g)
+            g->last_error = message;
+        else
+            error_without_grid = message;
+    } catch (...) {
+        // Out of memory for the message itself: keep the old one.
+    }
+}
 
 extern "C" {
 
@@ -705,18 +641,7 @@ int dpsm_step(dpsm_grid *g, double dt) {
     const char *fn = "dpsm_step";
     return guarded(g, fn, [&] {
         require_grid(g, fn);
-        dpsm::Decomposition *decomposition = g->core.decomposition();
-        if (decomposition && !(std::isfinite(dt) && dt > 0.0)) {
-            // The other ranks wait in the step's first agreement: take part,
-            // refusing, so that they fail too instead of waiting for ever.
-            try {
-                decomposition->agree_before_step(g->core, 0.0, true);
-            } catch (const dpsm::Error &) {
-                // every rank throws; this one reports its own reason below
-            }
-        }
-        require_positive(dt, fn, "dt");
-        dpsm::step(g->core, dt);
+        dpsm::step(g->core, dt);  // checks dt, on every rank of a distributed grid
     });
 }
 
@@ -735,13 +660,8 @@ int dpsm_get_mass(const dpsm_grid *g, int quantity, double *value) {
             case DPSM_MASS_UNMET: local = ledger.unmet.value(); break;
             default: known = false;
         }
-        const bool refused = !value || !known;
-        double total = local;
-        // A distributed grid's figure is global. Every rank takes part in the
-        // sum, a refusing one too, so that none waits for ever.
-        bool all_agreed = true;
-        if (dpsm::Decomposition *decomposition = g->core.decomposition())
-            all_agreed = decomposition->sum_unless_refused(local, refused, total);
+        double total = 0.0;
+        const bool all_agreed = global_figure(g, local, !value || !known, total);
         require_pointer(value, fn, "value");
         if (!known)
             fail(DPSM_ERR_UNKNOWN_ENUM, fn, "quantity = ", quantity,
@@ -768,7 +688,7 @@ int dpsm_get_step_info(const dpsm_grid *g, int item, double *value) {
             case DPSM_INFO_MAX_EXCESS_SLOPE: *value = info.max_excess_slope; break;
             case DPSM_INFO_CELL_UPDATES: *value = info.cell_updates; break;
             case DPSM_INFO_RANK_CELL_UPDATES:
-                *value = g->core.decomposition() ? info.rank_cell_updates : info.cell_updates;
+                *value = g->core.distribution() ? info.rank_cell_updates : info.cell_updates;
                 break;
             case DPSM_INFO_MESSAGES_SENT: *value = info.messages_sent; break;
             case DPSM_INFO_BYTES_SENT: *value = info.bytes_sent; break;
@@ -790,6 +710,19 @@ int dpsm_get_shape(const dpsm_grid *g, int64_t *nx, int64_t *ny) {
         require_pointer(ny, fn, "ny");
         *nx = g->core.geometry().nx;
         *ny = g->core.geometry().ny;
+    });
+}
+
+int dpsm_get_grid_kind(const dpsm_grid *g, int *kind) {
+    const char *fn = "dpsm_get_grid_kind";
+    return guarded(g, fn, [&] {
+        require_grid(g, fn);
+        require_pointer(kind, fn, "kind");
+        const dpsm::Geometry &geo = g->core.geometry();
+        *kind = geo.is_mesh() ? DPSM_GRID_MESH
+                : geo.dim == 2 ? DPSM_GRID_2D
+                : geo.axisymmetric ? DPSM_GRID_AXISYMMETRIC
+                : DPSM_GRID_1D;
     });
 }
 
@@ -934,12 +867,8 @@ int dpsm_get_side_outflow(const dpsm_grid *g, int side, double *value) {
         const bool mesh_edge = side == DPSM_MESH_EDGE && mesh_of(g);
         const double local =
             mesh_edge ? g->core.ledger().side_outflow[0].value() : known ? g->core.ledger().side_outflow[side].value() : 0.0;
-        double total = local;
-        // A distributed grid's figure is global; every rank takes part in the
-        // sum, a refusing one too, so that none waits for ever.
-        bool all_agreed = true;
-        if (dpsm::Decomposition *decomposition = g->core.decomposition())
-            all_agreed = decomposition->sum_unless_refused(local, !value || !(known || mesh_edge), total);
+        double total = 0.0;
+        const bool all_agreed = global_figure(g, local, !value || !(known || mesh_edge), total);
         require_pointer(value, fn, "value");
         require_side(g, side, fn);
         if (!all_agreed)
@@ -983,7 +912,7 @@ int dpsm_get_face_fluxes(const dpsm_grid *g, double *fx, double *fy) {
             for (std::int64_t f = 0; f < mesh->faces; ++f) fx[mesh->host_face[f]] = mesh->host_sign[f] * library[f];
             return;
         }
-        g->core.read_face_fluxes(fx, fy);
+        dpsm::read_face_fluxes(g->core, fx, fy);
     });
 }
 
@@ -991,8 +920,8 @@ int dpsm_save(const dpsm_grid *g, const char *path) {
     const char *fn = "dpsm_save";
     return guarded(g, fn, [&] {
         require_grid(g, fn);
-        if (const dpsm::Decomposition *decomposition = g->core.decomposition()) {
-            save_block(g->core, *decomposition, path, fn);
+        if (const dpsm::Distribution *distribution = g->core.distribution()) {
+            dpsm::save_distributed(g->core, *distribution, path, fn);
             return;
         }
         require_pointer(path, fn, "path");

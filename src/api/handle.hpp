@@ -1,19 +1,18 @@
 // The handle behind the C API's dpsm_grid, shared by the C boundary
-// (api/capi.cpp) and the optional MPI component's constructor (src/mpi/).
+// (api/capi.cpp) and the optional MPI component's constructors (src/mpi/).
 #pragma once
 
 #include <string>
 
 #include "model/grid.hpp"
+#include "stepping/engine_for.hpp"
 
 struct dpsm_grid {
-    explicit dpsm_grid(const dpsm::Geometry &geometry) : core(geometry) {}
+    // The engine's state is the grid's from the start, so that it hears of
+    // every change a host makes.
+    explicit dpsm_grid(const dpsm::Geometry &geometry) : core(geometry) {
+        core.set_engine_state(dpsm::engine_for(core).make_state(core));
+    }
     dpsm::Grid core;
     mutable std::string last_error;
 };
-
-namespace dpsm {
-// Sets (or, with "", clears) the message dpsm_last_error(NULL) returns on
-// this thread: for constructors that fail before there is a handle.
-void set_error_without_grid(const char *message) noexcept;
-}  // namespace dpsm

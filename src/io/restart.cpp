@@ -25,6 +25,7 @@
 #include "dpsm/dpsm.h"
 #include "model/error.hpp"
 #include "model/limits.hpp"
+#include "model/mesh_part.hpp"
 
 namespace dpsm {
 

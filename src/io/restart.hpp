@@ -33,7 +33,7 @@ struct RestartBlock {
     std::int64_t global_nx = 0, global_ny = 0, i0 = 0, j0 = 0;
     std::int32_t rank = 0, ranks = 0;
     // A part of a distributed mesh, as load_restart rebuilt it from the file,
-    // not finished (mesh/mesh.hpp, finish_part): the MPI component finishes
+    // not finished (model/mesh_part.hpp, finish_part): the MPI component finishes
     // it with the other ranks. Null otherwise.
     std::shared_ptr<Mesh> part;
 };

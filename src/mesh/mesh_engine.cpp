@@ -2,17 +2,17 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
-#include <cstdlib>
 #include <limits>
 #include <vector>
 
-#include "model/flux_law.hpp"
+#include "mesh/ghost_exchange.hpp"
+#include "mesh/mesh_parts.hpp"
+#include "mesh/mesh_state.hpp"
+#include "model/distribution.hpp"
+#include "model/engine.hpp"
+#include "model/face_law.hpp"
 #include "model/grid.hpp"
 #include "model/ledger.hpp"
-#include "model/threads.hpp"
-#include "mpi/decomposition.hpp"
-#include "stepping/engine.hpp"
 
 namespace dpsm {
 
@@ -23,43 +23,6 @@ constexpr std::int64_t kCellsForThreads = 32768;
 // A sub-step over more hot cells than this share of the mesh runs the plain
 // passes over every cell: the lists would cost more than they save.
 constexpr double kDenseShare = 0.125;
-
-// DPSM_VISIT_ALL_CELLS=1 turns the active set off (every sub-step visits
-// every cell), for tests that show it changes no result; read at every
-// sub-step so that a test can compare the two within one process.
-bool visit_all_cells() {
-    const char *all = std::getenv("DPSM_VISIT_ALL_CELLS");
-    return all && *all && *all != '0';
-}
-
-// The scratch of the passes, kept between sub-steps and steps.
-struct MeshScratch final : EngineState {
-    std::vector<double> gx, gy;   // least-squares gradients
-    std::vector<double> flux;     // per face, volume per unit time from a to b; 0 outside a sub-step's faces
-    std::vector<std::uint32_t> face_seen, cell_seen;
-    std::uint32_t stamp = 0;
-    std::vector<std::int64_t> faces, gradient_cells, update_cells, source_cells;
-    std::vector<std::int64_t> sink_faces;  // faces onto open edges or open cells
-    std::vector<std::int64_t> changed_ghosts;  // a part's ghosts whose owners sent new values
-    std::vector<std::int64_t> ghost_source_cells;  // a part's ghosts with a source, stepped where they are in reach
-    // A part that takes several sub-steps per exchange: the owned cells
-    // updated since the last exchange (all of them when batch_all).
-    std::vector<std::int64_t> batch_cells;
-    std::vector<std::uint8_t> in_batch;
-    bool batch_all = false;
-    std::vector<double> available;         // bed: the sand a face may take
-    std::vector<std::uint8_t> changed;     // dense: per cell, a face of it carried sand
-    bool flux_clean = true;
-    // The masks and edges sink_faces and source_cells were found for.
-    std::uint64_t masks_seen = 0, edges_seen = 0;
-    bool lists_current = false;
-};
-
-MeshScratch &scratch_of(Grid &grid) {
-    std::unique_ptr<EngineState> &state = grid.engine_state();
-    if (!state) state = std::make_unique<MeshScratch>();
-    return static_cast<MeshScratch &>(*state);
-}
 
 // One sub-step's view of the grid: what every pass reads.
 struct FaceLaw {
@@ -72,7 +35,7 @@ struct FaceLaw {
     const double *edge_level;       // per face; null: 0
     const double *tan_field;        // null: uniform
     const std::uint8_t *moving;     // hysteresis: null when off
-    const double *available;        // bed: null when none
+    const double *available;        // bed: the sand each cell may give, as a volume; null when none
     double nu, tan_theta, tolerance, tan_static, p, dt;
     bool isotropic;
 
@@ -95,14 +58,11 @@ struct FaceLaw {
             if (isotropic) tangential = gx[a] * m.tangent_x[f] + gy[a] * m.tangent_y[f];
         }
         const double normal = (h[a] - hb) / m.distance[f];
-        double tan_face = tan_theta;
-        if (tan_field) {
-            const double ta = ka == kSand ? tan_field[a] : tan_field[b];
-            const double tb = kb == kSand ? tan_field[b] : ta;
-            tan_face = 0.5 * (ta + tb);
-        }
+        const double tan_face =
+            tan_field ? law::face_tan(tan_field[a], b >= 0 ? tan_field[b] : tan_field[a], ka == kSand, kb == kSand)
+                      : tan_theta;
         double threshold = tan_face * (1.0 + tolerance);
-        if (moving && !moving[a] && !(b >= 0 && moving[b])) threshold = std::max(threshold, tan_static);
+        if (moving) threshold = law::threshold(threshold, !moving[a] && !(b >= 0 && moving[b]), tan_static);
         const double s = std::sqrt(normal * normal + tangential * tangential);
         if (!(s > threshold)) return 0.0;
         const double abs_normal = std::fabs(normal);
@@ -128,11 +88,12 @@ struct FaceLaw {
         double flux = slide_flux(nu, tan_face, s, p) / s * factor * normal;
         if (available) {
             // A face takes from its sand cell at most its share of the sand there.
-            const std::int64_t up = flux > 0.0 ? a : b;
-            if (up >= 0 && kind[up] == kSand) {
-                const double cap = available[up] * m.area[up] / (m.face_count[up] * dt);
-                flux = flux > 0.0 ? std::min(flux, cap) : std::max(flux, -cap);
-            }
+            const double unlimited = std::numeric_limits<double>::infinity();
+            const auto share = [&](std::int64_t c) {
+                return c >= 0 && kind[c] == kSand ? law::share_of_sand(available[c], m.face_count[c], dt, 1.0)
+                                                  : unlimited;
+            };
+            flux = law::capped(flux, share(a), -share(b));
         }
         return flux;
     }
@@ -170,6 +131,10 @@ inline double net_rate(const Mesh &m, const double *flux, std::int64_t c, bool &
 
 class MeshEngine final : public Engine {
 public:
+    std::unique_ptr<EngineState> make_state(const Grid &grid) const override {
+        return std::make_unique<MeshState>(grid);
+    }
+
     double stable_dt(const Grid &grid) const override {
         const double stiffness =
             slide_flux_max_derivative(grid.mobility(), grid.min_repose_angle(), grid.flux_exponent());
@@ -178,20 +143,18 @@ public:
 
     void prepare(Grid &grid) const override {
         const Mesh &m = *grid.geometry().mesh;
-        MeshScratch &s = scratch_of(grid);
+        MeshState &s = mesh_state(grid);
+        // A part of a distributed mesh takes its ghosts' values from their owners.
+        s.exchange = dynamic_cast<GhostExchange *>(grid.distribution());
         const std::size_t n = static_cast<std::size_t>(m.cells), nf = static_cast<std::size_t>(m.faces);
         s.gx.resize(n, 0.0), s.gy.resize(n, 0.0);
         if (s.flux.size() != nf) s.flux.assign(nf, 0.0);
         s.face_seen.resize(nf, 0), s.cell_seen.resize(n, 0);
-        s.changed.resize(n, 0);
-        if (grid.decomposition()) s.in_batch.resize(n, 0);
-        MeshActivity &act = grid.mesh_activity();
-        act.hot.resize(n, 0);
+        s.carried.resize(n, 0);
+        if (s.exchange) s.in_batch.resize(n, 0);
         if (!grid.bed().empty()) s.available.resize(n, 0.0);
-        if (s.lists_current && s.masks_seen == grid.masks_version() && s.edges_seen == grid.edges_version()) return;
+        if (s.lists_current) return;
         s.lists_current = true;
-        s.masks_seen = grid.masks_version();
-        s.edges_seen = grid.edges_version();
         // Faces onto a sink: the outflow is summed over them alone, in one
         // order. On a distributed mesh the rank that owns the cell the sand
         // leaves books it.
@@ -210,7 +173,7 @@ public:
             if (kind[c] == kSand && q[c] != 0.0) (c < m.owned ? s.source_cells : s.ghost_source_cells).push_back(c);
     }
 
-    bool may_move(const Grid &grid) const override { return grid.mesh_activity().may_move(); }
+    bool may_move(const Grid &grid) const override { return mesh_state(grid).activity.may_move(); }
 
     // Every source cell takes its source at every sub-step and counts as driven.
     bool drive_sources(Grid &, double, double, bool, double &reach) const override {
@@ -221,18 +184,19 @@ public:
 
     void advance(Grid &grid, const SubstepPlan &plan, const BookSubstep &book, StepInfo &info) const override {
         const Mesh &m = *grid.geometry().mesh;
-        MeshScratch &s = scratch_of(grid);
+        MeshState &s = mesh_state(grid);
         const bool record = grid.records_face_fluxes();
         if (record) std::fill(grid.face_fluxes().x.begin(), grid.face_fluxes().x.end(), 0.0);
         if (!plan.something_may_move) {
             info.at_rest = true;
             return;
         }
-        Decomposition *parts = grid.decomposition();
+        s.switches = read_switches();
+        const Distribution *parts = grid.distribution();
         // A part whose ghost layer is deep enough steps its ghosts in reach
-        // too and exchanges once per batch of sub-steps (Mesh::reach); the
-        // step ends with an exchange, so that a step starts exact.
-        const int per_exchange = parts ? m.substeps_per_exchange : 0;
+        // too and exchanges once per batch of sub-steps (mesh/mesh_parts.hpp);
+        // the step ends with an exchange, so that a step starts exact.
+        const int per_exchange = s.exchange ? m.substeps_per_exchange : 0;
         for (std::int64_t k = 0; k < plan.substeps; ++k) {
             double visited = 0.0;
             const int in_batch = per_exchange > 0 ? static_cast<int>(k % per_exchange) + 1 : 0;
@@ -241,12 +205,11 @@ public:
             if (parts) {
                 // Every rank takes the same sub-steps and stops at the same one.
                 std::vector<SubstepSummary> agreed{did};
-                parts->after_sweep(agreed);
+                parts->agree_on_substeps(agreed);
                 did = agreed[0];
             }
             const bool go_on = book(did);
-            if (in_batch > 0 && (!go_on || in_batch == per_exchange || k + 1 == plan.substeps))
-                exchange_batch(grid, m, s, *parts);
+            if (in_batch > 0 && (!go_on || in_batch == per_exchange || k + 1 == plan.substeps)) end_batch(grid, m, s);
             if (!go_on) break;
         }
     }
@@ -257,23 +220,12 @@ public:
         return false;
     }
 
-private:
-    // The end of a batch: the owned cells' heights (residuals, moving
-    // flags) that changed since the last exchange go to the ranks that hold
-    // them as ghosts; ghosts that were beyond reach, and so differ from
-    // their owners' values, wake the cells that read them.
-    static void exchange_batch(Grid &grid, const Mesh &m, MeshScratch &s, Decomposition &parts) {
-        std::vector<std::int64_t> &changed_ghosts = s.changed_ghosts;
-        changed_ghosts.clear();
-        parts.exchange_ghost_heights(grid, s.batch_all ? nullptr : &s.batch_cells, changed_ghosts);
-        for (const std::int64_t c : s.batch_cells) s.in_batch[c] = 0;
-        s.batch_cells.clear();
-        s.batch_all = false;
-        MeshActivity &act = grid.mesh_activity();
-        for (const std::int64_t c : changed_ghosts) act.wake_around(m, c);
-        changed_ghosts.clear();
+    void read_face_fluxes(const Grid &grid, double *fx, double *) const override {
+        const std::vector<double> &faces = grid.face_fluxes().x;
+        std::copy(faces.begin(), faces.end(), fx);
     }
 
+private:
     // The new height of a sand cell from its faces' fluxes and its source
     // (with a bed: the sand it may lose); whether a face of it carried sand.
     struct CellUpdate {
@@ -301,15 +253,15 @@ private:
 
     // `in_batch`: the sub-step's place after the last exchange (from 1) on a
     // part that takes several per exchange; 0: two exchanges in this one.
-    SubstepSummary substep(Grid &grid, const Mesh &m, MeshScratch &s, double dt, bool record, double &visited,
+    SubstepSummary substep(Grid &grid, const Mesh &m, MeshState &s, double dt, bool record, double &visited,
                            int in_batch) const {
-        MeshActivity &act = grid.mesh_activity();
+        MeshActivity &act = s.activity;
         const bool physics = grid.hysteresis() || !grid.bed().empty();
         // A part of a distributed mesh steps its owned cells and the faces
         // that touch them; its ghosts' heights and gradients come from their
-        // owners, only where they changed (decomposition.hpp).
-        Decomposition *parts = grid.decomposition();
-        const bool dense = physics || act.all_hot || visit_all_cells() ||
+        // owners, only where they changed (mesh/mesh_parts.hpp).
+        const bool parts = s.exchange != nullptr;
+        const bool dense = physics || act.all_hot || s.switches.visit_all_cells ||
                            static_cast<double>(act.hot_list.size()) > kDenseShare * static_cast<double>(m.owned);
         std::vector<std::int64_t> &changed_ghosts = s.changed_ghosts;
         changed_ghosts.clear();
@@ -361,7 +313,7 @@ private:
                         gradient_of(m, h.data(), kind.data(), m.ghosts_by_gradient_reach[static_cast<std::size_t>(k)],
                                     s.gx.data(), s.gy.data());
                 } else if (parts) {
-                    parts->exchange_ghost_gradients(grid, s.gx.data(), s.gy.data(), nullptr, changed_ghosts);
+                    exchange_ghost_gradients(s, nullptr, changed_ghosts);
                 }
             }
             double *flux = s.flux.data();
@@ -384,7 +336,7 @@ private:
                 }
             }
             s.flux_clean = false;
-            std::uint8_t *changed = s.changed.data();
+            std::uint8_t *changed = s.carried.data();
             std::int64_t changed_cells = 0;
 #pragma omp parallel for num_threads(threads) if (parallel) schedule(static) reduction(+ : changed_cells)
             for (std::int64_t c = 0; c < n; ++c) {
@@ -407,7 +359,7 @@ private:
             if (in_batch)
                 s.batch_all = true;
             else if (parts)
-                parts->exchange_ghost_heights(grid, nullptr, changed_ghosts);
+                exchange_ghost_heights(grid, s, nullptr, changed_ghosts);
             // The next sub-step looks at the cells that changed and those whose
             // gradients read them; where that is most of the mesh, at all.
             const std::size_t most = static_cast<std::size_t>(kDenseShare * static_cast<double>(n));
@@ -466,7 +418,7 @@ private:
                 if (parts && !in_batch) {
                     // A ghost whose gradient changed makes its faces steep or flat
                     // whether or not anything near them here changed.
-                    parts->exchange_ghost_gradients(grid, s.gx.data(), s.gy.data(), &s.gradient_cells, changed_ghosts);
+                    exchange_ghost_gradients(s, &s.gradient_cells, changed_ghosts);
                     for (const std::int64_t c : changed_ghosts) look_at_faces_of(c);
                     changed_ghosts.clear();
                 }
@@ -502,7 +454,7 @@ private:
                 for (const std::int64_t c : s.update_cells)
                     if (c < m.owned && !s.in_batch[c]) s.in_batch[c] = 1, s.batch_cells.push_back(c);
             } else if (parts) {
-                parts->exchange_ghost_heights(grid, &s.update_cells, changed_ghosts);
+                exchange_ghost_heights(grid, s, &s.update_cells, changed_ghosts);
             }
             act.cool_all();
             for (const std::int64_t c : s.update_cells) act.wake_around(m, c);
@@ -537,7 +489,7 @@ private:
         return did;
     }
 
-    static std::uint32_t next_stamp(MeshScratch &s) {
+    static std::uint32_t next_stamp(MeshState &s) {
         if (++s.stamp == 0) {
             std::fill(s.face_seen.begin(), s.face_seen.end(), 0);
             std::fill(s.cell_seen.begin(), s.cell_seen.end(), 0);
@@ -558,7 +510,7 @@ private:
 
     // The sand above the bed that faces may take this sub-step, after the
     // cell's own erosion; books what the source applied and what it could not.
-    static void prepare_bed(Grid &grid, const Mesh &m, MeshScratch &s, double dt, SubstepSummary &did) {
+    static void prepare_bed(Grid &grid, const Mesh &m, MeshState &s, double dt, SubstepSummary &did) {
         const std::vector<double> &zb = grid.bed(), &h = grid.heights(), &q = grid.source();
         const std::vector<std::uint8_t> &kind = grid.kinds();
         const double film = bed_film(grid);
@@ -577,7 +529,7 @@ private:
                 sand += applied;
             }
             if (c < m.owned) sourced.add(applied * m.area[c]);  // a ghost's owner books it
-            s.available[c] = sand > film ? sand : 0.0;
+            s.available[c] = sand > film ? sand * m.area[c] : 0.0;
         }
         did.unmet_mass = unmet.value();
         did.sourced_mass = sourced.value();

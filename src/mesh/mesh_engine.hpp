@@ -1,18 +1,12 @@
-// The engine for unstructured meshes (src/mesh/mesh.hpp): explicit Euler
+// The engine for unstructured meshes (src/model/mesh.hpp): explicit Euler
 // sub-steps over the faces of an active set of cells, the flux of each face
 // written as C (h_a - h_b) with 0 <= C <= nu cos(theta) / d (docs/guarantees.md,
 // "Meshes").
 #pragma once
 
-#include <cstdint>
-#include <vector>
-
-#include "mesh/mesh.hpp"
-
 namespace dpsm {
 
 class Engine;
-class Grid;
 
 // Near rest, a face nearly parallel to the steepest slope (the slope across
 // it, along its normal, at most this share of tan(theta)) carries nothing
@@ -36,41 +30,6 @@ constexpr double kMeshRestTolerance = 1e-4;
 // The sub-step is this share of the largest monotone one, so that every
 // sub-step in which sand moves lowers sum A (h - L)^2 by a bounded amount.
 constexpr double kMeshStepSafety = 0.9;
-
-// Which cells the next sub-step must look at, kept between steps: a face
-// can start to carry sand only where a cell within one face of its cells
-// changed (its slope reads its cells' least-squares gradients).
-struct MeshActivity {
-    std::vector<std::uint8_t> hot;      // per cell; meaningless while all_hot
-    std::vector<std::int64_t> hot_list;  // the cells with hot == 1
-    bool all_hot = true;
-
-    // While all_hot, every hot flag is 0.
-    void wake_all() {
-        for (const std::int64_t c : hot_list) hot[c] = 0;
-        hot_list.clear();
-        all_hot = true;
-    }
-    // Starts a list of hot cells from none.
-    void cool_all() {
-        for (const std::int64_t c : hot_list) hot[c] = 0;
-        hot_list.clear();
-        all_hot = false;
-    }
-    void wake(std::int64_t c) {
-        if (all_hot || hot[c]) return;
-        hot[c] = 1;
-        hot_list.push_back(c);
-    }
-    // A cell that changed and the cells whose gradients read it: a face
-    // reads its cells' heights and gradients.
-    void wake_around(const Mesh &mesh, std::int64_t c) {
-        if (all_hot) return;
-        wake(c);
-        for (std::int64_t k = mesh.grad_start[c]; k < mesh.grad_start[c + 1]; ++k) wake(mesh.grad_cells[k]);
-    }
-    bool may_move() const { return all_hot || !hot_list.empty(); }
-};
 
 const Engine &mesh_engine();
 

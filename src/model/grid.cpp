@@ -5,10 +5,8 @@
 #include <limits>
 #include <utility>
 
-#include "mpi/decomposition.hpp"
 #include "dpsm/dpsm.h"
-#include "structured/relax_to_rest.hpp"
-#include "structured/tiled_sweep.hpp"
+#include "model/distribution.hpp"
 
 namespace dpsm {
 
@@ -28,40 +26,23 @@ Grid::Grid(const Geometry &geometry)
       heights_(static_cast<std::size_t>(geometry.cells()), 0.0),
       residuals_(static_cast<std::size_t>(geometry.cells()), 0.0f),
       kinds_(static_cast<std::size_t>(geometry.cells()), kSand),
-      rate_(geometry.dim == 1 ? static_cast<std::size_t>(geometry.cells()) : 0, 0.0),
-      scheme_(geometry.dim == 2 ? kIsotropic : kPairwise) {
-    if (geometry.tiled()) {
-        active_ = std::make_unique<ActiveSet>(geometry.nx, geometry.ny);
-        active_->refresh_masks(*this);
-    }
-    if (geometry.is_mesh()) {
-        mesh_activity_ = std::make_unique<MeshActivity>();
-        mesh_activity_->hot.assign(static_cast<std::size_t>(geometry.cells()), 0);
-    }
-}
+      scheme_(geometry.dim == 2 ? kIsotropic : kPairwise) {}
 
 Grid::~Grid() = default;
 
-void Grid::set_decomposition(std::unique_ptr<Decomposition> decomposition) {
-    decomposition_ = std::move(decomposition);
-}
+void Grid::set_distribution(std::unique_ptr<Distribution> distribution) { distribution_ = std::move(distribution); }
 
-double Grid::global_sum(double local) const { return decomposition_ ? decomposition_->sum(local) : local; }
+double Grid::global_sum(double local) const { return distribution_ ? distribution_->sum(local) : local; }
 
-TiledWorkspace &Grid::tiled_workspace() {
-    if (!tiled_) tiled_ = std::make_unique<TiledWorkspace>();
-    return *tiled_;
-}
-
-RelaxWorkspace &Grid::relax_workspace() {
-    if (!relax_) relax_ = std::make_unique<RelaxWorkspace>(heights_.size(), static_cast<std::size_t>(active_->tiles()));
-    return *relax_;
+void Grid::notify(unsigned what, const ChangedCells *cells) const {
+    if (engine_state_) engine_state_->changed(*this, what, cells);
+    if (distribution_) distribution_->changed(*this, what, cells);
 }
 
 void Grid::set_repose_angle(double theta) {
     repose_angle_ = theta;
     tan_repose_ = std::tan(theta);
-    touched_everywhere();
+    notify(kLawChanged);
 }
 
 double Grid::sand_mass(const double *values) const {
@@ -73,18 +54,11 @@ double Grid::sand_mass(const double *values) const {
 
 double Grid::total_mass() const { return sand_mass(heights_.data()); }
 
-double Grid::sand_mass_change(const double *from, const double *to, const CellBox &within) const {
-    CompensatedSum change;
-    const std::int64_t nx = geometry_.nx;
-    const std::int64_t i0 = std::max<std::int64_t>(within.i0, 0), i1 = std::min(within.i1, nx);
-    const std::int64_t j0 = std::max<std::int64_t>(within.j0, 0), j1 = std::min(within.j1, geometry_.ny);
-    for (std::int64_t j = j0; j < j1; ++j)
-        for (std::int64_t c = i0 + nx * j; c < i1 + nx * j; ++c)
-            if (kinds_[c] == kSand && to[c] != from[c]) change.add((to[c] - from[c]) * geometry_.cell_area(c));
-    return change.value();
-}
-
 void Grid::write_heights(const Block &block, const double *values, bool add) {
+    // Listeners that step cells one by one (a mesh) hear which cells changed.
+    const bool list = (engine_state_ && engine_state_->wants_changed_cells()) ||
+                      (distribution_ && distribution_->wants_changed_cells());
+    changed_cells_.clear();
     // Book the difference cell by cell so that a host that changes a few cells
     // of a large pile gets the change exactly, not a difference of two large sums.
     CompensatedSum change;
@@ -94,105 +68,14 @@ void Grid::write_heights(const Block &block, const double *values, bool add) {
             const double v = values[i + block.ni * j];
             const double next = add ? heights_[c] + v : v;
             if (kinds_[c] == kSand) change.add((next - heights_[c]) * geometry_.cell_area(c));
-            // On a mesh only the cells that change, and those across their faces, wake.
-            if (mesh_activity_ && (next != heights_[c] || residuals_[c] != 0.0f))
-                mesh_activity_->wake_around(*geometry_.mesh, c);
+            if (list && (next != heights_[c] || residuals_[c] != 0.0f)) changed_cells_.push_back(c);
             heights_[c] = next;
             residuals_[c] = 0.0f;
         }
     ledger_.external.add(change.value());
-    ++heights_version_;
     if (open_cells_ > 0) update_open_levels();
-    if (active_) active_->mark_block(block.i0, block.j0, block.ni, block.nj);
-    if (tiled_ && active_) {
-        CellBox box;
-        box.add(block.i0, block.i0 + block.ni, block.j0, block.j0 + block.nj);
-        tiled_workspace_changed(*tiled_, *active_, box);
-    }
-}
-
-void Grid::set_heights_between_sweeps(const double *y, const CellBox &within) {
-    const std::int64_t nx = geometry_.nx, ny = geometry_.ny, side = ActiveSet::kTile;
-    const std::int64_t wi0 = std::max<std::int64_t>(within.i0, 0), wi1 = std::min(within.i1, nx);
-    const std::int64_t wj0 = std::max<std::int64_t>(within.j0, 0), wj1 = std::min(within.j1, ny);
-    if (wi0 >= wi1 || wj0 >= wj1) return;
-    for (std::int64_t tj = wj0 - wj0 % side; tj < wj1; tj += side)
-        for (std::int64_t ti = wi0 - wi0 % side; ti < wi1; ti += side) {
-            // Per tile, so that a pile in one corner wakes only its own cells.
-            const std::int64_t i_begin = std::max(ti, wi0), i_end = std::min(ti + side, wi1);
-            const std::int64_t j_begin = std::max(tj, wj0), j_end = std::min(tj + side, wj1);
-            std::int64_t i0 = nx, i1 = -1, j0 = ny, j1 = -1;
-            for (std::int64_t j = j_begin; j < j_end; ++j) {
-                const double *row_y = y + nx * j;
-                double *row_h = heights_.data() + nx * j;
-                float *row_r = residuals_.data() + nx * j;
-                auto differs = [&](std::int64_t i) { return row_h[i] != row_y[i] || row_r[i] != 0.0f; };
-                // The first and the last cell that differ; those between are
-                // simply overwritten (where they agree, with the same values).
-                std::int64_t first = i_begin;
-                while (first < i_end && !differs(first)) ++first;
-                if (first == i_end) continue;
-                std::int64_t last = i_end - 1;
-                while (!differs(last)) --last;
-                for (std::int64_t i = first; i <= last; ++i) {
-                    row_h[i] = row_y[i];
-                    row_r[i] = 0.0f;
-                }
-                i0 = std::min(i0, first);
-                i1 = std::max(i1, last);
-                j0 = std::min(j0, j);
-                j1 = j;
-            }
-            if (i1 < 0) continue;
-            CellBox box;
-            box.add(i0, i1 + 1, j0, j1 + 1);
-            if (active_) active_->mark_block(box.i0, box.j0, box.i1 - box.i0, box.j1 - box.j0);
-            if (tiled_ && active_) tiled_workspace_changed(*tiled_, *active_, box);
-        }
-}
-
-void Grid::copy_heights_between_sweeps(const double *y, const CellBox &within) {
-    const std::int64_t nx = geometry_.nx, ny = geometry_.ny, side = ActiveSet::kTile;
-    const std::int64_t wi0 = std::max<std::int64_t>(within.i0, 0), wi1 = std::min(within.i1, nx);
-    const std::int64_t wj0 = std::max<std::int64_t>(within.j0, 0), wj1 = std::min(within.j1, ny);
-    if (wi0 >= wi1 || wj0 >= wj1) return;
-    for (std::int64_t j = wj0; j < wj1; ++j)
-        std::copy(y + nx * j + wi0, y + nx * j + wi1, heights_.data() + nx * j + wi0);
-    // Per tile, as the host's edits are.
-    for (std::int64_t tj = wj0 - wj0 % side; tj < wj1; tj += side)
-        for (std::int64_t ti = wi0 - wi0 % side; ti < wi1; ti += side) {
-            CellBox box;
-            box.add(std::max(ti, wi0), std::min(ti + side, wi1), std::max(tj, wj0), std::min(tj + side, wj1));
-            if (active_) active_->mark_block(box.i0, box.j0, box.i1 - box.i0, box.j1 - box.j0);
-            if (tiled_ && active_) tiled_workspace_changed(*tiled_, *active_, box);
-        }
-}
-
-Grid::SavedResiduals Grid::drop_residuals() {
-    SavedResiduals saved;
-    const CellBox box = residual_bounds_.grown_within(0, CellBox{0, geometry_.nx, 0, geometry_.ny});
-    saved.box = box;
-    if (!box.empty()) {
-        saved.values.reserve(static_cast<std::size_t>((box.i1 - box.i0) * (box.j1 - box.j0)));
-        for (std::int64_t j = box.j0; j < box.j1; ++j)
-            saved.values.insert(saved.values.end(), residuals_.begin() + (box.i0 + geometry_.nx * j),
-                                residuals_.begin() + (box.i1 + geometry_.nx * j));
-    }
-    set_heights_between_sweeps(heights_.data(), residual_bounds_);
-    residual_bounds_ = CellBox{};
-    return saved;
-}
-
-void Grid::restore_residuals(const SavedResiduals &saved) {
-    const CellBox &box = saved.box;
-    if (box.empty()) return;
-    const std::int64_t width = box.i1 - box.i0;
-    for (std::int64_t j = box.j0; j < box.j1; ++j)
-        std::copy_n(saved.values.begin() + width * (j - box.j0), width,
-                    residuals_.begin() + (box.i0 + geometry_.nx * j));
-    residual_bounds_.add(box);
-    if (active_) active_->mark_block(box.i0, box.j0, width, box.j1 - box.j0);
-    if (tiled_ && active_) tiled_workspace_changed(*tiled_, *active_, box);
+    const ChangedCells cells{block.i0, block.j0, block.ni, block.nj, list ? &changed_cells_ : nullptr};
+    notify(kCellsChanged, &cells);
 }
 
 void Grid::read_heights(const Block &block, double *values) const {
@@ -203,7 +86,6 @@ void Grid::read_heights(const Block &block, double *values) const {
 
 void Grid::set_cell_kinds(const std::uint8_t *kinds) {
     CompensatedSum change;
-    std::int64_t walls = 0, opens = 0;
     for (std::size_t c = 0; c < kinds_.size(); ++c) {
         const std::uint8_t next = kinds ? kinds[c] : static_cast<std::uint8_t>(kSand);
         const double mass = heights_[c] * geometry_.cell_area(static_cast<std::int64_t>(c));
@@ -211,21 +93,22 @@ void Grid::set_cell_kinds(const std::uint8_t *kinds) {
         if (kinds_[c] != kSand && next == kSand) change.add(mass);
         if (kinds_[c] != next) residuals_[c] = 0.0f;
         kinds_[c] = next;
-        walls += next == kWall;
-        opens += next == kOpen;
     }
-    wall_cells_ = walls;
-    open_cells_ = opens;
-    if (tiled_) tiled_->all_stale = true;  // residuals were reset where kinds changed
-    ++masks_version_;
+    count_kinds();
     ledger_.external.add(change.value());
     update_source_summary();
     update_open_levels();
-    if (active_) {
-        active_->refresh_masks(*this);
-        active_->mark_all();
+    notify(kMasksChanged);  // residuals were reset where kinds changed, too
+}
+
+void Grid::count_kinds() {
+    std::int64_t walls = 0, opens = 0;
+    for (const std::uint8_t k : kinds_) {
+        walls += k == kWall;
+        opens += k == kOpen;
     }
-    if (mesh_activity_) mesh_activity_->wake_all();
+    wall_cells_ = walls;
+    open_cells_ = opens;
 }
 
 void Grid::restore(GridState &&s) {
@@ -242,18 +125,12 @@ void Grid::restore(GridState &&s) {
     edge_open_ = std::move(s.edge_open);
     edges_open_ = 0;
     for (const std::uint8_t open : edge_open_) edges_open_ += open;
-    ++edges_version_;
     update_held_levels();
     set_face_flux_recording(s.record_fluxes);
     heights_ = std::move(s.heights);
-    ++heights_version_;
     residuals_ = std::move(s.residuals);
-    residual_bounds_ = CellBox{};
-    residual_bounds_.add(0, geometry_.nx, 0, geometry_.ny);
     kinds_ = std::move(s.kinds);
     source_ = std::move(s.source);
-    clock_.assign(geometry_.tiled() && !source_.empty() ? heights_.size() : 0, 0.0);
-    clock_base_ = 0.0;
     bed_ = std::move(s.bed);
     // The tangents and the smallest angle exactly as the setter computes them.
     set_angle_field(s.angle_field.empty() ? nullptr : s.angle_field.data());
@@ -261,25 +138,15 @@ void Grid::restore(GridState &&s) {
     static_angle_ = s.static_angle;
     tan_static_ = s.static_angle > 0.0 ? std::tan(s.static_angle) : 0.0;
     moving_ = std::move(s.moving);
-    if (tiled_) tiled_->all_stale = true;
-    std::int64_t walls = 0, opens = 0;
-    for (const std::uint8_t k : kinds_) {
-        walls += k == kWall;
-        opens += k == kOpen;
-    }
-    wall_cells_ = walls;
-    open_cells_ = opens;
+    count_kinds();
     ledger_ = s.ledger;
     last_step_ = s.last_step;
     update_source_summary();
     update_open_levels();
-    // Every tile is looked at again: a sweep over a tile at rest changes
+    // Every cell is looked at again: a sub-step over cells at rest changes
     // nothing, so the results are those of the saved grid.
-    if (active_) {
-        active_->refresh_masks(*this);
-        active_->mark_all();
-    }
-    if (mesh_activity_) mesh_activity_->wake_all();
+    const ChangedCells cells{0, 0, geometry_.nx, geometry_.ny, nullptr};
+    notify(kEverythingChanged, &cells);
 }
 
 void Grid::set_source(const double *q) {
@@ -287,12 +154,8 @@ void Grid::set_source(const double *q) {
         source_.assign(q, q + heights_.size());
     else
         source_.clear();
-    if (q && geometry_.tiled() && clock_.size() != heights_.size()) {
-        clock_.assign(heights_.size(), 0.0);
-        if (tiled_) tiled_->all_stale = true;
-    }
-    ++masks_version_;
     update_source_summary();
+    notify(kSourcesChanged);
 }
 
 void Grid::set_bed(const double *zb) {
@@ -302,8 +165,7 @@ void Grid::set_bed(const double *zb) {
     } else {
         bed_.clear();
     }
-    ++masks_version_;
-    touched_everywhere();
+    notify(kMasksChanged | kLawChanged);
 }
 
 void Grid::lift_to_bed() {
@@ -320,10 +182,10 @@ void Grid::lift_to_bed() {
         lifted = true;
     }
     if (!lifted) return;
-    ++heights_version_;
     ledger_.external.add(change.value());
     if (open_cells_ > 0) update_open_levels();
-    if (tiled_) tiled_->all_stale = true;
+    const ChangedCells cells{0, 0, geometry_.nx, geometry_.ny, nullptr};
+    notify(kCellsChanged, &cells);
 }
 
 void Grid::set_side_levels(int side, const double *levels) {
@@ -333,41 +195,11 @@ void Grid::set_side_levels(int side, const double *levels) {
     else
         side_levels_[side].clear();
     update_held_levels();
-    ++side_levels_version_;
-    touched_everywhere();
+    notify(kSidesChanged | kLawChanged);
 }
 
 double Grid::outside_level(std::int64_t i, std::int64_t j) const {
     return level_beyond(side_levels_, geometry_.nx, geometry_.ny, i, j);
-}
-
-void Grid::read_face_fluxes(double *fx, double *fy) const {
-    const FaceFluxes &fluxes = *fluxes_;
-    if (geometry_.dim == 1 || geometry_.is_mesh()) {
-        std::copy(fluxes.x.begin(), fluxes.x.end(), fx);
-        return;
-    }
-    // A tile's faces hold the last step's fluxes only if that step visited it.
-    const std::int64_t nx = geometry_.nx, ny = geometry_.ny;
-    for (std::int64_t t = 0; t < active_->tiles(); ++t) {
-        const CellBox tile = active_->tile_cells(t);
-        const bool current = fluxes.tile_step[static_cast<std::size_t>(t)] == fluxes.step;
-        const std::int64_t x1 = tile.i1 + (tile.i1 == nx ? 1 : 0), y1 = tile.j1 + (tile.j1 == ny ? 1 : 0);
-        for (std::int64_t j = tile.j0; j < tile.j1; ++j) {
-            const std::size_t at = static_cast<std::size_t>(tile.i0 + (nx + 1) * j);
-            if (current)
-                std::copy_n(fluxes.x.begin() + at, x1 - tile.i0, fx + at);
-            else
-                std::fill_n(fx + at, x1 - tile.i0, 0.0);
-        }
-        for (std::int64_t j = tile.j0; j < y1; ++j) {
-            const std::size_t at = static_cast<std::size_t>(tile.i0 + nx * j);
-            if (current)
-                std::copy_n(fluxes.y.begin() + at, tile.i1 - tile.i0, fy + at);
-            else
-                std::fill_n(fy + at, tile.i1 - tile.i0, 0.0);
-        }
-    }
 }
 
 SideLevelRange side_level_range(const std::array<bool, 4> &open, const std::array<std::vector<double>, 4> &levels) {
@@ -398,9 +230,8 @@ void Grid::set_edge_open(const std::uint8_t *open) {
         edge_open_.clear();
     }
     side_open_[0] = false;  // the faces say which edges are open
-    ++edges_version_;
     update_held_levels();
-    touched_everywhere();
+    notify(kSidesChanged | kLawChanged);
 }
 
 void Grid::update_held_levels() {
@@ -441,10 +272,7 @@ void Grid::set_face_flux_recording(bool on) {
         return;
     }
     fluxes->x.assign((nx + 1) * ny, 0.0);
-    if (geometry_.dim == 2) {
-        fluxes->y.assign(nx * (ny + 1), 0.0);
-        fluxes->tile_step.assign(static_cast<std::size_t>(active_->tiles()), 0);
-    }
+    if (geometry_.dim == 2) fluxes->y.assign(nx * (ny + 1), 0.0);  // the engine numbers their tiles
     fluxes_ = std::move(fluxes);
 }
 
@@ -462,8 +290,7 @@ void Grid::set_angle_field(const double *theta) {
         angle_field_.clear();
         tan_field_.clear();
     }
-    ++masks_version_;
-    touched_everywhere();
+    notify(kMasksChanged | kLawChanged);
 }
 
 void Grid::set_static_angle(double theta) {
@@ -471,8 +298,7 @@ void Grid::set_static_angle(double theta) {
     tan_static_ = std::tan(theta);
     // Every cell starts at rest: sand moves first where the static angle is exceeded.
     moving_.assign(heights_.size(), 0);
-    if (tiled_) tiled_->all_stale = true;
-    touched_everywhere();
+    notify(kLawChanged);
 }
 
 void Grid::update_open_levels() {
@@ -494,7 +320,6 @@ void Grid::update_source_summary() {
         nonzero = kinds_[c] == kSand && source_[c] != 0.0;
     source_rate_nonzero_ = nonzero;
     source_mass_rate_ = nonzero ? sand_mass(source_.data()) : 0.0;
-    if (active_) active_->refresh_source(*this);
 }
 
 }  // namespace dpsm

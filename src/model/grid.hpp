@@ -8,11 +8,10 @@
 #include <memory>
 #include <vector>
 
-#include "mesh/mesh.hpp"
-#include "mesh/mesh_engine.hpp"
-#include "structured/active_set.hpp"
+#include "model/changes.hpp"
 #include "model/face_fluxes.hpp"
 #include "model/ledger.hpp"
+#include "model/mesh.hpp"
 #include "model/side_levels.hpp"
 #include "model/threads.hpp"
 
@@ -62,16 +61,13 @@ struct Geometry {
     static constexpr double kTwoPi = 6.283185307179586476925;
 };
 
-// What an engine keeps of its own on a grid (stepping/engine.hpp).
-struct EngineState {
-    virtual ~EngineState() = default;
-};
+// What an engine keeps of its own on a grid (model/engine.hpp: its active
+// set, scratch and clocks), hearing of every change the host makes.
+struct EngineState : ChangeListener {};
+
+class Distribution;
 
 // What the last step did, for dpsm_get_step_info.
-struct TiledWorkspace;
-struct RelaxWorkspace;
-class Decomposition;
-
 struct StepInfo {
     std::int64_t substeps = 0;
     double time_integrated = 0.0;
@@ -133,23 +129,23 @@ public:
     double rest_tolerance() const { return rest_tolerance_; }
     void set_rest_tolerance(double tol) {
         rest_tolerance_ = tol;
-        touched_everywhere();
+        notify(kLawChanged);
     }
     std::int64_t max_substeps() const { return max_substeps_; }
     void set_max_substeps(std::int64_t n) { max_substeps_ = n; }
     int threads() const { return threads_; }  // 0: OpenMP's default
     // The threads a step runs on (model/threads.hpp).
-    int step_threads() const { return thread_count(threads_, decomposition_ != nullptr); }
+    int step_threads() const { return thread_count(threads_, distribution_ != nullptr); }
     void set_threads(int n) { threads_ = n; }
     // Where the host counts cells and array positions from in messages on a
     // grid: 0 as C writes them, 1 as Fortran does (a mesh has its own start
-    // index, mesh/mesh.hpp). It changes no result.
+    // index, model/mesh.hpp). It changes no result.
     int index_base() const { return index_base_; }
     void set_index_base(int base) { index_base_ = base; }
     Scheme scheme() const { return scheme_; }
     void set_scheme(Scheme scheme) {
         scheme_ = scheme;
-        touched_everywhere();
+        notify(kLawChanged);
     }
     // The physics of real scenes (dpsm_set_bedrock and friends); each is empty
     // or at its default when a scene does not use it, and a scene that uses
@@ -167,12 +163,12 @@ public:
     // The same over this grid's own cells alone (on a block: the block's).
     double own_min_repose_angle() const { return angle_field_.empty() ? repose_angle_ : min_angle_field_; }
     // On a block of a distributed grid: the smallest angle over all blocks,
-    // set by the Decomposition before each step.
+    // set by the Distribution before each step.
     void set_distributed_min_repose_angle(double theta) { distributed_min_angle_ = theta; }
     double flux_exponent() const { return flux_exponent_; }
     void set_flux_exponent(double p) {
         flux_exponent_ = p;
-        touched_everywhere();
+        notify(kLawChanged);
     }
     // Hysteresis: on once a static angle is set; moving() then holds, per
     // cell, whether one of its faces carried sand in the last sub-step.
@@ -208,13 +204,10 @@ public:
         if (geometry_.is_mesh()) {
             edge_open_.clear();
             edges_open_ = 0;
-            ++edges_version_;
         }
         update_held_levels();
-        touched_everywhere();
+        notify(kSidesChanged | kLawChanged);
     }
-    // Changes whenever the host opens or closes edges of a mesh.
-    std::uint64_t edges_version() const { return edges_version_; }
     // The surface level outside an open side, per boundary face (k counts
     // along the side: j for the x sides, i for the y sides); 0 unless the
     // host set levels (dpsm_set_side_levels).
@@ -237,18 +230,6 @@ public:
     // source does not leak mass one half-ulp at a time.
     const std::vector<float> &residuals() const { return residuals_; }
     std::vector<float> &residuals_for_stepping() { return residuals_; }
-    // A sweep or step may have left residuals that are not 0 within the box.
-    void residuals_written(const CellBox &box) { residual_bounds_.add(box); }
-    // Every residual becomes 0, waking the cells whose residual was not (the
-    // relaxation to rest has no use for them); costs what the residuals that
-    // steps left behind cover, not the grid. Returns what they were, for
-    // restore_residuals.
-    struct SavedResiduals {
-        CellBox box;
-        std::vector<float> values;  // the box's, row by row
-    };
-    SavedResiduals drop_residuals();
-    void restore_residuals(const SavedResiduals &saved);
     void swap_heights(std::vector<double> &heights, std::vector<float> &residuals) {
         heights_.swap(heights);
         residuals_.swap(residuals);
@@ -262,16 +243,6 @@ public:
     double open_level_min() const { return open_level_min_; }
     double open_level_max() const { return open_level_max_; }
     bool source_active() const { return source_rate_nonzero_; }
-    // Sources applied lazily (structured/tiled_sweep.hpp), as on 2D grids without the
-    // physics of real scenes: per cell, the sub-steps counted since the grid
-    // began after which a source cell's stored height is current, where that
-    // is later than clock_base(), the count at the start of the present step
-    // (at the end of a step every source cell is current).
-    bool lazy_sources() const { return geometry_.tiled() && !uses_physics(); }
-    const std::vector<double> &source_clock() const { return clock_; }
-    std::vector<double> &source_clock_for_stepping() { return clock_; }
-    double clock_base() const { return clock_base_; }
-    void set_clock_base(double count) { clock_base_ = count; }
     double source_mass_rate() const { return source_mass_rate_; }
 
     // A block of cells [i0, i0+ni) x [j0, j0+nj), values x fastest: sets the
@@ -288,14 +259,6 @@ public:
     // new grid of the same geometry. Unlike the setters it books nothing in
     // the ledger (the state carries its ledger); it recomputes what is derived.
     void restore(GridState &&state);
-    // The relaxation to rest (structured/relax_to_rest.cpp) between its sweeps: every
-    // height becomes y's and every residual 0, where y may differ from the
-    // heights only within the box. Only the cells that change are looked at
-    // again, as after a host's edit, but nothing is booked.
-    void set_heights_between_sweeps(const double *y, const CellBox &within);
-    // The same where every residual is 0 already: copies the box without a
-    // look at which cells differ, and wakes all of it.
-    void copy_heights_between_sweeps(const double *y, const CellBox &within);
     void set_source(const double *q);                 // NULL: none
 
     // The volume each face carried in the last step, recorded only when the
@@ -304,64 +267,41 @@ public:
     bool records_face_fluxes() const { return record_fluxes_; }
     void set_face_flux_recording(bool on);
     FaceFluxes &face_fluxes() { return *fluxes_; }
+    const FaceFluxes &face_fluxes() const { return *fluxes_; }
     const FaceFluxes *face_fluxes_if_any() const { return fluxes_.get(); }
-    // The last step's face fluxes, in the layout of dpsm_get_face_fluxes (fy: 2D only).
-    void read_face_fluxes(double *fx, double *fy) const;
 
     // Mass on sand cells now, a compensated sum.
     double total_mass() const;
     // Mass of values (heights or source rates) on sand cells: sum v * area.
     double sand_mass(const double *values) const;
-    // The mass of `to` less that of `from` on the sand cells of a box, summed
-    // cell by cell, so that a change to a few cells of a large pile comes out
-    // exactly rather than as the difference of two large sums.
-    double sand_mass_change(const double *from, const double *to, const CellBox &within) const;
     MassLedger &ledger() { return ledger_; }
     const MassLedger &ledger() const { return ledger_; }
 
-    // The mesh engine's active set (meshes only).
-    MeshActivity &mesh_activity() { return *mesh_activity_; }
-    const MeshActivity &mesh_activity() const { return *mesh_activity_; }
-    // What an engine keeps between steps besides the grid's fields (meshes: scratch).
-    std::unique_ptr<EngineState> &engine_state() { return engine_state_; }
-
-    // Scratch space of the 1D sweep (1D and axisymmetric grids only).
-    std::vector<double> &rate_workspace() { return rate_; }
-    // The 2D sweep's active set and scratch (2D grids only).
-    ActiveSet &active_set() { return *active_; }
-    const ActiveSet &active_set() const { return *active_; }
-    TiledWorkspace &tiled_workspace();
-    // The relaxation to rest's arrays (2D grids only), allocated on first use.
-    RelaxWorkspace &relax_workspace();
+    // What the engine that steps this grid keeps of its own (model/engine.hpp);
+    // null until the grid's handle attaches it.
+    EngineState *engine_state() const { return engine_state_.get(); }
+    void set_engine_state(std::unique_ptr<EngineState> state) { engine_state_ = std::move(state); }
 
     StepInfo &last_step() { return last_step_; }
     const StepInfo &last_step() const { return last_step_; }
 
-    // The grid's place in a distributed grid (mpi/decomposition.hpp); null on a
-    // serial grid, which never pays for any of it.
-    Decomposition *decomposition() const { return decomposition_.get(); }
-    void set_decomposition(std::unique_ptr<Decomposition> decomposition);
-    // Changes whenever the host sets cell kinds or sources: a distributed grid
-    // refreshes its halo's copies of them when it does.
-    std::uint64_t masks_version() const { return masks_version_; }
-    // Counts the host's writes of heights (and a bed lifting them).
-    std::uint64_t heights_version() const { return heights_version_; }
-    // Changes whenever the host sets side levels: a distributed grid then
-    // assembles the levels along the global domain's sides again.
-    std::uint64_t side_levels_version() const { return side_levels_version_; }
-    // The sum over all blocks of a distributed grid; `local` on a serial grid.
+    // The grid's part in a distributed grid (model/distribution.hpp); null on
+    // a serial grid, which never pays for any of it.
+    Distribution *distribution() const { return distribution_.get(); }
+    void set_distribution(std::unique_ptr<Distribution> distribution);
+    // The sum over all ranks of a distributed grid; `local` on a serial grid.
     double global_sum(double local) const;
+
+    // Tells the engine's state and the distribution what changed
+    // (model/changes.hpp); `cells` with kCellsChanged.
+    void notify(unsigned what, const ChangedCells *cells = nullptr) const;
 
 private:
     void update_source_summary();
     void update_open_levels();
     void update_held_levels();
     void lift_to_bed();
-    // Something that may make any face steep changed: every tile is looked at again.
-    void touched_everywhere() {
-        if (active_) active_->mark_all();
-        if (mesh_activity_) mesh_activity_->wake_all();
-    }
+    void count_kinds();
 
     Geometry geometry_;
     double repose_angle_;
@@ -375,11 +315,8 @@ private:
 
     std::vector<double> heights_;
     std::vector<float> residuals_;
-    CellBox residual_bounds_;  // outside it every residual is 0
     std::vector<std::uint8_t> kinds_;
     std::vector<double> source_;
-    std::vector<double> clock_;  // empty until a 2D grid has a source
-    double clock_base_ = 0.0;
     std::vector<double> bed_;
     std::vector<double> angle_field_, tan_field_;
     double min_angle_field_ = 0.0;
@@ -387,15 +324,9 @@ private:
     double flux_exponent_ = 1.0;
     double static_angle_ = 0.0, tan_static_ = 0.0;  // 0: no hysteresis
     std::vector<std::uint8_t> moving_;
-    std::vector<double> rate_;
-    std::unique_ptr<ActiveSet> active_;
-    std::unique_ptr<MeshActivity> mesh_activity_;
     std::unique_ptr<EngineState> engine_state_;
     std::vector<std::uint8_t> edge_open_;
     std::int64_t edges_open_ = 0;  // faces of edge_open_ that are open
-    std::uint64_t edges_version_ = 0;
-    std::unique_ptr<TiledWorkspace> tiled_;
-    std::unique_ptr<RelaxWorkspace> relax_;
     bool record_fluxes_ = false;
     std::unique_ptr<FaceFluxes> fluxes_;
     Scheme scheme_;
@@ -410,10 +341,8 @@ private:
 
     MassLedger ledger_;
     StepInfo last_step_;
-    std::unique_ptr<Decomposition> decomposition_;
-    std::uint64_t masks_version_ = 0;
-    std::uint64_t heights_version_ = 0;
-    std::uint64_t side_levels_version_ = 0;
+    std::unique_ptr<Distribution> distribution_;
+    mutable std::vector<std::int64_t> changed_cells_;  // write_heights' list for listeners that want one
 };
 
 }  // namespace dpsm

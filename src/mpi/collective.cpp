@@ -6,9 +6,9 @@
 #include <random>
 #include <sstream>
 
+#include "model/engine.hpp"
 #include "model/grid.hpp"
 #include "model/ledger.hpp"
-#include "stepping/engine.hpp"
 
 namespace dpsm {
 
@@ -35,13 +35,13 @@ void check_communicator(MPI_Comm comm, const char *fn, int &rank, int &size) {
     check_mpi(MPI_Comm_size(comm, &size), "MPI_Comm_size");
 }
 
-CollectiveDecomposition::~CollectiveDecomposition() {
+CollectiveDistribution::~CollectiveDistribution() {
     int finalized = 0;
     MPI_Finalized(&finalized);
     if (!finalized) MPI_Comm_free(&comm_);
 }
 
-std::vector<double> CollectiveDecomposition::agree_on_step(const Grid &grid, double dt, bool refused,
+std::vector<double> CollectiveDistribution::agree_on_step(const Grid &grid, double dt, bool refused,
                                                            std::vector<double> flags) const {
     const bool mesh = grid.geometry().is_mesh();
     const std::size_t first_flag = 1, first_parameter = 1 + flags.size();
@@ -105,7 +105,7 @@ std::vector<double> CollectiveDecomposition::agree_on_step(const Grid &grid, dou
                                v.begin() + static_cast<std::ptrdiff_t>(first_parameter));
 }
 
-void CollectiveDecomposition::after_sweep(std::vector<SubstepSummary> &levels) {
+void CollectiveDistribution::agree_on_substeps(std::vector<SubstepSummary> &levels) const {
     std::vector<double> v;
     for (const SubstepSummary &level : levels) {
         v.push_back(level.moved ? 1.0 : 0.0);
@@ -119,7 +119,7 @@ void CollectiveDecomposition::after_sweep(std::vector<SubstepSummary> &levels) {
     }
 }
 
-bool CollectiveDecomposition::sum_unless_refused(double local, bool refused, double &total) const {
+bool Communicator::sum_unless_refused(double local, bool refused, double &total) const {
     std::vector<double> mine = {refused ? 0.0 : local, refused ? 1.0 : 0.0}, all(2 * static_cast<std::size_t>(ranks()));
     check_mpi(MPI_Allgather(mine.data(), 2, MPI_DOUBLE, all.data(), 2, MPI_DOUBLE, comm_), "MPI_Allgather of a sum");
     CompensatedSum sum;
@@ -132,25 +132,25 @@ bool CollectiveDecomposition::sum_unless_refused(double local, bool refused, dou
     return !any_refused;
 }
 
-double CollectiveDecomposition::sum(double local) const {
+double Communicator::sum(double local) const {
     double total = 0.0;
     sum_unless_refused(local, false, total);
     return total;
 }
 
-int CollectiveDecomposition::rank() const {
+int Communicator::rank() const {
     int rank = 0;
     MPI_Comm_rank(comm_, &rank);
     return rank;
 }
 
-int CollectiveDecomposition::ranks() const {
+int Communicator::ranks() const {
     int size = 1;
     MPI_Comm_size(comm_, &size);
     return size;
 }
 
-std::uint64_t CollectiveDecomposition::shared_mark() const {
+std::uint64_t Communicator::shared_mark() const {
     std::uint64_t mark = 0;
     if (rank() == 0) {
         // The clock alone would do between saves of one run; the random
@@ -167,17 +167,23 @@ std::uint64_t CollectiveDecomposition::shared_mark() const {
     return mark;
 }
 
-void CollectiveDecomposition::first_failure(int status, int &failed_rank, int &failed_status) const {
-    std::vector<int> all(static_cast<std::size_t>(ranks()));
+Failure Communicator::first_failure(int status, const std::string &message) const {
+    const int me = rank(), size = ranks();
+    std::vector<int> all(static_cast<std::size_t>(size));
     check_mpi(MPI_Allgather(&status, 1, MPI_INT, all.data(), 1, MPI_INT, comm_), "MPI_Allgather of the statuses");
-    failed_rank = -1;
-    failed_status = DPSM_OK;
-    for (std::size_t r = 0; r < all.size(); ++r)
-        if (all[r] != DPSM_OK) {
-            failed_rank = static_cast<int>(r);
-            failed_status = all[r];
-            return;
+    Failure failure;
+    for (int r = 0; r < size && failure.rank < 0; ++r)
+        if (all[static_cast<std::size_t>(r)] != DPSM_OK) {
+            failure.rank = r;
+            failure.status = all[static_cast<std::size_t>(r)];
         }
+    if (failure.rank < 0) return failure;
+    // The failing rank's message, to every rank.
+    int length = me == failure.rank ? static_cast<int>(message.size()) : 0;
+    check_mpi(MPI_Bcast(&length, 1, MPI_INT, failure.rank, comm_), "MPI_Bcast of a message");
+    failure.message = me == failure.rank ? message : std::string(static_cast<std::size_t>(length), ' ');
+    check_mpi(MPI_Bcast(&failure.message[0], length, MPI_CHAR, failure.rank, comm_), "MPI_Bcast of a message");
+    return failure;
 }
 
 }  // namespace dpsm

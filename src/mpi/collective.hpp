@@ -1,22 +1,17 @@
 // What the two kinds of distributed grid share (distributed.cpp: blocks of a
 // 2D grid; distributed_mesh.cpp: parts of a mesh): MPI calls that throw
-// Error, the communicator's checks, and a Decomposition over a duplicate of
-// the host's communicator that agrees on a step's parameters, sums figures in
-// rank order, and tells every rank which rank failed.
+// Error, the communicator's checks, the collectives of model/distribution.hpp
+// over a communicator, and a Distribution over a duplicate of the host's
+// communicator that agrees on a step's parameters.
 #pragma once
 
 #include <mpi.h>
 
 #include <cstdint>
-#include <exception>
-#include <new>
 #include <string>
 #include <vector>
 
-#include "api/handle.hpp"
-#include "dpsm/dpsm.h"
-#include "model/error.hpp"
-#include "mpi/decomposition.hpp"
+#include "model/distribution.hpp"
 
 namespace dpsm {
 
@@ -26,43 +21,40 @@ void check_mpi(int code, const char *what);
 // Checks that MPI is running and `comm` is an intracommunicator; its rank and size.
 void check_communicator(MPI_Comm comm, const char *fn, int &rank, int &size);
 
-// Runs `body` (which makes a grid without a handle to report on) and turns
-// whatever it throws into a status and the message of dpsm_last_error(NULL).
-template <class Body>
-int without_grid(const char *fn, Body &&body) noexcept {
-    try {
-        body();
-        set_error_without_grid("");
-        return DPSM_OK;
-    } catch (const Error &e) {
-        set_error_without_grid(e.what());
-        return e.status();
-    } catch (const std::bad_alloc &) {
-        set_error_without_grid((std::string(fn) + ": out of memory").c_str());
-        return DPSM_ERR_OUT_OF_MEMORY;
-    } catch (const std::exception &e) {
-        set_error_without_grid(e.what());
-        return DPSM_ERR_INTERNAL;
-    } catch (...) {
-        set_error_without_grid("dpsm: internal error of unknown kind");
-        return DPSM_ERR_INTERNAL;
-    }
-}
-
-// A Decomposition over its own communicator (a duplicate of the host's,
-// freed with it).
-class CollectiveDecomposition : public Decomposition {
+// The collectives over a communicator the caller owns (a constructor's, a
+// load's, before there is a grid).
+class Communicator final : public Collectives {
 public:
-    explicit CollectiveDecomposition(MPI_Comm comm) : comm_(comm) {}
-    ~CollectiveDecomposition() override;
-
-    void after_sweep(std::vector<SubstepSummary> &levels) override;
-    double sum(double local) const override;
-    bool sum_unless_refused(double local, bool refused, double &total) const override;
+    explicit Communicator(MPI_Comm comm) : comm_(comm) {}
     int rank() const override;
     int ranks() const override;
+    double sum(double local) const override;
+    bool sum_unless_refused(double local, bool refused, double &total) const override;
+    Failure first_failure(int status, const std::string &message) const override;
     std::uint64_t shared_mark() const override;
-    void first_failure(int status, int &failed_rank, int &failed_status) const override;
+
+private:
+    MPI_Comm comm_;
+};
+
+// A Distribution over its own communicator (a duplicate of the host's,
+// freed with it).
+class CollectiveDistribution : public Distribution {
+public:
+    explicit CollectiveDistribution(MPI_Comm comm) : comm_(comm), ranks_(comm) {}
+    ~CollectiveDistribution() override;
+
+    void agree_on_substeps(std::vector<SubstepSummary> &levels) const override;
+    int rank() const override { return ranks_.rank(); }
+    int ranks() const override { return ranks_.ranks(); }
+    double sum(double local) const override { return ranks_.sum(local); }
+    bool sum_unless_refused(double local, bool refused, double &total) const override {
+        return ranks_.sum_unless_refused(local, refused, total);
+    }
+    Failure first_failure(int status, const std::string &message) const override {
+        return ranks_.first_failure(status, message);
+    }
+    std::uint64_t shared_mark() const override { return ranks_.shared_mark(); }
 
 protected:
     // One MAX all-reduce of `flags` (minima as negated values) together with
@@ -72,6 +64,9 @@ protected:
     std::vector<double> agree_on_step(const Grid &grid, double dt, bool refused, std::vector<double> flags) const;
 
     MPI_Comm comm_;
+
+private:
+    Communicator ranks_;
 };
 
 }  // namespace dpsm

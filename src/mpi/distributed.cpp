@@ -1,6 +1,7 @@
 // The MPI component: a 2D grid as one rank's block of a grid distributed over
 // a communicator (include/dpsm/dpsm_mpi.h). The core runs the block as it runs
-// any grid; this file is its Decomposition (mpi/decomposition.hpp):
+// any grid; this file is its Distribution (model/distribution.hpp) and its
+// Halo (structured/halo.hpp):
 //
 //  - the halo: every cell within kHaloDepth (the most a sweep reads beyond a
 //    tile) of the block that another rank owns. Whoever owns it sends it: one
@@ -39,19 +40,21 @@
 #include <string>
 #include <vector>
 
-#include "structured/active_set.hpp"
-#include "mpi/collective.hpp"
-#include "mpi/decomposition.hpp"
-#include "mpi/distributed_mesh.hpp"
+#include "api/guarded.hpp"
+#include "api/handle.hpp"
 #include "dpsm/dpsm.h"
 #include "dpsm/dpsm_mpi.h"
-#include "model/error.hpp"
-#include "model/limits.hpp"
-#include "model/grid.hpp"
-#include "api/handle.hpp"
-#include "model/ledger.hpp"
 #include "io/restart.hpp"
-#include "structured/tiled_sweep.hpp"
+#include "model/engine.hpp"
+#include "model/error.hpp"
+#include "model/grid.hpp"
+#include "model/ledger.hpp"
+#include "model/limits.hpp"
+#include "mpi/collective.hpp"
+#include "mpi/distributed_mesh.hpp"
+#include "structured/active_set.hpp"
+#include "structured/halo.hpp"
+#include "structured/structured_state.hpp"
 
 namespace dpsm {
 namespace {
@@ -99,11 +102,11 @@ struct Neighbour {
     std::vector<double> send_buffer, receive_buffer;
 };
 
-class MpiDecomposition final : public CollectiveDecomposition {
+class BlockDistribution final : public CollectiveDistribution, public Halo {
 public:
-    MpiDecomposition(MPI_Comm comm, int rank, const std::vector<Rect> &blocks, std::int64_t global_nx,
-                     std::int64_t global_ny)
-        : CollectiveDecomposition(comm), block_(blocks[static_cast<std::size_t>(rank)]) {
+    BlockDistribution(MPI_Comm comm, int rank, const std::vector<Rect> &blocks, std::int64_t global_nx,
+                      std::int64_t global_ny)
+        : CollectiveDistribution(comm), block_(blocks[static_cast<std::size_t>(rank)]) {
         halo_.resize(kHaloDepth, block_.ni, block_.nj);
         halo_.i0 = block_.i0;
         halo_.j0 = block_.j0;
@@ -126,23 +129,22 @@ public:
         requests_.resize(2 * neighbours_.size());
     }
 
-    StepAgreement agree_before_step(Grid &grid, double dt, bool refused) override {
+    StepAgreement agree_before_step(Grid &grid, const Engine &engine, double dt, bool refused) override {
         // Everything as a maximum: minima are maxima of the negated values.
         const double none = -std::numeric_limits<double>::infinity();
         const bool open = grid.has_open_cells();
         const std::vector<double> v =
             agree_on_step(grid, dt, refused,
-                          {grid.source_active() ? 1.0 : 0.0, open ? 1.0 : 0.0,
-                           grid.active_set().may_move() ? 1.0 : 0.0,
-                           grid.masks_version() != exchanged_masks_ ? 1.0 : 0.0, open ? -grid.open_level_min() : none,
+                          {grid.source_active() ? 1.0 : 0.0, open ? 1.0 : 0.0, engine.may_move(grid) ? 1.0 : 0.0,
+                           masks_changed_ ? 1.0 : 0.0, open ? -grid.open_level_min() : none,
                            open ? grid.open_level_max() : none, -grid.own_min_repose_angle(),
-                           grid.side_levels_version() != exchanged_levels_ ? 1.0 : 0.0});
+                           sides_changed_ ? 1.0 : 0.0});
         grid.set_distributed_min_repose_angle(-v[6]);
         if (v[3] != 0.0) exchange_masks(grid);
         if (v[7] != 0.0) assemble_side_levels(grid);
         StepAgreement state;
         state.source_active = v[0] != 0.0;
-        // Lazy sources (structured/tiled_sweep.hpp): the halo carries each cell's clock.
+        // Lazy sources (structured/lazy_sources.hpp): the halo carries each cell's clock.
         lazy_sources_ = state.source_active && !grid.uses_physics();
         state.has_open_cells = v[1] != 0.0;
         state.may_move = v[2] != 0.0;
@@ -158,15 +160,29 @@ public:
         return state;
     }
 
-    void before_sweep(Grid &grid) override {
-        ActiveSet &active = grid.active_set();
+    void agree_on_substeps(std::vector<SubstepSummary> &levels) const override {
+        CollectiveDistribution::agree_on_substeps(levels);
+    }
+    DistributedPlace place() const override { return {halo_.global_nx, halo_.global_ny, halo_.i0, halo_.j0}; }
+    // A block refreshes its halo before every sweep.
+    double substeps_per_exchange(const Grid &) const override { return 1.0; }
+
+    void changed(const Grid &, unsigned what, const ChangedCells *) override {
+        if (what & (kMasksChanged | kSourcesChanged)) masks_changed_ = true;
+        if (what & kSidesChanged) sides_changed_ = true;
+    }
+
+    const HaloStore &store() const override { return halo_; }
+
+    void before_sweep(const Grid &grid, StructuredState &state) override {
+        ActiveSet &active = *state.active;
         const std::vector<double> &h = grid.heights();
         const std::vector<float> &res = grid.residuals();
         const std::vector<std::uint8_t> &moving = grid.moving();
         const bool hysteresis = grid.hysteresis();  // the same on every rank (agree_before_step)
         const bool lazy = lazy_sources_;
-        const std::vector<double> &clock = grid.source_clock();
-        const double base = grid.clock_base();
+        const std::vector<double> &clock = state.clock;
+        const double base = state.clock_base;
         const int per_cell = 2 + (hysteresis ? 1 : 0) + (lazy ? 1 : 0);
         for (std::size_t k = 0; k < neighbours_.size(); ++k) {
             Neighbour &n = neighbours_[k];
@@ -208,8 +224,7 @@ public:
             check_mpi(MPI_Isend(out.data(), static_cast<int>(out.size()), MPI_DOUBLE, n.rank, kTagHeights, comm_,
                                 &requests_[neighbours_.size() + k]),
                       "MPI_Isend of the halo");
-            messages_sent_ += 1.0;
-            bytes_sent_ += static_cast<double>(out.size() * sizeof(double));
+            count_message(static_cast<double>(out.size() * sizeof(double)));
         }
         check_mpi(MPI_Waitall(static_cast<int>(requests_.size()), requests_.data(), MPI_STATUSES_IGNORE),
                   "MPI_Waitall of the halo");
@@ -275,7 +290,7 @@ private:
             halo_.side_levels[side].assign(next, next + along[side]);
             next += along[side];
         }
-        exchanged_levels_ = grid.side_levels_version();
+        sides_changed_ = false;
     }
 
     // The halo's kinds, sources, bed and angles, and the boxes of its cells with a source.
@@ -300,8 +315,7 @@ private:
             check_mpi(MPI_Isend(out.data(), static_cast<int>(out.size()), MPI_DOUBLE, n.rank, kTagMasks, comm_,
                                 &requests_[neighbours_.size() + k]),
                       "MPI_Isend of the halo's cell kinds and sources");
-            messages_sent_ += 1.0;
-            bytes_sent_ += static_cast<double>(out.size() * sizeof(double));
+            count_message(static_cast<double>(out.size() * sizeof(double)));
         }
         check_mpi(MPI_Waitall(static_cast<int>(requests_.size()), requests_.data(), MPI_STATUSES_IGNORE),
                   "MPI_Waitall of the halo's cell kinds and sources");
@@ -322,16 +336,18 @@ private:
                 }
             if (!sources.empty()) remote_sources_.push_back(sources);
         }
-        exchanged_masks_ = grid.masks_version();
+        masks_changed_ = false;
     }
 
+    HaloStore halo_;
     Rect block_;
     std::vector<Neighbour> neighbours_;
     std::vector<MPI_Request> requests_;
     std::vector<CellBox> remote_hot_, remote_sources_;
     bool lazy_sources_ = false;  // this step applies sources lazily (agree_before_step)
-    std::uint64_t exchanged_masks_ = std::numeric_limits<std::uint64_t>::max();  // none yet
-    std::uint64_t exchanged_levels_ = std::numeric_limits<std::uint64_t>::max();  // none yet
+    // A host changed kinds, sources, bed or angles (the halo's copies), or
+    // sides and their levels, on this rank since the last exchange (none yet).
+    bool masks_changed_ = true, sides_changed_ = true;
 };
 
 // What each rank passes to dpsm_create_2d_mpi, gathered on every rank.
@@ -443,19 +459,12 @@ template <class Build>
 dpsm_grid *distributed_grid(MPI_Comm comm, int rank, const std::vector<Rect> &blocks, std::int64_t nx_global,
                             std::int64_t ny_global, Build &&build, const char *fn) {
     std::unique_ptr<dpsm_grid> made;
-    int failed = 0;
-    try {
-        made = build();
-    } catch (const std::bad_alloc &) {
-        failed = 1;
-    }
-    check_mpi(MPI_Allreduce(MPI_IN_PLACE, &failed, 1, MPI_INT, MPI_MAX, comm), "MPI_Allreduce");
-    if (failed) fail(DPSM_ERR_OUT_OF_MEMORY, fn, "out of memory for the block on some rank");
+    on_every_rank(Communicator(comm), fn, [&] { made = build(); });
     MPI_Comm own = MPI_COMM_NULL;
     check_mpi(MPI_Comm_dup(comm, &own), "MPI_Comm_dup");
     MPI_Comm_set_errhandler(own, MPI_ERRORS_RETURN);
     try {
-        made->core.set_decomposition(std::make_unique<MpiDecomposition>(own, rank, blocks, nx_global, ny_global));
+        made->core.set_distribution(std::make_unique<BlockDistribution>(own, rank, blocks, nx_global, ny_global));
     } catch (...) {
         MPI_Comm_free(&own);
         throw;
@@ -467,7 +476,7 @@ int create_distributed(MPI_Comm comm, std::int64_t nx_global, std::int64_t ny_gl
                        std::int64_t j0, std::int64_t nx_local, std::int64_t ny_local, double dx, double dy,
                        dpsm_grid **out, const char *fn) noexcept {
     if (out) *out = nullptr;
-    return without_grid(fn, [&] {
+    return guarded(nullptr, fn, [&] {
         int rank = 0, size = 0;
         check_communicator(comm, fn, rank, size);
         const Arguments mine{nx_global, ny_global, i0, j0, nx_local, ny_local, out == nullptr ? 1 : 0, dx, dy};
@@ -489,42 +498,34 @@ std::string hex64(std::uint64_t v) {
 // any grid is made: every rank fails alike, none waits.
 int load_distributed(MPI_Comm comm, const char *path, dpsm_grid **out, const char *fn) noexcept {
     if (out) *out = nullptr;
-    return without_grid(fn, [&] {
+    return guarded(nullptr, fn, [&] {
         int rank = 0, size = 0;
         check_communicator(comm, fn, rank, size);
         Geometry geometry{};
         GridState state;
         RestartBlock block;
-        int status = DPSM_OK;
-        std::string reason;
-        try {
-            if (!path) fail(DPSM_ERR_NULL_POINTER, fn, "path is NULL");
-            if (!out) fail(DPSM_ERR_NULL_POINTER, fn, "out is NULL");
-            load_restart(path, geometry, state, block, fn);
-            if (!block.present)
-                fail(DPSM_ERR_NOT_APPLICABLE, fn, path,
-                     " holds a grid of its own, not a block of a distributed grid; load it with dpsm_load");
-            if (block.ranks != size)
-                fail(DPSM_ERR_INVALID_SIZE, fn, path, " holds a block of a grid saved on ", block.ranks,
-                     " ranks; this communicator has ", size, " (load a distributed grid on as many ranks as saved it)");
-            if (block.rank != rank)
-                fail(DPSM_ERR_INVALID_VALUE, fn, path, " holds the block of rank ", block.rank, "; this is rank ", rank,
-                     " (each rank loads the file it saved)");
-        } catch (const Error &e) {
-            status = e.status();
-            reason = e.what();
-        } catch (const std::bad_alloc &) {
-            status = DPSM_ERR_OUT_OF_MEMORY;
-            reason = std::string(fn) + ": out of memory for the file";
-        }
-        std::vector<int> statuses(static_cast<std::size_t>(size));
-        check_mpi(MPI_Allgather(&status, 1, MPI_INT, statuses.data(), 1, MPI_INT, comm), "MPI_Allgather of the statuses");
-        if (status != DPSM_OK) throw Error(status, reason);
-        for (int r = 0; r < size; ++r)
-            if (statuses[static_cast<std::size_t>(r)] != DPSM_OK)
-                fail(statuses[static_cast<std::size_t>(r)], fn, "rank ", r, " could not load its file (",
-                     dpsm_status_string(statuses[static_cast<std::size_t>(r)]),
-                     "; its dpsm_last_error(NULL) says why), so no rank loaded");
+        on_every_rank(
+            Communicator(comm), fn,
+            [&] {
+                if (!path) fail(DPSM_ERR_NULL_POINTER, fn, "path is NULL");
+                if (!out) fail(DPSM_ERR_NULL_POINTER, fn, "out is NULL");
+                load_restart(path, geometry, state, block, fn);
+                if (!block.present)
+                    fail(DPSM_ERR_NOT_APPLICABLE, fn, path,
+                         " holds a grid of its own, not a block of a distributed grid; load it with dpsm_load");
+                if (block.ranks != size)
+                    fail(DPSM_ERR_INVALID_SIZE, fn, path, " holds a block of a grid saved on ", block.ranks,
+                         " ranks; this communicator has ", size,
+                         " (load a distributed grid on as many ranks as saved it)");
+                if (block.rank != rank)
+                    fail(DPSM_ERR_INVALID_VALUE, fn, path, " holds the block of rank ", block.rank, "; this is rank ",
+                         rank, " (each rank loads the file it saved)");
+            },
+            [&](const Failure &failure) {
+                return std::string(fn) + ": rank " + std::to_string(failure.rank) + " could not load its file (" +
+                       dpsm_status_string(failure.status) +
+                       "; its dpsm_last_error(NULL) says why), so no rank loaded";
+            });
 
         std::vector<std::uint64_t> marks(static_cast<std::size_t>(size));
         check_mpi(MPI_Allgather(&block.save_mark, 1, MPI_UINT64_T, marks.data(), 1, MPI_UINT64_T, comm),

@@ -2,9 +2,11 @@
 // one rank's part, the cells it owns and the ghost cells around them that
 // other ranks own. The mesh engine runs the part as it runs any mesh, over
 // its owned cells and the faces that touch them (mesh/mesh_engine.cpp); this
-// file is its Decomposition (mpi/decomposition.hpp):
+// file is its Distribution (model/distribution.hpp) and its GhostExchange
+// (mesh/ghost_exchange.hpp), which moves whatever the engine asks for
+// (mesh/mesh_parts.hpp):
 //
-//  - construction: every rank builds its part (mesh/mesh.cpp), then the ranks
+//  - construction: every rank builds its part (model/mesh_part.cpp), then the ranks
 //    check together that the owners agree (each global id owned once, every
 //    ghost held by the rank that claims to own it, faces seen alike from both
 //    sides), learn each ghost's neighbours and face count from its owner, and
@@ -13,9 +15,8 @@
 //    distance). Each cell's faces and gradient neighbours are summed in the
 //    order of their global ids, so an owned cell is computed from the same
 //    values by the same arithmetic as in the serial mesh: bit for bit;
-//  - sub-steps: two exchanges with the ranks that own this part's ghosts or
-//    hold its cells as ghosts: the owned cells' gradients (for the faces
-//    between an owned cell and a ghost) and, after the update, their heights.
+//  - sub-steps: exchanges with the ranks that own this part's ghosts or
+//    hold its cells as ghosts (mesh/mesh_parts.hpp says which values).
 //    Only values that changed since they were last sent travel, one
 //    synchronous message per neighbour that has any, and a non-blocking
 //    barrier tells every rank that all messages arrived; a part at rest
@@ -30,7 +31,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
-#include <cstdlib>
 #include <limits>
 #include <memory>
 #include <sstream>
@@ -39,15 +39,18 @@
 #include <utility>
 #include <vector>
 
+#include "api/guarded.hpp"
 #include "api/handle.hpp"
 #include "dpsm/dpsm.h"
 #include "dpsm/dpsm_mpi.h"
-#include "mesh/mesh.hpp"
-#include "mesh/mesh_engine.hpp"
+#include "mesh/ghost_exchange.hpp"
+#include "mesh/mesh_parts.hpp"
+#include "model/engine.hpp"
 #include "model/error.hpp"
 #include "model/grid.hpp"
+#include "model/mesh_part.hpp"
+#include "model/switches.hpp"
 #include "mpi/collective.hpp"
-#include "mpi/decomposition.hpp"
 #include "mpi/distributed_mesh.hpp"
 
 namespace dpsm {
@@ -68,48 +71,6 @@ struct CellLists {
         cells.insert(cells.end(), list.begin(), list.end());
     }
 };
-
-// The first failure of any rank, told to every rank: each passes its own
-// status and message; when any failed, every rank throws the lowest failing
-// rank's status, with its message (the others add which rank it was).
-void agree_or_throw(MPI_Comm comm, int status, const std::string &message, const char *fn) {
-    int rank = 0, size = 1;
-    MPI_Comm_rank(comm, &rank);
-    MPI_Comm_size(comm, &size);
-    std::vector<int> statuses(static_cast<std::size_t>(size));
-    check_mpi(MPI_Allgather(&status, 1, MPI_INT, statuses.data(), 1, MPI_INT, comm), "MPI_Allgather of the statuses");
-    int first = -1;
-    for (int r = 0; r < size && first < 0; ++r)
-        if (statuses[static_cast<std::size_t>(r)] != DPSM_OK) first = r;
-    if (first < 0) return;
-    int length = rank == first ? static_cast<int>(message.size()) : 0;
-    check_mpi(MPI_Bcast(&length, 1, MPI_INT, first, comm), "MPI_Bcast of a message");
-    std::string text = rank == first ? message : std::string(static_cast<std::size_t>(length), ' ');
-    check_mpi(MPI_Bcast(&text[0], length, MPI_CHAR, first, comm), "MPI_Bcast of a message");
-    if (rank == first) throw Error(statuses[static_cast<std::size_t>(first)], text);
-    const std::string prefix = std::string(fn) + ": ";
-    if (text.compare(0, prefix.size(), prefix) == 0) text = text.substr(prefix.size());
-    throw Error(statuses[static_cast<std::size_t>(first)], std::string(fn) + ": on rank " + std::to_string(first) +
-                                                              ": " + text);
-}
-
-// Runs `body`, which may throw Error, on this rank; then every rank learns
-// whether any failed and throws alike.
-template <class Body>
-void on_every_rank(MPI_Comm comm, const char *fn, Body &&body) {
-    int status = DPSM_OK;
-    std::string message;
-    try {
-        body();
-    } catch (const Error &e) {
-        status = e.status();
-        message = e.what();
-    } catch (const std::bad_alloc &) {
-        status = DPSM_ERR_OUT_OF_MEMORY;
-        message = std::string(fn) + ": out of memory for this rank's part";
-    }
-    agree_or_throw(comm, status, message, fn);
-}
 
 // Sends each rank r the values `to[r]` and returns what every rank sent this
 // one, by rank (an all-to-all of counts, then of the values).
@@ -196,7 +157,7 @@ PartLinks link_parts(MPI_Comm comm, Mesh &m, const std::vector<int> &owner_of_ce
 
     // Each global id in [0, n_global), owned once, its ghosts held by their owner:
     // checked at a home rank for every id (id % size).
-    on_every_rank(comm, fn, [&] {
+    on_every_rank(Communicator(comm), fn, [&] {
         for (std::int64_t c = 0; c < m.cells; ++c)
             if (m.global_id[c] >= n_global)
                 fail(DPSM_ERR_INVALID_VALUE, fn, name_cell(m, c), ": its global id is beyond ",
@@ -211,7 +172,7 @@ PartLinks link_parts(MPI_Comm comm, Mesh &m, const std::vector<int> &owner_of_ce
         to.push_back(owner_of_cell[static_cast<std::size_t>(c)]);
     }
     const std::vector<std::vector<std::int64_t>> at_home = all_to_all(comm, claims);
-    on_every_rank(comm, fn, [&] {
+    on_every_rank(Communicator(comm), fn, [&] {
         std::unordered_map<std::int64_t, int> owner;
         for (int r = 0; r < size; ++r) {
             const std::vector<std::int64_t> &v = at_home[static_cast<std::size_t>(r)];
@@ -290,7 +251,7 @@ PartLinks link_parts(MPI_Comm comm, Mesh &m, const std::vector<int> &owner_of_ce
     std::vector<std::int64_t> ghost_start(nghosts + 1, 0), ghost_neighbours;
     std::vector<double> ghost_faces(nghosts, 0.0);
     std::vector<std::vector<std::int64_t>> neighbours_of(nghosts);
-    on_every_rank(comm, fn, [&] {
+    on_every_rank(Communicator(comm), fn, [&] {
         for (int r = 0; r < size; ++r) {
             const std::vector<std::int64_t> &v = told[static_cast<std::size_t>(r)];
             std::size_t k = 0;
@@ -351,8 +312,7 @@ PartLinks link_parts(MPI_Comm comm, Mesh &m, const std::vector<int> &owner_of_ce
         for (std::int64_t k = m.cell_face_start[c]; k < m.cell_face_start[c + 1]; ++k) edges += m.other[k] < 0;
         most[1] = std::max(most[1], edges);
     }
-    if (const char *limit = std::getenv("DPSM_MPI_SUBSTEPS_PER_EXCHANGE"))
-        if (*limit) most[0] = std::max(most[0], -std::max(0, std::atoi(limit)));
+    if (const int limit = read_switches().mpi_substeps_per_exchange; limit >= 0) most[0] = std::max(most[0], -limit);
     check_mpi(MPI_Allreduce(MPI_IN_PLACE, most, 2, MPI_INT, MPI_MAX, comm), "MPI_Allreduce of the ghost layers' reach");
     m.substeps_per_exchange = -most[0];
     links.edge_faces = most[1];
@@ -369,44 +329,29 @@ PartLinks link_parts(MPI_Comm comm, Mesh &m, const std::vector<int> &owner_of_ce
     return links;
 }
 
-class MeshPartDecomposition final : public CollectiveDecomposition {
+class MeshPartDistribution final : public CollectiveDistribution, public GhostExchange {
 public:
     // `comm` is this part's own duplicate; `neighbours` its distributed-graph
     // communicator over the ranks in `links` (both freed with it).
-    MeshPartDecomposition(MPI_Comm comm, MPI_Comm neighbours, PartLinks links, std::int64_t owned)
-        : CollectiveDecomposition(comm),
+    MeshPartDistribution(MPI_Comm comm, MPI_Comm neighbours, PartLinks links, std::int64_t owned)
+        : CollectiveDistribution(comm),
           neighbours_(neighbours),
           links_(std::move(links)),
-          height_slots_(links_.send_heights, owned),
-          gradient_slots_(links_.send_gradients, owned),
-          sent_h_(links_.send_heights.cells.size(), 0.0),
-          sent_moving_(links_.send_heights.cells.size(), 0.0),
-          sent_residual_(links_.send_heights.cells.size(), 0.0),
-          sent_gx_(links_.send_gradients.cells.size(), 0.0),
-          sent_gy_(links_.send_gradients.cells.size(), 0.0) {
-        // Ghosts' gradients start at 0 on every rank (mesh_engine.cpp), as sent_gx_ and sent_gy_ do.
-        // What dpsm_save records of the part's place (io/restart.cpp: kMeshPart).
-        halo_.global_nx = links_.global_cells;
-        halo_.global_ny = 1;
-    }
+          slots_{SendSlots(links_.send_heights, owned), SendSlots(links_.send_gradients, owned)} {}
 
-    ~MeshPartDecomposition() override {
+    ~MeshPartDistribution() override {
         int finalized = 0;
         MPI_Finalized(&finalized);
         if (!finalized) MPI_Comm_free(&neighbours_);
     }
 
-    StepAgreement agree_before_step(Grid &grid, double dt, bool refused) override {
-        std::vector<double> flags = {grid.masks_version() != exchanged_masks_ ? 1.0 : 0.0,
-                                     grid.heights_version() != exchanged_heights_ ? 1.0 : 0.0,
+    StepAgreement agree_before_step(Grid &grid, const Engine &engine, double dt, bool refused) override {
+        std::vector<double> flags = {masks_changed_ ? 1.0 : 0.0, heights_changed_ ? 1.0 : 0.0,
                                      static_cast<double>(grid.relaxation())};
-        const std::vector<double> state = local_state(grid);
+        const std::vector<double> state = local_state(grid, engine);
         flags.insert(flags.end(), state.begin(), state.end());
         // Whether a host changed edge kinds or levels (read on the ghosts' edge faces when they are stepped here).
-        flags.push_back(steps_ghosts(grid) && (grid.edges_version() != exchanged_edges_ ||
-                                         grid.side_levels_version() != exchanged_levels_)
-                            ? 1.0
-                            : 0.0);
+        flags.push_back(steps_ghosts(grid) && sides_changed_ ? 1.0 : 0.0);
         // The relaxation mode: every rank steps in time or every rank relaxes.
         flags.push_back(-static_cast<double>(grid.relaxation()));
         std::vector<double> v = agree_on_step(grid, dt, refused, flags);
@@ -415,17 +360,18 @@ public:
                                                 "(dpsm_set_relaxation); every rank must step the same way");
         const bool edges_changed = v[v.size() - 2] != 0.0;
         std::vector<double> agreed(v.begin() + 3, v.end() - 2);
-        if (edges_changed) exchange_edges(grid);
+        if (edges_changed) take_owners_edges(grid, *this, links_.edge_faces);
         if (v[0] != 0.0 || v[1] != 0.0) {
             // A host changed something on some rank: the ghosts take their owners' values, then the flags again.
-            if (v[0] != 0.0) exchange_masks(grid);
-            send_all_heights(grid);
-            exchanged_heights_ = grid.heights_version();
-            agreed = local_state(grid);
+            if (v[0] != 0.0) take_owners_masks(grid, *this);
+            take_owners_heights(grid, *this);
+            agreed = local_state(grid, engine);
             check_mpi(MPI_Allreduce(MPI_IN_PLACE, agreed.data(), static_cast<int>(agreed.size()), MPI_DOUBLE, MPI_MAX,
                                     comm_),
                       "MPI_Allreduce before dpsm_step");
         }
+        // What the ghosts took from their owners is no edit of this rank's host.
+        masks_changed_ = heights_changed_ = sides_changed_ = false;
         grid.set_distributed_min_repose_angle(-agreed[5]);
         StepAgreement out;
         out.source_active = agreed[0] != 0.0;
@@ -440,10 +386,7 @@ public:
         return out;
     }
 
-    void before_sweep(Grid &) override {}
-
-    // Whether this part steps the ghosts in reach (several sub-steps per exchange, Mesh::reach).
-    static bool steps_ghosts(const Grid &grid) { return grid.geometry().mesh->substeps_per_exchange > 0; }
+    DistributedPlace place() const override { return {links_.global_cells, 1, 0, 0}; }
 
     // K sub-steps per exchange where the ghost layer allows K >= 1, else an
     // exchange of gradients and one of heights in every sub-step.
@@ -452,68 +395,89 @@ public:
         return k > 0 ? static_cast<double>(k) : 0.5;
     }
 
+    void changed(const Grid &, unsigned what, const ChangedCells *) override {
+        if (what & (kMasksChanged | kSourcesChanged)) masks_changed_ = true;
+        if (what & kCellsChanged) heights_changed_ = true;
+        if (what & kSidesChanged) sides_changed_ = true;
+        if (what & (kCellsChanged | kMasksChanged | kSidesChanged)) held_.known = false;
+    }
+
     // Point-to-point, each value only when it changed since it was last sent
     // (the ghost's copy on the other rank is then that value): a part whose
     // cells near its neighbours are at rest sends nothing.
-    void exchange_ghost_gradients(Grid &, double *gx, double *gy, const std::vector<std::int64_t> *computed,
-                                  std::vector<std::int64_t> &changed_ghosts) override {
-        send_changes(links_.send_gradients, gradient_slots_, computed, 2, kTagGradients,
+    void send_changed(Ghosts ghosts, const std::vector<GhostField> &fields, const std::vector<std::int64_t> *computed,
+                      std::vector<std::int64_t> &changed_ghosts) override {
+        const CellLists &send = ghosts == kEveryGhost ? links_.send_heights : links_.send_gradients;
+        const CellLists &receive = ghosts == kEveryGhost ? links_.receive_heights : links_.receive_gradients;
+        std::vector<std::vector<double>> &sent = sent_[ghosts];
+        std::vector<std::size_t> present;
+        for (std::size_t k = 0; k < fields.size(); ++k)
+            if (fields[k].present()) present.push_back(k);
+        if (sent.size() < fields.size()) sent.resize(fields.size());
+        for (const std::size_t k : present) sent[k].resize(send.cells.size(), 0.0);
+        const int width = static_cast<int>(present.size());
+        send_changes(send, slots_[ghosts], computed, width, kTags[ghosts],
                      [&](std::size_t slot, std::int64_t c, double *out) {
-                         if (gx[c] == sent_gx_[slot] && gy[c] == sent_gy_[slot]) return false;
-                         out[0] = sent_gx_[slot] = gx[c];
-                         out[1] = sent_gy_[slot] = gy[c];
+                         bool differs = false;
+                         for (const std::size_t k : present) differs = differs || fields[k].get(c) != sent[k][slot];
+                         if (!differs) return false;
+                         for (std::size_t j = 0; j < present.size(); ++j)
+                             out[j] = sent[present[j]][slot] = fields[present[j]].get(c);
                          return true;
                      });
-        receive_changes(links_.receive_gradients, 2, kTagGradients, [&](std::int64_t c, const double *in) {
-            gx[c] = in[0];
-            gy[c] = in[1];
-            changed_ghosts.push_back(c);
+        receive_changes(receive, width, kTags[ghosts], [&](std::int64_t c, const double *in) {
+            // A ghost stepped here already holds its owner's values: it changed only beyond reach.
+            bool differs = false;
+            for (std::size_t j = 0; j < present.size(); ++j) {
+                const GhostField &field = fields[present[j]];
+                differs = differs || field.get(c) != unpacked(field, in[j]);
+                field.set(c, in[j]);
+            }
+            if (differs) changed_ghosts.push_back(c);
         });
     }
 
-    void exchange_ghost_heights(Grid &grid, const std::vector<std::int64_t> *computed,
-                                std::vector<std::int64_t> &changed_ghosts) override {
-        std::vector<double> &h = grid.heights_for_stepping();
-        std::vector<float> &residual = grid.residuals_for_stepping();
-        const bool hysteresis = grid.hysteresis();
-        std::vector<std::uint8_t> &moving = grid.moving_for_stepping();
-        // A part that steps its ghosts needs their residuals too (the next
-        // update adds to them), in the message's last place.
-        const bool residuals = steps_ghosts(grid);
-        const int width = 1 + hysteresis + residuals;
-        send_changes(links_.send_heights, height_slots_, computed, width, kTagHeights,
-                     [&](std::size_t slot, std::int64_t c, double *out) {
-                         const double flag = hysteresis ? moving[c] : 0.0;
-                         const double rest = residuals ? residual[c] : 0.0;
-                         if (h[c] == sent_h_[slot] && flag == sent_moving_[slot] && rest == sent_residual_[slot])
-                             return false;
-                         out[0] = sent_h_[slot] = h[c];
-                         if (hysteresis) out[1] = sent_moving_[slot] = flag;
-                         if (residuals) out[width - 1] = sent_residual_[slot] = rest;
-                         return true;
-                     });
-        receive_changes(links_.receive_heights, width, kTagHeights, [&](std::int64_t c, const double *in) {
-            // A ghost stepped here already holds its owner's values: it changed only beyond reach.
-            const bool changed = h[c] != in[0] || (hysteresis && moving[c] != in[1]) ||
-                                 (residuals && residual[c] != static_cast<float>(in[width - 1]));
-            h[c] = in[0];
-            if (hysteresis) moving[c] = static_cast<std::uint8_t>(in[1]);
-            if (residuals) residual[c] = static_cast<float>(in[width - 1]);
-            if (changed) changed_ghosts.push_back(c);
-        });
+    // One neighbourhood all-to-all of the fields' values of every listed cell.
+    void send_all(Ghosts ghosts, const std::vector<GhostField> &fields, bool remember) override {
+        const CellLists &send = ghosts == kEveryGhost ? links_.send_heights : links_.send_gradients;
+        const CellLists &receive = ghosts == kEveryGhost ? links_.receive_heights : links_.receive_gradients;
+        std::vector<std::size_t> present;
+        for (std::size_t k = 0; k < fields.size(); ++k)
+            if (fields[k].present()) present.push_back(k);
+        exchange(send, receive, static_cast<int>(present.size()),
+                 [&](std::int64_t c, double *out) {
+                     for (std::size_t j = 0; j < present.size(); ++j) out[j] = fields[present[j]].get(c);
+                 },
+                 [&](std::int64_t c, const double *in) {
+                     for (std::size_t j = 0; j < present.size(); ++j) fields[present[j]].set(c, in[j]);
+                 });
+        if (!remember) return;
+        std::vector<std::vector<double>> &sent = sent_[ghosts];
+        if (sent.size() < fields.size()) sent.resize(fields.size());
+        for (const std::size_t k : present) {
+            sent[k].resize(send.cells.size());
+            for (std::size_t slot = 0; slot < send.cells.size(); ++slot) sent[k][slot] = fields[k].get(send.cells[slot]);
+        }
     }
 
 private:
+    // A value as a field holds it once received (a float or a byte rounds).
+    static double unpacked(const GhostField &field, double value) {
+        if (field.f64) return value;
+        if (field.f32) return static_cast<double>(static_cast<float>(value));
+        return static_cast<double>(static_cast<std::uint8_t>(value));
+    }
+
     // This rank's figures for the step's agreement, each as a maximum (minima
     // negated): a source, open cells, something that may move, the lowest and
     // highest open cell, the smallest angle, the open edge faces' levels, an
     // open edge. Over its owned cells and the faces that touch them.
-    std::vector<double> local_state(const Grid &grid) {
+    std::vector<double> local_state(const Grid &grid, const Engine &engine) {
         const HeldLevels &held = held_levels(grid);
         const double none = -std::numeric_limits<double>::infinity();
         return {grid.source_active() ? 1.0 : 0.0,
                 held.open ? 1.0 : 0.0,
-                grid.mesh_activity().may_move() ? 1.0 : 0.0,
+                engine.may_move(grid) ? 1.0 : 0.0,
                 held.open ? -held.open_lo : none,
                 held.open ? held.open_hi : none,
                 -grid.own_min_repose_angle(),
@@ -527,17 +491,14 @@ private:
     // change neither (open cells are not stepped): they are found again only
     // when a host set heights, masks, edges or levels, not at every step.
     struct HeldLevels {
-        std::uint64_t heights = 0, masks = 0, edges = 0, levels = 0;
         bool known = false, open = false, edge = false;
         double open_lo = 0.0, open_hi = 0.0, edge_lo = 0.0, edge_hi = 0.0;
     };
     const HeldLevels &held_levels(const Grid &grid) {
         HeldLevels &h = held_;
-        if (h.known && h.heights == grid.heights_version() && h.masks == grid.masks_version() &&
-            h.edges == grid.edges_version() && h.levels == grid.side_levels_version())
-            return h;
-        h = HeldLevels{grid.heights_version(), grid.masks_version(), grid.edges_version(), grid.side_levels_version(),
-                       true};
+        if (h.known) return h;
+        h = HeldLevels{};
+        h.known = true;
         const Mesh &m = *grid.geometry().mesh;
         if (grid.has_open_cells()) {
             const std::vector<std::uint8_t> &kind = grid.kinds();
@@ -558,75 +519,6 @@ private:
             h.edge = true;
         }
         return h;
-    }
-
-    // Every ghost's height (and moving flag) from its owner, after a host
-    // changed heights on some rank; the ghosts that changed wake the owned
-    // cells that read them, and what was sent is what the ghosts now hold.
-    void send_all_heights(Grid &grid) {
-        std::vector<double> &h = grid.heights_for_stepping();
-        std::vector<float> &residual = grid.residuals_for_stepping();
-        std::vector<std::uint8_t> &moving = grid.moving_for_stepping();
-        const bool hysteresis = grid.hysteresis();
-        const Mesh &m = *grid.geometry().mesh;
-        const bool residuals = steps_ghosts(grid);
-        MeshActivity &activity = grid.mesh_activity();
-        exchange(links_.send_heights, links_.receive_heights, 3,
-                 [&](std::int64_t c, double *out) {
-                     out[0] = h[c], out[1] = hysteresis ? moving[c] : 0.0, out[2] = residuals ? residual[c] : 0.0;
-                 },
-                 [&](std::int64_t c, const double *in) {
-                     const bool changed = h[c] != in[0] || (hysteresis && moving[c] != in[1]);
-                     h[c] = in[0];
-                     if (hysteresis) moving[c] = static_cast<std::uint8_t>(in[1]);
-                     if (residuals) residual[c] = static_cast<float>(in[2]);
-                     if (changed) activity.wake_around(m, c);
-                 });
-        for (std::size_t slot = 0; slot < links_.send_heights.cells.size(); ++slot) {
-            const std::int64_t c = links_.send_heights.cells[slot];
-            sent_h_[slot] = h[c];
-            sent_moving_[slot] = hysteresis ? moving[c] : 0.0;
-            sent_residual_[slot] = residuals ? residual[c] : 0.0;
-        }
-    }
-
-    // The kinds and levels of the ghosts' faces on the domain edge from
-    // their owners, for the ghosts stepped here: each cell's edge faces in
-    // the order its sums take them (their midpoints), alike on both ranks
-    // when the ghost's faces are all here. Set as a host would set them.
-    void exchange_edges(Grid &grid) {
-        const Mesh &m = *grid.geometry().mesh;
-        const std::size_t most = static_cast<std::size_t>(links_.edge_faces);
-        const std::vector<double> &levels = grid.side_levels(0);
-        std::vector<std::uint8_t> open(static_cast<std::size_t>(m.faces));
-        for (std::int64_t f = 0; f < m.faces; ++f) open[f] = m.face_b[f] < 0 && grid.edge_open(f);
-        std::vector<double> level = levels.empty() ? std::vector<double>(static_cast<std::size_t>(m.faces), 0.0) : levels;
-        const auto edge_faces = [&](std::int64_t c, std::vector<std::int64_t> &out) {
-            out.clear();
-            for (std::int64_t k = m.cell_face_start[c]; k < m.cell_face_start[c + 1]; ++k)
-                if (m.other[k] < 0) out.push_back(m.cell_faces[k]);
-        };
-        std::vector<std::int64_t> faces;
-        const std::vector<std::uint8_t> open_before = open;
-        const std::vector<double> level_before = level;
-        if (most > 0)
-            exchange(links_.send_heights, links_.receive_heights, static_cast<int>(2 * most),
-                     [&](std::int64_t c, double *out) {
-                         edge_faces(c, faces);
-                         std::fill(out, out + 2 * most, 0.0);
-                         for (std::size_t k = 0; k < faces.size(); ++k)
-                             out[2 * k] = open[faces[k]], out[2 * k + 1] = level[faces[k]];
-                     },
-                     [&](std::int64_t c, const double *in) {
-                         if (m.reach[static_cast<std::size_t>(c)] < 1) return;  // not stepped here
-                         edge_faces(c, faces);
-                         for (std::size_t k = 0; k < faces.size(); ++k)
-                             open[faces[k]] = in[2 * k] != 0.0, level[faces[k]] = in[2 * k + 1];
-                     });
-        if (open != open_before) grid.set_edge_open(open.data());
-        if (level != level_before) grid.set_side_levels(0, level.data());
-        exchanged_edges_ = grid.edges_version();
-        exchanged_levels_ = grid.side_levels_version();
     }
 
     // Packs, for each neighbour, the listed cells' values that `pack(slot, c,
@@ -677,8 +569,7 @@ private:
             check_mpi(MPI_Issend(outgoing_[r].data(), static_cast<int>(outgoing_[r].size()), MPI_DOUBLE, send.ranks[r],
                                  tag, neighbours_, &sends_.back()),
                       "MPI_Issend of changed ghost values");
-            messages_sent_ += 1.0;
-            bytes_sent_ += static_cast<double>(outgoing_[r].size() * sizeof(double));
+            count_message(static_cast<double>(outgoing_[r].size() * sizeof(double)));
         }
     }
 
@@ -745,7 +636,7 @@ private:
         scaled(send, per_cell, send_counts_, send_offsets_);
         scaled(receive, per_cell, receive_counts_, receive_offsets_);
         for (const int count : send_counts_)
-            if (count > 0) messages_sent_ += 1.0, bytes_sent_ += static_cast<double>(count) * sizeof(double);
+            if (count > 0) count_message(static_cast<double>(count) * sizeof(double));
         check_mpi(MPI_Neighbor_alltoallv(send_buffer_.data(), send_counts_.data(), send_offsets_.data(), MPI_DOUBLE,
                                          receive_buffer_.data(), receive_counts_.data(), receive_offsets_.data(),
                                          MPI_DOUBLE, neighbours_),
@@ -765,57 +656,26 @@ private:
         }
     }
 
-    // The ghosts' kinds, sources, bed and angles from their owners, set as a
-    // host would set them (so that everything derived from them follows).
-    void exchange_masks(Grid &grid) {
-        const bool has_source = !grid.source().empty(), has_bed = !grid.bed().empty(),
-                   has_angles = !grid.angle_field().empty();
-        std::vector<std::uint8_t> kinds = grid.kinds();
-        std::vector<double> q = has_source ? grid.source() : std::vector<double>(kinds.size(), 0.0);
-        std::vector<double> zb = grid.bed(), theta = grid.angle_field();
-        const std::vector<double> &own_q = grid.source(), &own_zb = grid.bed(), &own_theta = grid.angle_field();
-        const std::vector<std::uint8_t> &own_kinds = grid.kinds();
-        bool any_source = false;
-        exchange(links_.send_heights, links_.receive_heights, 4,
-                 [&](std::int64_t c, double *out) {
-                     out[0] = own_kinds[c];
-                     out[1] = own_q.empty() ? 0.0 : own_q[c];
-                     out[2] = own_zb.empty() ? 0.0 : own_zb[c];
-                     out[3] = own_theta.empty() ? 0.0 : own_theta[c];
-                 },
-                 [&](std::int64_t c, const double *in) {
-                     kinds[c] = static_cast<std::uint8_t>(in[0]);
-                     q[c] = in[1];
-                     any_source = any_source || in[1] != 0.0;
-                     if (has_bed) zb[c] = in[2];
-                     if (has_angles) theta[c] = in[3];
-                 });
-        if (kinds != own_kinds) grid.set_cell_kinds(kinds.data());
-        if ((has_source && q != own_q) || (!has_source && any_source)) grid.set_source(q.data());
-        if (has_bed && zb != own_zb) grid.set_bed(zb.data());
-        if (has_angles && theta != own_theta) grid.set_angle_field(theta.data());
-        exchanged_masks_ = grid.masks_version();
-    }
-
-    static constexpr int kTagGradients = 1, kTagHeights = 2;
+    // Per set of ghosts (GhostExchange::Ghosts), the message tag of its values.
+    static constexpr int kTags[2] = {2, 1};
     // The first value of a message: (position, values) of the cells that
     // changed, or the values of every listed cell in order.
     static constexpr double kChangedCells = 0.0, kEveryCell = 1.0;
     MPI_Comm neighbours_;
     PartLinks links_;
-    // Per owned cell, the places it has in the lists sent to neighbours.
-    SendSlots height_slots_, gradient_slots_;
-    // Per place in those lists, the value last sent (the ghost's copy).
-    std::vector<double> sent_h_, sent_moving_, sent_residual_, sent_gx_, sent_gy_;
+    // Per set of ghosts and owned cell, the places it has in the lists sent to neighbours.
+    SendSlots slots_[2];
+    // Per set of ghosts, field and place in those lists, the value last sent
+    // (the ghost's copy; 0 before any, as the ghosts' gradients start).
+    std::vector<std::vector<double>> sent_[2];
     std::vector<std::vector<double>> outgoing_;
     std::vector<double> incoming_, whole_;
     std::vector<MPI_Request> sends_;
     std::vector<double> send_buffer_, receive_buffer_;
     std::vector<int> send_counts_, send_offsets_, receive_counts_, receive_offsets_;
-    std::uint64_t exchanged_masks_ = std::numeric_limits<std::uint64_t>::max();    // none yet
-    std::uint64_t exchanged_heights_ = std::numeric_limits<std::uint64_t>::max();  // none yet
-    std::uint64_t exchanged_edges_ = std::numeric_limits<std::uint64_t>::max();    // none yet
-    std::uint64_t exchanged_levels_ = std::numeric_limits<std::uint64_t>::max();   // none yet
+    // A host changed kinds, sources, bed or angles, heights, or edges and
+    // their levels on this rank since the ghosts last took them (none yet).
+    bool masks_changed_ = true, heights_changed_ = true, sides_changed_ = true;
     HeldLevels held_;
 };
 
@@ -828,7 +688,7 @@ dpsm_grid *part_grid(MPI_Comm comm, std::shared_ptr<Mesh> mesh, const char *fn, 
     for (std::int64_t c = 0; c < mesh->cells; ++c) owner_of_cell[c] = mesh->input.owner[mesh->host_cell[c]];
     PartLinks links = link_parts(comm, *mesh, owner_of_cell, fn);
     std::unique_ptr<dpsm_grid> made;
-    on_every_rank(comm, fn, [&] {
+    on_every_rank(Communicator(comm), fn, [&] {
         std::shared_ptr<const Mesh> done = mesh;
         made = std::make_unique<dpsm_grid>(Geometry{2, false, done->cells, 1, done->min_distance, done->min_distance, done});
         if (state) made->core.restore(std::move(*state));
@@ -845,7 +705,7 @@ dpsm_grid *part_grid(MPI_Comm comm, std::shared_ptr<Mesh> mesh, const char *fn, 
         MPI_Comm_free(&own);
         check_mpi(status, "MPI_Dist_graph_create_adjacent");
     }
-    made->core.set_decomposition(std::make_unique<MeshPartDecomposition>(own, neighbours, std::move(links), mesh->owned));
+    made->core.set_distribution(std::make_unique<MeshPartDistribution>(own, neighbours, std::move(links), mesh->owned));
     return made.release();
 }
 
@@ -892,11 +752,11 @@ template <class Build>
 int create_part(MPI_Comm comm, int start_index, std::int64_t ncells, const std::int64_t *global_id, const int *owner,
                 dpsm_grid **out, const char *fn, Build &&build) noexcept {
     if (out) *out = nullptr;
-    return without_grid(fn, [&] {
+    return guarded(nullptr, fn, [&] {
         int rank = 0, size = 0;
         check_communicator(comm, fn, rank, size);
         std::shared_ptr<Mesh> mesh;
-        on_every_rank(comm, fn, [&] {
+        on_every_rank(Communicator(comm), fn, [&] {
             const std::vector<std::uint8_t> ghost = ghosts_of_rank(comm, ncells, global_id, owner, out, start_index, fn);
             // From here on global ids count from 0 (the messages add start_index again).
             std::vector<std::int64_t> ids(global_id, global_id + ncells);

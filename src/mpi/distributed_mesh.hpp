@@ -7,12 +7,12 @@
 #include <memory>
 
 #include "api/handle.hpp"
-#include "mesh/mesh.hpp"
+#include "model/mesh_part.hpp"
 #include "model/grid.hpp"
 
 namespace dpsm {
 
-// Finishes a rank's part of a mesh (mesh/mesh.hpp: part_from_*, with its
+// Finishes a rank's part of a mesh (model/mesh.hpp: part_from_*, with its
 // input's global ids and owners) with the other ranks and makes its grid,
 // tied to a duplicate of `comm`; with `state`, the grid restores it.
 // Collective; throws Error on every rank alike.

@@ -6,15 +6,17 @@
 #include <sstream>
 #include <string>
 
-#include "mpi/decomposition.hpp"
 #include "dpsm/dpsm.h"
+#include "model/distribution.hpp"
 #include "model/error.hpp"
 #include "model/limits.hpp"
-#include "stepping/engine.hpp"
+#include "stepping/engine_for.hpp"
 
 namespace dpsm {
 
 double stable_dt(const Grid &grid) { return engine_for(grid).stable_dt(grid); }
+
+void read_face_fluxes(const Grid &grid, double *fx, double *fy) { engine_for(grid).read_face_fluxes(grid, fx, fy); }
 
 namespace {
 
@@ -74,7 +76,7 @@ void require_sources_within_range(Grid &grid, double dt, double reach) {
             if (!(std::fabs(reaches) <= kMaxMagnitude)) beyond = static_cast<std::int64_t>(c);
         }
     }
-    const bool anywhere = grid.decomposition() ? grid.global_sum(beyond >= 0 ? 1.0 : 0.0) > 0.0 : beyond >= 0;
+    const bool anywhere = grid.distribution() ? grid.global_sum(beyond >= 0 ? 1.0 : 0.0) > 0.0 : beyond >= 0;
     if (!anywhere) return;
     std::ostringstream msg;
     msg << "dpsm_step: dt = " << dt << " would carry ";
@@ -87,14 +89,14 @@ void require_sources_within_range(Grid &grid, double dt, double reach) {
     throw Error(DPSM_ERR_INVALID_VALUE, msg.str());
 }
 
-// What decides the step's work: the grid's own figures, or on a block of a
-// distributed grid the same figures over all blocks (mpi/decomposition.hpp).
-StepAgreement agree_before_step(Grid &grid, double dt) {
-    if (Decomposition *decomposition = grid.decomposition()) return decomposition->agree_before_step(grid, dt, false);
+// What decides the step's work: the grid's own figures, or on a part of a
+// distributed grid the same figures over all ranks (model/distribution.hpp).
+StepAgreement agree_before_step(Grid &grid, const Engine &engine, double dt) {
+    if (Distribution *distribution = grid.distribution()) return distribution->agree_before_step(grid, engine, dt, false);
     StepAgreement state;
     state.source_active = grid.source_active();
     state.has_open_cells = grid.has_open_cells();
-    state.may_move = engine_for(grid).may_move(grid);
+    state.may_move = engine.may_move(grid);
     state.open_level_min = grid.open_level_min();
     state.open_level_max = grid.open_level_max();
     state.side_level_min = grid.side_level_min();
@@ -103,26 +105,36 @@ StepAgreement agree_before_step(Grid &grid, double dt) {
     return state;
 }
 
+// A rank that refuses a step takes part in the step's first agreement,
+// refusing, so that the other ranks, which wait in it, fail too instead of
+// waiting for ever; its caller then reports its own reason.
+void take_part_refusing(Grid &grid) {
+    Distribution *distribution = grid.distribution();
+    if (!distribution) return;
+    try {
+        distribution->agree_before_step(grid, engine_for(grid), 0.0, true);
+    } catch (const Error &) {
+        // every rank throws; this one reports its own reason
+    }
+}
+
 }  // namespace
 
 void step(Grid &grid, double dt) {
+    if (!(std::isfinite(dt) && dt > 0.0)) {
+        take_part_refusing(grid);
+        if (!std::isfinite(dt)) fail(DPSM_ERR_INVALID_VALUE, "dpsm_step", "dt = ", dt, " is not finite");
+        fail(DPSM_ERR_INVALID_VALUE, "dpsm_step", "dt = ", dt, " must be positive");
+    }
     // The default advances the model's time by dt, as the time-accurate
     // steps do; relaxing straight to rest is a host's explicit choice.
     if (grid.relaxation() != kToRest) {
         step_in_time(grid, dt);
         return;
     }
-    // Not on a distributed grid (relax_to_rest refuses it): its peers may
-    // be waiting in the step's first agreement, so take part, refusing. A
-    // mesh relaxes by time-accurate sub-steps to rest, which its parts take together.
-    Decomposition *decomposition = grid.decomposition();
-    if (decomposition && !grid.geometry().is_mesh()) {
-        try {
-            decomposition->agree_before_step(grid, 0.0, true);
-        } catch (const Error &) {
-            // every rank throws; this one reports its own reason below
-        }
-    }
+    // Not on a distributed grid (relax_to_rest refuses it, below). A mesh
+    // relaxes by time-accurate sub-steps to rest, which its parts take together.
+    if (!grid.geometry().is_mesh()) take_part_refusing(grid);
     // No time scale: dt only says that time passed.
     double tried = 0.0;
     const std::int64_t budget = grid.max_substeps();
@@ -140,8 +152,9 @@ void step(Grid &grid, double dt) {
 void step_in_time(Grid &grid, double dt, std::int64_t most) {
     const Engine &engine = engine_for(grid);
     double messages = 0.0, bytes = 0.0;
-    if (Decomposition *decomposition = grid.decomposition()) decomposition->take_traffic(messages, bytes);  // from here
-    const StepAgreement state = agree_before_step(grid, dt);  // first: it may set the smallest angle
+    Distribution *distribution = grid.distribution();
+    if (distribution) distribution->take_traffic(messages, bytes);  // from here
+    const StepAgreement state = agree_before_step(grid, engine, dt);  // first: it may set the smallest angle
     const double dt_max = stable_dt(grid);
     const double needed = std::ceil(dt / dt_max);
     // A count beyond 2^53 cannot be stepped exactly; a scene that comes to rest
@@ -218,10 +231,10 @@ void step_in_time(Grid &grid, double dt, std::int64_t most) {
     // A lazy source acts over all of dt, whenever its cells took it.
     if (lazy) ledger.sourced.add(grid.source_mass_rate() * dt);
     info.rank_cell_updates = info.cell_updates;
-    if (Decomposition *decomposition = grid.decomposition()) {
+    if (distribution) {
         info.cell_updates = grid.global_sum(info.cell_updates);
-        decomposition->take_traffic(info.messages_sent, info.bytes_sent);
-        info.substeps_per_exchange = decomposition->substeps_per_exchange(grid);
+        distribution->take_traffic(info.messages_sent, info.bytes_sent);
+        info.substeps_per_exchange = distribution->substeps_per_exchange(grid);
     }
     const bool whole_dt = source_active || !(info.at_rest || !bounded);
     info.time_integrated = whole_dt ? dt : static_cast<double>(info.substeps) * sub_dt;

@@ -11,8 +11,13 @@ namespace dpsm {
 double stable_dt(const Grid &grid);
 
 // dpsm_step: relaxes to rest or advances in time, as the grid's relaxation
-// asks (model/grid.hpp).
+// asks (model/grid.hpp). Refuses a dt that is not finite or not positive
+// (on every rank of a distributed grid).
 void step(Grid &grid, double dt);
+
+// The last step's face fluxes in the layout of dpsm_get_face_fluxes (library
+// order; fy on 2D grids only); the grid records them.
+void read_face_fluxes(const Grid &grid, double *fx, double *fy);
 
 // Advances exactly dt (or until rest) by time-accurate sub-steps; a dt of
 // more than 2^53 stable sub-steps (infinity included) steps at the stable

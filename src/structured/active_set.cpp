@@ -1,7 +1,6 @@
 #include "structured/active_set.hpp"
 
 #include <algorithm>
-#include <cstdlib>
 
 #include "model/grid.hpp"
 
@@ -10,13 +9,6 @@ namespace dpsm {
 namespace {
 // How far a sweep reads beyond its tile: its levels plus one ring of ghosts.
 constexpr std::int64_t kReach = ActiveSet::kMaxLevels + 1;
-
-// DPSM_VISIT_ALL_TILES=1 turns the active set off, for tests that show it
-// changes no result.
-bool visit_all_tiles() {
-    const char *all = std::getenv("DPSM_VISIT_ALL_TILES");
-    return all && *all && *all != '0';
-}
 }  // namespace
 
 template <class Visit>
@@ -191,7 +183,7 @@ void ActiveSet::end_of_step() {
     }
 }
 
-void ActiveSet::tiles_to_visit(int levels, std::vector<std::int64_t> &tiles, std::vector<CellBox> &boxes,
+void ActiveSet::tiles_to_visit(int levels, bool visit_all, std::vector<std::int64_t> &tiles, std::vector<CellBox> &boxes,
                                std::vector<CellBox> &seeds) const {
     // A face carries sand in a sub-step only if it did in the one before or a
     // cell within one of it changed: the cells touching moving faces spread by
@@ -204,7 +196,6 @@ void ActiveSet::tiles_to_visit(int levels, std::vector<std::int64_t> &tiles, std
     tiles.clear();
     boxes.clear();
     seeds.clear();
-    const bool visit_all = visit_all_tiles();
     // Only the tiles next to one with activity can be reached: mark those
     // first, so that a grid mostly at rest costs a byte per tile, not the
     // look at nine neighbours' boxes.

@@ -76,7 +76,9 @@ public:
     // the box of its cells that can change (the rest of the tile stays as it is)
     // and the box of the hot boxes and sources (grown by one) that reach it,
     // its seeds: in sub-step s only cells within s - 1 of them can change.
-    void tiles_to_visit(int levels, std::vector<std::int64_t> &tiles, std::vector<CellBox> &boxes,
+    // visit_all (DPSM_VISIT_ALL_TILES, model/switches.hpp): every tile whole,
+    // for tests that show that the active set changes no result.
+    void tiles_to_visit(int levels, bool visit_all, std::vector<std::int64_t> &tiles, std::vector<CellBox> &boxes,
                         std::vector<CellBox> &seeds) const;
 
     CellBox &hot(std::int64_t t) { return hot_[t]; }
@@ -110,7 +112,7 @@ public:
         return has_source_[t] != 0 || (!remote_source_.empty() && remote_source_[t] != 0);
     }
 
-    // A distributed grid's view of its neighbours (mpi/decomposition.hpp): boxes of
+    // A distributed grid's view of its neighbours (structured/halo.hpp): boxes of
     // cells beyond this block, in its coordinates, that may move in the coming
     // sweep (their hot and driven boxes) or hold a source. Tiles the first
     // reach are visited, and tiles the second reach see those sources, as if

@@ -5,9 +5,10 @@
 #include <cstdint>
 #include <limits>
 
-#include "model/flux_law.hpp"
+#include "model/face_law.hpp"
 #include "model/ledger.hpp"
-#include "structured/tiled_sweep.hpp"
+#include "structured/lazy_sources.hpp"
+#include "structured/structured_state.hpp"
 
 namespace dpsm {
 
@@ -47,7 +48,7 @@ public:
         if (ka == kWall || kb == kWall || (ka != kSand && kb != kSand)) return;
         double flux = flux_from_to(a, b, h_[a], h_[b], d);
         if (flux == 0.0) return;
-        if (!available_.empty()) flux = capped(flux, flux > 0.0 ? a : b, flux > 0.0 ? weight_a : weight_b);
+        if (!available_.empty()) flux = capped(flux, a, b, weight_a, weight_b);
         if (flux == 0.0) return;
         carried(a, b);
         if (faces_) faces_[b] += flux * len * dt_;
@@ -66,7 +67,7 @@ public:
         if (kind_[a] != kSand) return;
         double flux = flux_from_to(a, -1, h_[a], level, d);
         if (flux == 0.0) return;
-        if (!available_.empty() && flux > 0.0) flux = capped(flux, a, weight_a);
+        if (!available_.empty() && flux > 0.0) flux = capped(flux, a, -1, weight_a, 0.0);
         if (flux == 0.0) return;
         carried(a, -1);
         rate_[a] -= flux * weight_a;
@@ -101,24 +102,24 @@ private:
         const bool b_sand = b >= 0 && kind_[b] == kSand;
         const std::vector<double> &tan_field = grid_.tan_field();
         if (!tan_field.empty()) {
-            const double ta = kind_[a] == kSand ? tan_field[a] : tan_field[b];
-            const double tb = b_sand ? tan_field[b] : ta;
-            tan_face = 0.5 * (ta + tb);
+            tan_face = law::face_tan(tan_field[a], b >= 0 ? tan_field[b] : tan_field[a], kind_[a] == kSand, b_sand);
             threshold = tan_face * (1.0 + grid_.rest_tolerance());
         }
         if (grid_.hysteresis()) {
             const std::vector<std::uint8_t> &moving = grid_.moving();
-            const bool at_rest = !moving[a] && !(b >= 0 && moving[b]);
-            if (at_rest) threshold = std::max(threshold, grid_.tan_static());
+            threshold = law::threshold(threshold, !moving[a] && !(b >= 0 && moving[b]), grid_.tan_static());
         }
         p = grid_.flux_exponent();
     }
 
-    // A face takes from its sand cell `up` at most its share of the sand there.
-    double capped(double flux, std::int64_t up, double weight_up) const {
-        if (kind_[up] != kSand) return flux;
-        const double cap = available_[up] / (kFaces * dt_ * weight_up);
-        return flux > 0.0 ? std::min(flux, cap) : std::max(flux, -cap);
+    // A face takes from its sand cell at most its share of the sand there
+    // (b < 0: the outside of an open side, which gives without limit).
+    double capped(double flux, std::int64_t a, std::int64_t b, double weight_a, double weight_b) const {
+        const double unlimited = std::numeric_limits<double>::infinity();
+        const auto most = [&](std::int64_t c, double weight) {
+            return c >= 0 && kind_[c] == kSand ? law::share_of_sand(available_[c], kFaces, dt_, weight) : unlimited;
+        };
+        return law::capped(flux, most(a, weight_a), -most(b, weight_b));
     }
 
     void carried(std::int64_t a, std::int64_t b) {
@@ -211,7 +212,7 @@ void apply_source_1d(Grid &grid, double substeps, double dt) {
 SubstepSummary slide_rates_1d(Grid &grid, double dt, bool record) {
     const Geometry &geo = grid.geometry();
     const std::int64_t nx = geo.nx;
-    std::vector<double> &rate = grid.rate_workspace();
+    std::vector<double> &rate = structured_state(grid).rates;
     std::fill(rate.begin(), rate.end(), 0.0);
     FaceSweep sweep(grid, rate, dt, record);
     // Along a line or a radius: weights are face length over cell area.
@@ -230,12 +231,9 @@ SubstepSummary slide_rates_1d(Grid &grid, double dt, bool record) {
 }
 
 void apply_rates(Grid &grid, double dt) {
-    const std::vector<double> &rate = grid.rate_workspace();
+    const std::vector<double> &rate = structured_state(grid).rates;
     std::vector<double> &h = grid.heights_for_stepping();
     std::vector<float> &residual = grid.residuals_for_stepping();
-    CellBox all;
-    all.add(0, grid.geometry().nx, 0, grid.geometry().ny);
-    grid.residuals_written(all);
     const std::vector<std::uint8_t> &kind = grid.kinds();
     const std::vector<double> &q = grid.source();
     const std::vector<double> &zb = grid.bed();

@@ -1,6 +1,6 @@
 // One explicit sweep of the slide fluxes on a 1D or axisymmetric grid (2D
 // grids use structured/tiled_sweep.hpp). Every face between two cells carries one flux
-// by the law in model/flux_law.hpp, which one cell loses and the other gains, so mass
+// by the law in model/face_law.hpp, which one cell loses and the other gains, so mass
 // is conserved face by face: the paper's pairwise exchange (its Eq. 12).
 // Faces no steeper than the rest threshold tan(theta) (1 + tol) carry nothing,
 // as in the 2D kernel, so a surface at rest is exactly at rest.
@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "model/grid.hpp"
-#include "stepping/engine.hpp"
+#include "model/engine.hpp"
 
 namespace dpsm {
 

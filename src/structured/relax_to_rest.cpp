@@ -31,7 +31,9 @@
 #include "model/error.hpp"
 #include "model/ledger.hpp"
 #include "structured/structured_engine.hpp"
+#include "structured/structured_state.hpp"
 #include "structured/tile_kernel.hpp"
+#include "structured/tiled_heights.hpp"
 #include "structured/tiled_sweep.hpp"
 
 namespace dpsm {
@@ -196,8 +198,8 @@ namespace {
 class Evaluator {
 public:
     Evaluator(Grid &grid, double dt)
-        : grid_(grid), dt_(dt), nx_(grid.geometry().nx), ws_(grid.relax_workspace()) {
-        residuals_ = grid.drop_residuals();  // the sweeps without residuals need them 0
+        : grid_(grid), dt_(dt), nx_(grid.geometry().nx), ws_(structured_state(grid).relax_workspace(grid)) {
+        residuals_ = drop_residuals(grid);  // the sweeps without residuals need them 0
     }
     // Every box empty again, for the next step.
     ~Evaluator() {
@@ -214,13 +216,13 @@ public:
     SubstepSummary evaluate(const double *y) {
         // The active set then computes only the cells that y moved or that
         // touch a moving face, as in any sub-step.
-        for (const std::int64_t t : ws_.live_tiles) grid_.copy_heights_between_sweeps(y, ws_.live[t]);
+        for (const std::int64_t t : ws_.live_tiles) copy_heights_between_sweeps(grid_, y, ws_.live[t]);
         last_visited_ = static_cast<double>(tiled_sweep(grid_, 1, dt_, levels_, /*find_excess=*/true,
                                                         /*residuals=*/false));
         visited_ += last_visited_;
         // The sweep leaves the heights from before it in its scratch
         // (structured/tiled_sweep.hpp): y in the live boxes, the start elsewhere.
-        const TiledWorkspace &ws = grid_.tiled_workspace();
+        const TiledWorkspace &ws = structured_state(grid_).tiled_workspace();
         const double *next = grid_.heights().data(), *before = ws.heights.data();
         bool new_tiles = false;
         for (std::size_t k = 0; k < ws.visit.size(); ++k) {
@@ -273,7 +275,7 @@ public:
     // the live boxes: elsewhere nothing changed).
     double mass_left(const double *y) const {
         CompensatedSum left;
-        for (const std::int64_t t : ws_.live_tiles) left.add(grid_.sand_mass_change(y, ws_.start.get(), ws_.live[t]));
+        for (const std::int64_t t : ws_.live_tiles) left.add(sand_mass_change(grid_, y, ws_.start.get(), ws_.live[t]));
         return left.value();
     }
     // Whether y's sand lies within the extremes of the start's (and of the
@@ -310,16 +312,16 @@ public:
     }
     // The grid's heights become y's.
     void finish(const double *y) {
-        for (const std::int64_t t : ws_.live_tiles) grid_.set_heights_between_sweeps(y, ws_.live[t]);
+        for (const std::int64_t t : ws_.live_tiles) set_heights_between_sweeps(grid_, y, ws_.live[t]);
     }
     // The grid becomes the start again, residuals included, and every cell a
     // sweep read may move: the active set as it was, or wider.
     void restore_start() {
         finish(ws_.start.get());
-        grid_.restore_residuals(residuals_);
+        restore_residuals(grid_, residuals_);
         for (const std::int64_t t : ws_.filled_tiles) {
             const CellBox &box = ws_.filled[t];
-            grid_.active_set().mark_block(box.i0, box.j0, box.i1 - box.i0, box.j1 - box.j0);
+            active_set(grid_).mark_block(box.i0, box.j0, box.i1 - box.i0, box.j1 - box.j0);
         }
     }
     const double *start() const { return ws_.start.get(); }
@@ -362,7 +364,7 @@ private:
     double dt_;
     std::int64_t nx_;
     RelaxWorkspace &ws_;
-    Grid::SavedResiduals residuals_;  // as they were before the relaxation
+    SavedResiduals residuals_;  // as they were before the relaxation
     std::vector<SubstepSummary> levels_;
     std::int64_t evaluations_ = 0;
     double visited_ = 0.0, last_visited_ = 0.0;
@@ -372,7 +374,7 @@ private:
 
 const char *relaxation_unsupported(const Grid &grid) {
     if (grid.geometry().dim != 2) return "1D or axisymmetric grids";
-    if (grid.decomposition()) return "distributed grids";
+    if (grid.distribution()) return "distributed grids";
     if (grid.scheme() != kIsotropic) return "the pairwise scheme (dpsm_set_scheme)";
     if (!grid.bed().empty()) return "a bed (dpsm_set_bedrock)";
     // Both were seen to need far more evaluations, or never to rest, in a
@@ -431,7 +433,7 @@ bool relax_to_rest(Grid &grid, std::int64_t budget, double &cells_visited) {
     info.at_rest = true;
     info.time_integrated = 0.0;
     // At rest already: no tile can move, and no evaluation is needed to know it.
-    if (!grid.active_set().may_move()) {
+    if (!active_set(grid).may_move()) {
         grid.last_step() = info;
         return true;
     }

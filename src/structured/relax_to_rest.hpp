@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "model/grid.hpp"
+#include "structured/active_set.hpp"
 
 namespace dpsm {
 

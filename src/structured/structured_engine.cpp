@@ -4,10 +4,14 @@
 #include <limits>
 #include <vector>
 
-#include "model/flux_law.hpp"
+#include "model/distribution.hpp"
+#include "model/face_law.hpp"
 #include "model/grid.hpp"
+#include "structured/halo.hpp"
+#include "structured/lazy_sources.hpp"
 #include "structured/line_sweep.hpp"
 #include "structured/relax_to_rest.hpp"
+#include "structured/structured_state.hpp"
 #include "structured/tiled_sweep.hpp"
 
 namespace dpsm {
@@ -29,24 +33,47 @@ double structured_stable_dt(const Grid &grid) {
 
 namespace {
 
+// What both structured engines share: their state, their sub-step, their
+// face fluxes on a line.
+class StructuredEngine : public Engine {
+public:
+    std::unique_ptr<EngineState> make_state(const Grid &grid) const override {
+        return std::make_unique<StructuredState>(grid);
+    }
+    double stable_dt(const Grid &grid) const override { return structured_stable_dt(grid); }
+    bool relax_to_rest(Grid &grid, std::int64_t budget, double &cells_visited) const override {
+        structured_state(grid).switches = read_switches();
+        return dpsm::relax_to_rest(grid, budget, cells_visited);
+    }
+    void read_face_fluxes(const Grid &grid, double *fx, double *) const override {
+        const std::vector<double> &faces = grid.face_fluxes().x;
+        std::copy(faces.begin(), faces.end(), fx);
+    }
+};
+
 // 2D grids: tiles of the active set, swept up to ActiveSet::kMaxLevels
 // sub-steps at a time (structured/tiled_sweep.hpp).
-class TiledEngine final : public Engine {
+class TiledEngine final : public StructuredEngine {
 public:
-    double stable_dt(const Grid &grid) const override { return structured_stable_dt(grid); }
-    void prepare(Grid &grid) const override { prepare_tiled_sweep(grid, grid.step_threads()); }
-    bool may_move(const Grid &grid) const override { return grid.active_set().may_move(); }
+    void prepare(Grid &grid) const override {
+        // A block of a distributed grid reads the cells beyond it from its halo.
+        structured_state(grid).halo = dynamic_cast<Halo *>(grid.distribution());
+        prepare_tiled_sweep(grid, grid.step_threads());
+    }
+    bool may_move(const Grid &grid) const override { return active_set(grid).may_move(); }
 
     bool drive_sources(Grid &grid, double dt, double sub_dt, bool lazy, double &reach) const override {
         reach = std::numeric_limits<double>::infinity();
         if (lazy) return dpsm::drive_sources(grid, dt, sub_dt, reach);
-        grid.active_set().drive_every_source();
+        active_set(grid).drive_every_source();
         return true;
     }
-    void forget_driven(Grid &grid) const override { grid.active_set().forget_driven(); }
+    void forget_driven(Grid &grid) const override { active_set(grid).forget_driven(); }
 
     void advance(Grid &grid, const SubstepPlan &plan, const BookSubstep &book, StepInfo &info) const override {
+        StructuredState &state = structured_state(grid);
         if (plan.something_may_move) {
+            state.switches = read_switches();
             std::vector<SubstepSummary> levels;
             bool source_may_steepen = false;
             for (std::int64_t k = 0; k < plan.substeps && !info.at_rest; k += ActiveSet::kMaxLevels) {
@@ -57,7 +84,7 @@ public:
                     tiled_sweep(grid, count, plan.sub_dt, levels, last_sweep, true, static_cast<double>(k)));
                 if (plan.lazy_sources) {
                     // Collective on a distributed grid: every rank takes the same sub-steps.
-                    const bool near_moves = grid.active_set().drive_sources_near_moves();
+                    const bool near_moves = state.active->drive_sources_near_moves();
                     source_may_steepen = source_may_steepen || grid.global_sum(near_moves ? 1.0 : 0.0) > 0.0;
                 }
                 for (SubstepSummary &level : levels) {
@@ -72,20 +99,43 @@ public:
         if (plan.lazy_sources) {
             const double substeps = static_cast<double>(plan.substeps);
             info.cell_updates += catch_up_sources(grid, substeps, plan.sub_dt);
-            grid.set_clock_base(grid.clock_base() + substeps);
+            state.clock_base += substeps;
         }
-        grid.active_set().end_of_step();
+        state.active->end_of_step();
     }
 
-    bool relax_to_rest(Grid &grid, std::int64_t budget, double &cells_visited) const override {
-        return dpsm::relax_to_rest(grid, budget, cells_visited);
+    // A tile's faces hold the last step's fluxes only if that step visited it.
+    void read_face_fluxes(const Grid &grid, double *fx, double *fy) const override {
+        const FaceFluxes &fluxes = grid.face_fluxes();
+        const ActiveSet &active = active_set(grid);
+        const std::int64_t nx = grid.geometry().nx, ny = grid.geometry().ny;
+        for (std::int64_t t = 0; t < active.tiles(); ++t) {
+            const CellBox tile = active.tile_cells(t);
+            // No step has numbered the tiles yet: every face holds 0.
+            const bool current = static_cast<std::size_t>(t) >= fluxes.tile_step.size() ||
+                                 fluxes.tile_step[static_cast<std::size_t>(t)] == fluxes.step;
+            const std::int64_t x1 = tile.i1 + (tile.i1 == nx ? 1 : 0), y1 = tile.j1 + (tile.j1 == ny ? 1 : 0);
+            for (std::int64_t j = tile.j0; j < tile.j1; ++j) {
+                const std::size_t at = static_cast<std::size_t>(tile.i0 + (nx + 1) * j);
+                if (current)
+                    std::copy_n(fluxes.x.begin() + at, x1 - tile.i0, fx + at);
+                else
+                    std::fill_n(fx + at, x1 - tile.i0, 0.0);
+            }
+            for (std::int64_t j = tile.j0; j < y1; ++j) {
+                const std::size_t at = static_cast<std::size_t>(tile.i0 + nx * j);
+                if (current)
+                    std::copy_n(fluxes.y.begin() + at, tile.i1 - tile.i0, fy + at);
+                else
+                    std::fill_n(fy + at, tile.i1 - tile.i0, 0.0);
+            }
+        }
     }
 };
 
 // 1D and axisymmetric grids: every face every sub-step (structured/line_sweep.hpp).
-class LineEngine final : public Engine {
+class LineEngine final : public StructuredEngine {
 public:
-    double stable_dt(const Grid &grid) const override { return structured_stable_dt(grid); }
     void prepare(Grid &) const override {}
     bool may_move(const Grid &) const override { return true; }
 
@@ -121,11 +171,6 @@ public:
             apply_rates(grid, plan.sub_dt);
             info.cell_updates += cells;
         }
-    }
-
-    // Refuses with the reason (relax_to_rest.hpp): 1D and axisymmetric grids step in time.
-    bool relax_to_rest(Grid &grid, std::int64_t budget, double &cells_visited) const override {
-        return dpsm::relax_to_rest(grid, budget, cells_visited);
     }
 };
 

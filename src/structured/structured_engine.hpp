@@ -3,7 +3,7 @@
 // and axisymmetric ones.
 #pragma once
 
-#include "stepping/engine.hpp"
+#include "model/engine.hpp"
 
 namespace dpsm {
 

@@ -1,7 +1,7 @@
 // The 2D sweep on one tile: a private copy of the tile and a halo of `levels`
 // cells (plus one ring of ghosts) is advanced `levels` sub-steps in cache,
 // shrinking by one cell a level, and only the tile itself is kept. Faces are
-// computed once per level; the flux law is the dead-zone form of model/flux_law.hpp
+// computed once per level; the flux law is the dead-zone form of model/face_law.hpp
 // (no flux up to the rest threshold tan(theta) (1 + tol)), so a tile whose
 // faces are all below it is exactly at rest and may be skipped.
 //
@@ -165,11 +165,9 @@ using TileKernel = void (*)(TileBuffers &buffers, const LevelCells &cells, const
 // scenes the source is applied at every sub-step (a bed caps erosion).
 TileKernel select_tile_kernel(bool masked, bool isotropic, bool source, bool grid_in = false, bool grid_out = false,
                               PhysicsKind physics = PhysicsKind::none);
-// Whether an environment variable is set to something other than 0: the
-// switches by which tests compare kernels and ways of sweeping.
-bool environment_flag(const char *variable);
 // The lanes of the kernels chosen: 8 (AVX-512), 4 (AVX2 and FMA) or 1, the
-// widest this CPU has that DPSM_NO_AVX512=1 or DPSM_NO_AVX2=1 does not rule out.
+// widest this CPU has that DPSM_NO_AVX512=1 or DPSM_NO_AVX2=1 does not rule
+// out (model/switches.hpp), chosen once per process.
 int tile_kernel_lanes();
 // Whether the kernels chosen run in AVX-512.
 bool tile_kernels_use_avx512();

@@ -1,6 +1,5 @@
 // The tile kernel for any CPU, and the choice of kernel at run time.
-#include <cstdlib>
-
+#include "model/switches.hpp"
 #include "structured/tile_kernel_impl.hpp"
 
 namespace dpsm {
@@ -30,23 +29,20 @@ void TileBuffers::resize(int w, int h_) {
     chunk_bits.assign(static_cast<std::size_t>(4) * (w + 1), 0u);
 }
 
-bool environment_flag(const char *variable) {
-    const char *value = std::getenv(variable);
-    return value && *value && *value != '0';
-}
-
 // DPSM_NO_AVX512=1 and DPSM_NO_AVX2=1 rule those kernels out, so that one
 // machine can run (and the tests compare) every kernel it has.
 static int widest_lanes() {
+    const Switches switches = read_switches();
+    (void)switches;
 #if defined(DPSM_HAVE_AVX512_KERNEL)
     __builtin_cpu_init();
-    if (!environment_flag("DPSM_NO_AVX512") && __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512bw") &&
+    if (!switches.no_avx512 && __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512bw") &&
         __builtin_cpu_supports("avx512vl") && __builtin_cpu_supports("avx512dq"))
         return 8;
 #endif
 #if defined(DPSM_HAVE_AVX2_KERNEL)
     __builtin_cpu_init();
-    if (!environment_flag("DPSM_NO_AVX2") && __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma")) return 4;
+    if (!switches.no_avx2 && __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma")) return 4;
 #endif
     return 1;
 }

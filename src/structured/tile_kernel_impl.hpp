@@ -38,6 +38,7 @@
 #include <type_traits>
 #include <utility>
 
+#include "model/face_law.hpp"
 #include "model/grid.hpp"
 #include "structured/simd.hpp"
 #include "structured/tile_kernel.hpp"
@@ -141,7 +142,7 @@ DPSM_KERNEL_FLATTEN void advance_tile_level(TileBuffers &b, const LevelCells &io
     };
     auto direction = [&](double d, double d_across) {
         const double threshold = p.tan_theta * p.rest_factor * d;
-        const double at_rest = std::max(p.tan_theta * p.rest_factor, p.tan_static) * d;
+        const double at_rest = law::threshold(p.tan_theta * p.rest_factor, true, p.tan_static) * d;
         const double scale = p.nu * p.dt / d;
         return Direction{V::broadcast(p.tan_theta * d), V::broadcast(threshold * threshold), V::broadcast(d * d),
                          V::broadcast(scale), V::broadcast(0.25 * d / d_across), zero, V::broadcast(d),
@@ -184,14 +185,14 @@ DPSM_KERNEL_FLATTEN void advance_tile_level(TileBuffers &b, const LevelCells &io
             threshold2 = select(at_rest, d.threshold2_at_rest, d.threshold2);
             return;
         }
-        V tan_a = V::load(tan_cell + f.a), tan_b = V::load(tan_cell + f.b);
-        if constexpr (Masked) {
-            tan_a = select(V::kind_is(kind + f.a, kSand), tan_a, tan_b);
-            tan_b = select(V::kind_is(kind + f.b, kSand), tan_b, tan_a);
-        }
-        const V tan_face = (tan_a + tan_b) * V::broadcast(0.5);
+        const V tan_a = V::load(tan_cell + f.a), tan_b = V::load(tan_cell + f.b);
+        V tan_face;
+        if constexpr (Masked)
+            tan_face = law::face_tan(tan_a, tan_b, V::kind_is(kind + f.a, kSand), V::kind_is(kind + f.b, kSand));
+        else
+            tan_face = law::mean_tan(tan_a, tan_b);
         V threshold = tan_face * d.rest_spacing;
-        if (hysteresis) threshold = select(at_rest, max(threshold, d.static_spacing), threshold);
+        if (hysteresis) threshold = law::threshold(threshold, at_rest, d.static_spacing);
         tan_d = tan_face * d.spacing;
         threshold2 = threshold * threshold;
     };
@@ -241,7 +242,7 @@ DPSM_KERNEL_FLATTEN void advance_tile_level(TileBuffers &b, const LevelCells &io
             // sqrt(D) - d tan(theta): 0 where the lanes computed 1/sqrt(0).
             auto excess = [&] { return max(D * inverse - tan_d, zero); };
             if (exponent != ExponentKind::one) flux = raised(flux, excess() * d.inverse_spacing, hot);
-            if (bed) flux = max(min(flux, f.available_a * d.most_per_sand), f.available_b * d.least_per_sand);
+            if (bed) flux = law::capped(flux, f.available_a * d.most_per_sand, f.available_b * d.least_per_sand);
             carries = flux != zero;
             if (track_excess) d.largest_excess = max_where(carries, d.largest_excess, excess());
             return flux * d.scale;

@@ -7,8 +7,9 @@
 // (2) every face once, (3) every cell's update.
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
-#include "model/flux_law.hpp"
+#include "model/face_law.hpp"
 #include "model/grid.hpp"
 #include "structured/tile_kernel.hpp"
 
@@ -79,14 +80,9 @@ void advance_tile_level_physics(TileBuffers &b, int in, const TileRect &reg, con
     auto face = [&](int a, int c, double gn, double gt, double inv_d) {
         const bool a_sand = kind[a] == kSand, c_sand = kind[c] == kSand;
         if (kind[a] == kWall || kind[c] == kWall || (!a_sand && !c_sand)) return 0.0;
-        double tan_face = p.tan_theta;
-        if (p.angle_field) {
-            const double ta = a_sand ? tan_cell[a] : tan_cell[c];
-            const double tc = c_sand ? tan_cell[c] : ta;
-            tan_face = 0.5 * (ta + tc);
-        }
+        const double tan_face = p.angle_field ? law::face_tan(tan_cell[a], tan_cell[c], a_sand, c_sand) : p.tan_theta;
         double threshold = tan_face * p.rest_factor;
-        if (p.hysteresis && !moving[a] && !moving[c]) threshold = std::max(threshold, p.tan_static);
+        if (p.hysteresis) threshold = law::threshold(threshold, !moving[a] && !moving[c], p.tan_static);
         const double u = gn * gn + gt * gt;
         if (!(u > threshold * threshold)) return 0.0;
         // A face steep only across its normal, its two cells level to within
@@ -97,13 +93,13 @@ void advance_tile_level_physics(TileBuffers &b, int in, const TileRect &reg, con
         if (Isotropic && std::fabs(h[a] - h[c]) <= kLevelWithinRounding * std::max(std::fabs(h[a]), std::fabs(h[c])))
             return 0.0;
         const double s = std::sqrt(u);
-        double flux = p.nu * excess_power(s - tan_face, p.flux_exponent) / std::sqrt(1.0 + u) * (gn / s);
+        double flux = slide_flux_at(p.nu, tan_face, s, u, p.flux_exponent) * (gn / s);
         if (p.bed) {
-            const int up = flux > 0.0 ? a : c;
-            if (kind[up] == kSand) {
-                const double cap = available[up] / (kFacesPerCell * p.dt * inv_d);
-                flux = flux > 0.0 ? std::min(flux, cap) : std::max(flux, -cap);
-            }
+            const double unlimited = std::numeric_limits<double>::infinity();
+            const auto most = [&](int cell, bool sand) {
+                return sand ? law::share_of_sand(available[cell], kFacesPerCell, p.dt, inv_d) : unlimited;
+            };
+            flux = law::capped(flux, most(a, a_sand), -most(c, c_sand));
         }
         if (flux != 0.0) excess_max = std::max(excess_max, s - tan_face);
         return flux;

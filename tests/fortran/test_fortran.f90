@@ -112,7 +112,7 @@ contains
     real(c_double) :: dt, value, total, external, slope_excess
     integer(c_int64_t) :: nx64, ny64
     integer(c_int32_t) :: nx32, ny32
-    integer(c_int) :: threads
+    integer(c_int) :: threads, kind
     integer :: ierr, i, j
     character(len=:), allocatable :: message
 
@@ -167,6 +167,8 @@ contains
     call expect(ierr == DPSM_OK, 'dpsm_set_threads(2)')
     call dpsm_get_threads(g, threads, ierr)
     call expect(ierr == DPSM_OK .and. threads == 2, 'dpsm_get_threads after dpsm_set_threads(2)')
+    call dpsm_get_grid_kind(g, kind, ierr)
+    call expect(ierr == DPSM_OK .and. kind == DPSM_GRID_2D, 'dpsm_get_grid_kind of a 2D grid')
 
     call dpsm_stable_dt(g, dt, ierr)
     call expect(ierr == DPSM_OK .and. close_to(dt, 1/(2*nu*cos(theta)*(1/dx**2 + 1/dy**2)), 1e-12_c_double), &
@@ -410,11 +412,14 @@ contains
     type(dpsm_grid) :: g
     real(c_double) :: h(nx), h2(nx), dt, total
     integer(c_int64_t) :: n1, n2
+    integer(c_int) :: kind
     integer :: ierr
     call dpsm_create_1d(g, int(nx, c_int64_t), dx, ierr)
     call expect(ierr == DPSM_OK, 'dpsm_create_1d (c_int64_t)')
     call dpsm_get_shape(g, n1, n2)
     call expect(n1 == nx .and. n2 == 1, 'a 1D grid has ny = 1')
+    call dpsm_get_grid_kind(g, kind)
+    call expect(kind == DPSM_GRID_1D, 'dpsm_get_grid_kind of a 1D grid')
     call dpsm_stable_dt(g, dt)
     call expect(close_to(dt, dx**2/(2*DPSM_DEFAULT_MOBILITY*cos(DPSM_DEFAULT_REPOSE_ANGLE)), 1e-12_c_double), &
                 '1D: dpsm_stable_dt is dx^2 / (2 nu cos(theta)) with the defaults')
@@ -440,12 +445,15 @@ contains
     real(c_double), parameter :: dr = 0.05_c_double
     type(dpsm_grid) :: g
     real(c_double) :: h(nr), dt, total, volume
+    integer(c_int) :: kind
     integer :: ierr, i
     call dpsm_create_axisymmetric(g, nr, dr, ierr)
     call expect(ierr == DPSM_OK, 'dpsm_create_axisymmetric (default integers)')
     call dpsm_destroy(g)
     call dpsm_create_axisymmetric(g, int(nr, c_int64_t), dr, ierr)
     call expect(ierr == DPSM_OK, 'dpsm_create_axisymmetric (c_int64_t)')
+    call dpsm_get_grid_kind(g, kind, ierr)
+    call expect(ierr == DPSM_OK .and. kind == DPSM_GRID_AXISYMMETRIC, 'dpsm_get_grid_kind of an axisymmetric grid')
     call dpsm_set_boundary(g, DPSM_XMIN, DPSM_OPEN, ierr)
     call expect(ierr == DPSM_ERR_NOT_APPLICABLE, 'axisymmetric: the axis is not a boundary')
     call dpsm_set_boundary(g, DPSM_XMAX, DPSM_OPEN, ierr)
@@ -763,6 +771,7 @@ contains
     integer(c_int64_t) :: cell_start(5), cell_nodes(16), bad_nodes(16), nx, ny, nfaces, faces(2, 12), back(2, 12)
     integer(c_int32_t) :: nf32, faces32(2, 12)
     integer(c_int8_t) :: kinds(12)
+    integer(c_int) :: kind
     integer :: ierr, i, j, f
     character(len=:), allocatable :: message
 
@@ -783,6 +792,8 @@ contains
     call expect(ierr == DPSM_OK .and. nfaces == 12, 'dpsm_get_face_count: 4 interior faces and 8 on the edge')
     call dpsm_get_face_count(g, nf32, ierr)
     call expect(ierr == DPSM_OK .and. nf32 == 12, 'dpsm_get_face_count (c_int32_t)')
+    call dpsm_get_grid_kind(g, kind, ierr)
+    call expect(ierr == DPSM_OK .and. kind == DPSM_GRID_MESH, 'dpsm_get_grid_kind of a mesh')
     faces = -7
     call dpsm_get_mesh_faces(g, faces, ierr)
     call expect(ierr == DPSM_OK, 'dpsm_get_mesh_faces (c_int64_t)')

@@ -644,6 +644,13 @@ static void op_parameter(reader_t *r, unsigned which) {
             ON_BOTH(s, DPSM_OK, g_op, dpsm_get_threads(g_, &n));
             if (s->geom != GEOM_2D ? n != 1 : v > 0 ? n != v : n < 1) die("dpsm_get_threads says %d after %d", n, v);
             if (dpsm_get_threads(s->g, NULL) != DPSM_ERR_NULL_POINTER) die("dpsm_get_threads accepted a NULL n");
+            /* What kind of grid it is: the constructor's, through any restart. */
+            int kind = 0;
+            g_op = "dpsm_get_grid_kind";
+            ON_BOTH(s, DPSM_OK, g_op, dpsm_get_grid_kind(g_, &kind));
+            const int want = s->geom == GEOM_2D ? DPSM_GRID_2D : s->geom == GEOM_AXI ? DPSM_GRID_AXISYMMETRIC : DPSM_GRID_1D;
+            if (kind != want) die("dpsm_get_grid_kind says %d, not %d", kind, want);
+            if (dpsm_get_grid_kind(s->g, NULL) != DPSM_ERR_NULL_POINTER) die("dpsm_get_grid_kind accepted a NULL kind");
             break;
         }
     }
@@ -1454,6 +1461,9 @@ static void op_null_grid(reader_t *r) {
         case 28: st = dpsm_get_face_fluxes(NULL, h, NULL), fn = "dpsm_get_face_fluxes"; break;
         case 29: {
             int n = 0;
+            if (dpsm_get_grid_kind(NULL, &n) != DPSM_ERR_NULL_POINTER ||
+                !strstr(dpsm_last_error(NULL), "dpsm_get_grid_kind"))
+                die("dpsm_get_grid_kind(NULL) was not refused naming itself: \"%s\"", dpsm_last_error(NULL));
             st = dpsm_get_threads(NULL, &n), fn = "dpsm_get_threads";
             break;
         }
@@ -2134,8 +2144,10 @@ static void mesh_step(mesh_state_t *ms, reader_t *r) {
         g_op = "dpsm_load";
         if (dpsm_load(path, &copy) != DPSM_OK || !copy) die("dpsm_load(%s) of a mesh failed: %s", path, dpsm_last_error(NULL));
         int64_t sx = 0, sy = 0, nf = 0;
+        int kind = 0;
         if (dpsm_get_shape(copy, &sx, &sy) != DPSM_OK || sx != m->ncells || sy != 1 ||
-            dpsm_get_face_count(copy, &nf) != DPSM_OK || nf != m->nfaces)
+            dpsm_get_face_count(copy, &nf) != DPSM_OK || nf != m->nfaces ||
+            dpsm_get_grid_kind(copy, &kind) != DPSM_OK || kind != DPSM_GRID_MESH)
             die("the loaded mesh is %lld x %lld with %lld faces, not %lld x 1 with %lld", (long long)sx, (long long)sy,
                 (long long)nf, (long long)m->ncells, (long long)m->nfaces);
         mesh_state_t other = *ms;
@@ -2506,6 +2518,9 @@ static void op_mesh(reader_t *r) {
         die("the mesh's shape is %lld x %lld, not %lld x 1", (long long)sx, (long long)sy, (long long)m.ncells);
     if (dpsm_get_face_count(g, &nf) != DPSM_OK || nf != m.nfaces)
         die("the mesh has %lld faces, not %lld", (long long)nf, (long long)m.nfaces);
+    int grid_kind = 0;
+    if (dpsm_get_grid_kind(g, &grid_kind) != DPSM_OK || grid_kind != DPSM_GRID_MESH)
+        die("a mesh's kind is %d", grid_kind);
     int64_t *faces = xcalloc((size_t)(2 * nf), sizeof(int64_t));
     uint8_t *seen = xcalloc((size_t)m.ncells, 1);
     if (dpsm_get_mesh_faces(g, faces) != DPSM_OK) die("dpsm_get_mesh_faces failed: %s", dpsm_last_error(g));

@@ -90,6 +90,7 @@ class Test2D(LedgerMixin, unittest.TestCase):
         self.assertEqual(self.g.shape, (self.ny, self.nx))
         self.assertEqual((self.g.nx, self.g.ny), (self.nx, self.ny))
         self.assertEqual(self.g.kind, "2d")
+        self.assertEqual(self.g.get_grid_kind(), dpsm.GRID_2D)
         self.assertIn("nx=24", repr(self.g))
 
     def test_parameters(self):
@@ -703,6 +704,7 @@ class TestRestart(LedgerMixin, unittest.TestCase):
                 g.save(path)
                 with dpsm.Grid.load(path) as loaded:
                     self.assertEqual(loaded.kind, kind)
+                    self.assertEqual(loaded.get_grid_kind(), g.get_grid_kind())
                     self.assertEqual(loaded.shape, g.shape)
                     g.step(1.0)
                     loaded.step(1.0)
@@ -1090,6 +1092,7 @@ class TestMesh(LedgerMixin, unittest.TestCase):
                 g.save(path)
                 with dpsm.Grid.load(path) as loaded:
                     self.assertEqual(loaded.kind, "mesh")
+                    self.assertEqual(loaded.get_grid_kind(), dpsm.GRID_MESH)
                     self.assertEqual(loaded.shape, (4,))
                     self.assertEqual(loaded.last_error(), "")
                     self.assertEqual(as_list(loaded.get_mesh_faces()), self.faces)

@@ -81,7 +81,7 @@ static void test_2d_slope_square_overflows(void **state) {
     dpsm_destroy(g);
 }
 
-/* 2. The same in 1D (src/model/flux_law.hpp, slide_flux: (s - tan) / sqrt(1 + s*s)
+/* 2. The same in 1D (src/model/face_law.hpp, slide_flux: (s - tan) / sqrt(1 + s*s)
  * is 0 once s*s overflows): nothing moves, yet every sub-step counts as
  * motion, so the surface never rests. */
 static void test_1d_slope_square_overflows(void **state) {

@@ -41,6 +41,16 @@ DPSM_YMAX = 3
 ## Sides of the domain: DPSM_MESH_EDGE, as in dpsm.h.
 DPSM_MESH_EDGE = 4  # every domain edge of a mesh (meshes only)
 
+# Grid kinds (dpsm_get_grid_kind).
+## Grid kinds (dpsm_get_grid_kind): DPSM_GRID_1D, as in dpsm.h.
+DPSM_GRID_1D = 1
+## Grid kinds (dpsm_get_grid_kind): DPSM_GRID_AXISYMMETRIC, as in dpsm.h.
+DPSM_GRID_AXISYMMETRIC = 2
+## Grid kinds (dpsm_get_grid_kind): DPSM_GRID_2D, as in dpsm.h.
+DPSM_GRID_2D = 3
+## Grid kinds (dpsm_get_grid_kind): DPSM_GRID_MESH, as in dpsm.h.
+DPSM_GRID_MESH = 4
+
 # Boundary kinds.
 ## Boundary kinds: DPSM_OPEN, as in dpsm.h.
 DPSM_OPEN = 0

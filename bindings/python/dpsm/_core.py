@@ -26,9 +26,9 @@ np = _import_numpy()
 HAVE_NUMPY = np is not None
 
 _INT_RANGE = (-(2**31), 2**31 - 1)
-# Where a restart file says what kind of grid it holds (docs/guide_restart.md):
-# dim and axisymmetric, little-endian uint32 each.
-_RESTART_KIND_OFFSET = 12
+# Grid.kind of each of dpsm_get_grid_kind's answers.
+_KIND_NAMES = {C.DPSM_GRID_1D: "1d", C.DPSM_GRID_AXISYMMETRIC: "axisymmetric", C.DPSM_GRID_2D: "2d",
+               C.DPSM_GRID_MESH: "mesh"}
 _INT64_RANGE = (-(2**63), 2**63 - 1)
 _P_DOUBLE = ctypes.POINTER(ctypes.c_double)
 _P_INT64 = ctypes.POINTER(ctypes.c_int64)
@@ -102,28 +102,6 @@ def _c_path(path, function):
     if b"\0" in raw:
         raise Error(C.DPSM_ERR_IO, "the path %r holds a NUL byte" % (path,), function)
     return raw
-
-
-def _restart_kind(raw_path, ny):
-    """The kind of grid a restart file holds, from its header (which dpsm_load
-    has just checked): "2d", "1d" or "axisymmetric"."""
-    if ny > 1:
-        return "2d"
-    try:
-        with open(raw_path, "rb") as f:
-            f.seek(_RESTART_KIND_OFFSET)
-            fields = f.read(8)
-    except OSError:
-        fields = b""
-    if len(fields) != 8:
-        # The file went away since dpsm_load read it: with ny == 1 the arrays
-        # of every kind hold nx values, so take the 1D view of them.
-        return "1d"
-    dim = int.from_bytes(fields[:4], "little")
-    axisymmetric = int.from_bytes(fields[4:], "little")
-    if dim == 2:
-        return "2d"
-    return "axisymmetric" if axisymmetric else "1d"
 
 
 def _check(status, function, handle=None, created=False, library=None):
@@ -505,7 +483,7 @@ class Grid:
     ``TypeError`` naming the function and the argument, before C is called.
     """
 
-    def __init__(self, _handle=None, _kind=None, _lib=None):
+    def __init__(self, _handle=None, _lib=None):
         """Not for hosts: a Grid is made by one of the ``create_*`` class methods (or by ``dpsm.mpi``,
         which passes ``_lib``, the library that made the handle: only its functions may take it)."""
         ## {name or number: [face, ...]}: the faces of the domain edge in each group of edges its
@@ -518,8 +496,11 @@ class Grid:
         # library may live in the process, each knowing only its own grids.
         self._lib = _lib or lib
         self._handle = _handle
-        ## What the grid is: "1d", "2d", "axisymmetric" or "mesh".
-        self.kind = _kind
+        kind = ctypes.c_int()
+        _check(self._lib.dpsm_get_grid_kind(_handle, ctypes.byref(kind)), "dpsm_get_grid_kind", _handle,
+               library=self._lib)
+        ## What the grid is: "1d", "2d", "axisymmetric" or "mesh" (``dpsm_get_grid_kind``).
+        self.kind = _KIND_NAMES[kind.value]
         nx, ny = ctypes.c_int64(), ctypes.c_int64()
         _check(self._lib.dpsm_get_shape(_handle, ctypes.byref(nx), ctypes.byref(ny)), "dpsm_get_shape", _handle,
                library=self._lib)
@@ -529,7 +510,7 @@ class Grid:
     # ---- creating and releasing --------------------------------------------
 
     @classmethod
-    def _create(cls, function, kind, *args, index_base=0):
+    def _create(cls, function, *args, index_base=0):
         # The base is checked before the grid exists, so a bad one leaves nothing behind.
         base = _c_int(index_base, "index_base", function, C.DPSM_ERR_INVALID_VALUE)
         if base not in (0, 1):
@@ -538,7 +519,7 @@ class Grid:
                         function)
         handle = GridPtr()
         _check(getattr(lib, function)(*args, ctypes.byref(handle)), function, created=True)
-        grid = cls(_handle=handle, _kind=kind)
+        grid = cls(_handle=handle)
         if base:
             grid.set_index_base(base)
         return grid
@@ -550,20 +531,20 @@ class Grid:
     def create_1d(cls, nx, dx, index_base=0):
         """``dpsm_create_1d``: ``nx`` cells of width ``dx``."""
         f = "dpsm_create_1d"
-        return cls._create(f, "1d", _c_int64(nx, "nx", f), _c_double(dx, "dx", f), index_base=index_base)
+        return cls._create(f, _c_int64(nx, "nx", f), _c_double(dx, "dx", f), index_base=index_base)
 
     @classmethod
     def create_2d(cls, nx, ny, dx, dy, index_base=0):
         """``dpsm_create_2d``: ``nx`` by ``ny`` cells of size ``dx`` by ``dy``."""
         f = "dpsm_create_2d"
-        return cls._create(f, "2d", _c_int64(nx, "nx", f), _c_int64(ny, "ny", f), _c_double(dx, "dx", f),
+        return cls._create(f, _c_int64(nx, "nx", f), _c_int64(ny, "ny", f), _c_double(dx, "dx", f),
                            _c_double(dy, "dy", f), index_base=index_base)
 
     @classmethod
     def create_axisymmetric(cls, nr, dr, index_base=0):
         """``dpsm_create_axisymmetric``: ``nr`` rings of width ``dr``."""
         f = "dpsm_create_axisymmetric"
-        return cls._create(f, "axisymmetric", _c_int64(nr, "nr", f), _c_double(dr, "dr", f), index_base=index_base)
+        return cls._create(f, _c_int64(nr, "nr", f), _c_double(dr, "dr", f), index_base=index_base)
 
     # ---- meshes ----------------------------------------------------------------
     # Indices are 0-based, as in C, unless ``start_index=1`` says they count
@@ -619,7 +600,7 @@ class Grid:
         if nnodes >= 1 and ncells >= 1 and start_index in (0, 1) and int(start[0]) == start_index:
             _sizes_agree(f, [("cell_nodes", total, "values", int(start[-1]) - start_index,
                               "cell_start[-1]" + (" - 1" if start_index else ""))])
-        grid = cls._create(f, "mesh", *first, nnodes, xy, ncells, start_p, nodes_p)
+        grid = cls._create(f, *first, nnodes, xy, ncells, start_p, nodes_p)
         del keep_xy, keep_start, keep_nodes
         return grid
 
@@ -654,7 +635,7 @@ class Grid:
             _sizes_agree(f, [("cell_area", nareas, "values", ncells, "ncells (the rows of cell_xy)"),
                              ("face_xy", nfxy, "rows", nfaces, "nfaces (the rows of face_cells)"),
                              ("face_length", nlength, "values", nfaces, "nfaces (the rows of face_cells)")])
-        grid = cls._create(f, "mesh", *first, ncells, cxy, area, nfaces, cells, fxy, length)
+        grid = cls._create(f, *first, ncells, cxy, area, nfaces, cells, fxy, length)
         del keep_cxy, keep_area, keep_cells, keep_fxy, keep_length
         return grid
 
@@ -678,7 +659,7 @@ class Grid:
         f, first = cls._mesh_function(function, start_index)
         _, xy, nnodes, keep_xy = _table_in(node_xy, 2, name, f, False)
         _, tris, ntriangles, keep_tris = _table_in(triangle_nodes, 3, "triangle_nodes", f, True)
-        grid = cls._create(f, "mesh", *first, nnodes, xy, ntriangles, tris)
+        grid = cls._create(f, *first, nnodes, xy, ntriangles, tris)
         del keep_xy, keep_tris
         return grid
 
@@ -801,21 +782,16 @@ class Grid:
         raw = _c_path(path, f)
         handle = GridPtr()
         _check(lib.dpsm_load(raw, ctypes.byref(handle)), f, created=True)
-        return cls._loaded(handle, raw, lib)
+        return cls._loaded(handle, lib)
 
     @classmethod
-    def _loaded(cls, handle, raw_path, library):
-        """The Grid of a ``handle`` that ``library`` loaded from ``raw_path``, of the kind the file holds."""
-        # A mesh knows its faces; a grid refuses (and the next call, which
-        # succeeds, clears that message).
-        nfaces = ctypes.c_int64()
-        mesh = library.dpsm_get_face_count(handle, ctypes.byref(nfaces)) == C.DPSM_OK
-        nx, ny = ctypes.c_int64(), ctypes.c_int64()
-        status = library.dpsm_get_shape(handle, ctypes.byref(nx), ctypes.byref(ny))
-        if status != C.DPSM_OK:  # cannot happen with a loaded grid; do not leak it
+    def _loaded(cls, handle, library):
+        """The Grid of a ``handle`` that ``library`` loaded, of the kind the file holds."""
+        try:
+            return cls(_handle=handle, _lib=library)
+        except Error:  # cannot happen with a loaded grid; do not leak it
             library.dpsm_destroy(handle)
-            _check(status, "dpsm_get_shape", library=library)
-        return cls(_handle=handle, _kind="mesh" if mesh else _restart_kind(raw_path, ny.value), _lib=library)
+            raise
 
     def save(self, path):
         """``dpsm_save``: writes everything needed to continue the run bit for
@@ -957,6 +933,13 @@ class Grid:
         distributed grid unless ``OMP_NUM_THREADS`` is set)."""
         f = "dpsm_set_threads"
         self._call(f, _c_int(n, "n", f, C.DPSM_ERR_INVALID_VALUE))
+
+    def get_grid_kind(self):
+        """``dpsm_get_grid_kind``: ``GRID_1D``, ``GRID_AXISYMMETRIC``, ``GRID_2D`` or ``GRID_MESH``, the
+        constructor that made this grid (``kind`` names it)."""
+        value = ctypes.c_int()
+        self._call("dpsm_get_grid_kind", ctypes.byref(value))
+        return value.value
 
     def get_threads(self):
         """``dpsm_get_threads``: how many threads a step will use."""

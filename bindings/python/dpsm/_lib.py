@@ -81,6 +81,7 @@ SIGNATURES = {
     "dpsm_set_max_substeps": (_int, [GridPtr, _i64]),
     "dpsm_set_threads": (_int, [GridPtr, _int]),
     "dpsm_get_threads": (_int, [GridPtr, _P(_int)]),
+    "dpsm_get_grid_kind": (_int, [GridPtr, _P(_int)]),
     "dpsm_set_index_base": (_int, [GridPtr, _int]),
     "dpsm_set_bedrock": (_int, [GridPtr, _P(_dbl)]),
     "dpsm_set_repose_angle_field": (_int, [GridPtr, _P(_dbl)]),

@@ -204,11 +204,11 @@ def _agree(comm, function, prepare):
     return prepared
 
 
-def _make(function, kind, args):
+def _make(function, args):
     """The DistributedGrid that libdpsm_mpi's ``function`` makes from ``args`` (all but ``out``)."""
     handle = _lib.GridPtr()
     _check(getattr(lib, function)(*args, ctypes.byref(handle)), function, created=True, library=lib)
-    return DistributedGrid(_handle=handle, _kind=kind, _lib=lib)
+    return DistributedGrid(_handle=handle, _lib=lib)
 
 
 def _handle_of(comm, fortran):
@@ -253,7 +253,7 @@ def create_2d(comm, nx_global, ny_global, i0, j0, nx_local, ny_local, dx, dy):
         _c_int64(nx_global, "nx_global", f), _c_int64(ny_global, "ny_global", f), _c_int64(i0, "i0", f),
         _c_int64(j0, "j0", f), _c_int64(nx_local, "nx_local", f), _c_int64(ny_local, "ny_local", f),
         _c_double(dx, "dx", f), _c_double(dy, "dy", f)))
-    return _make(f, "2d", (_handle_of(comm, False),) + args)
+    return _make(f, (_handle_of(comm, False),) + args)
 
 
 def create_graph(comm, global_id, owner, cell_xy, cell_area, face_cells, face_xy, face_length, start_index=0):
@@ -287,7 +287,7 @@ def create_graph(comm, global_id, owner, cell_xy, cell_area, face_cells, face_xy
         return name, (ncells, ids, owners, cxy, area, nfaces, cells, fxy, length), keep
 
     name, args, keep = _agree(comm, f, prepare)
-    grid = _make(name, "mesh", (_handle_of(comm, name.endswith("_f")),) + args)
+    grid = _make(name, (_handle_of(comm, name.endswith("_f")),) + args)
     del keep
     return grid
 
@@ -322,7 +322,7 @@ def create_mesh(comm, node_xy, cell_start, cell_nodes, global_id, owner, start_i
         return name, (nnodes, xy, ncells, start_p, nodes_p, ids, owners), keep
 
     name, args, keep = _agree(comm, f, prepare)
-    grid = _make(name, "mesh", (_handle_of(comm, name.endswith("_f")),) + args)
+    grid = _make(name, (_handle_of(comm, name.endswith("_f")),) + args)
     del keep
     return grid
 
@@ -336,4 +336,4 @@ def load(comm, path):
     raw = _agree(comm, f, lambda: _c_path(path, f))
     handle = _lib.GridPtr()
     _check(lib.dpsm_load_mpi(_handle_of(comm, False), raw, ctypes.byref(handle)), f, created=True, library=lib)
-    return DistributedGrid._loaded(handle, raw, lib)
+    return DistributedGrid._loaded(handle, lib)

@@ -1,24 +1,27 @@
-// The one interface between the stepping policy (stepper.cpp) and an engine,
-// the code that evaluates fluxes and advances heights over one kind of
-// geometry: the structured engine for 1D, 2D and axisymmetric grids
-// (src/structured/), a mesh engine later. The stepper splits dt into
-// sub-steps, decides when the surface rests, refuses work it cannot bound
-// and books the ledger; an engine only does what is asked over its own
-// cells, keeps its own active set, and reports what each sub-step did. A new
-// engine implements this class and is chosen in engine_for(); nothing in the
-// C boundary or the stepper changes.
+// What an engine is to the stepping policy: the code that evaluates fluxes
+// and advances heights over one kind of geometry (src/structured/ for 1D,
+// 2D and axisymmetric grids, src/mesh/ for unstructured meshes, a GPU one
+// day). The stepper (src/stepping/) splits dt into sub-steps, decides when
+// the surface rests, refuses work it cannot bound and books the ledger; an
+// engine only does what is asked over its own cells, keeps its own state
+// (an EngineState the grid holds for it: active set, scratch, clocks) and
+// reports what each sub-step did. A new engine implements this class and is
+// chosen in stepping/engine_for.cpp; nothing in the C boundary or the
+// stepper changes.
 #pragma once
 
 #include <cstdint>
 #include <functional>
+#include <memory>
 
 namespace dpsm {
 
 class Grid;
+struct EngineState;
 struct StepInfo;
 
 // What one sub-step did over the engine's cells (on a block of a distributed
-// grid: over all blocks, once the decomposition has summed it).
+// grid: over all blocks, once the distribution has agreed on it).
 struct SubstepSummary {
     bool moved = false;                // some face carried sand
     double outflow_rate = 0.0;         // mass per unit time into sinks (open sides and open cells)
@@ -40,7 +43,7 @@ struct SubstepPlan {
     std::int64_t substeps = 0;
     double sub_dt = 0.0;
     // Sources applied in closed form where they cannot make a face steep
-    // (src/structured/tiled_sweep.hpp, "Lazy sources").
+    // (src/structured/lazy_sources.hpp).
     bool lazy_sources = false;
     // Some cell may move: a source keeps a face steep, or the engine said
     // may_move() before the step.
@@ -51,6 +54,10 @@ class Engine {
 public:
     virtual ~Engine() = default;
 
+    // The state this engine keeps on a grid between calls, made with the
+    // grid (its handle attaches it before any call reaches the grid, so that
+    // the state hears of every change).
+    virtual std::unique_ptr<EngineState> make_state(const Grid &grid) const = 0;
     // The largest sub-step at which explicit Euler is monotone for the flux
     // law on this geometry (dpsm_stable_dt).
     virtual double stable_dt(const Grid &grid) const = 0;
@@ -83,9 +90,10 @@ public:
     // it was where the stepper must step in time instead; throws
     // Error(DPSM_ERR_NOT_APPLICABLE) for a scene it does not support.
     virtual bool relax_to_rest(Grid &grid, std::int64_t budget, double &cells_visited) const = 0;
-};
 
-// The engine that steps this grid.
-const Engine &engine_for(const Grid &grid);
+    // The last step's face fluxes in the layout of dpsm_get_face_fluxes
+    // (library order; fy on 2D grids only), where the grid records them.
+    virtual void read_face_fluxes(const Grid &grid, double *fx, double *fy) const = 0;
+};
 
 }  // namespace dpsm

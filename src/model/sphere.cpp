@@ -1,10 +1,10 @@
-#include "mesh/sphere.hpp"
+#include "model/sphere.hpp"
 
 #include <cmath>
 
 #include "dpsm/dpsm.h"
-#include "mesh/mesh.hpp"
 #include "model/error.hpp"
+#include "model/mesh.hpp"
 
 namespace dpsm {
 

@@ -1,12 +1,11 @@
-#include "stepping/engine.hpp"
+#include "stepping/engine_for.hpp"
 
-#include "model/grid.hpp"
 #include "mesh/mesh_engine.hpp"
+#include "model/grid.hpp"
 #include "structured/structured_engine.hpp"
 
 namespace dpsm {
 
-// The only place that knows which engines there are.
 const Engine &engine_for(const Grid &grid) {
     const Geometry &geo = grid.geometry();
     if (geo.is_mesh()) return mesh_engine();

@@ -13,7 +13,7 @@
 #include <string>
 #include <vector>
 
-#include "mesh/sphere.hpp"
+#include "model/sphere.hpp"
 
 namespace dpsm {
 
@@ -29,7 +29,7 @@ struct MeshInput {
     int start_index = 0;
     // The nodes' coordinates are longitude and latitude in degrees (the
     // _geographic constructors); lengths and areas are then on the sphere
-    // (mesh/sphere.hpp).
+    // (model/sphere.hpp).
     bool geographic = false;
     // kPolygons and kDual: nodes and cells over them (kDual: 3 per triangle,
     // cell_start empty).
@@ -145,7 +145,7 @@ struct Mesh {
 // the host's values and name array positions as the host writes them
 // (host_position).
 // With `geographic`, node_xy holds longitude and latitude in degrees
-// (mesh/sphere.hpp).
+// (model/sphere.hpp).
 std::shared_ptr<const Mesh> mesh_from_polygons(std::int64_t nnodes, const double *node_xy, std::int64_t ncells,
                                                const std::int64_t *cell_start, const std::int64_t *cell_nodes,
                                                const char *function, int base, bool geographic = false);
@@ -156,35 +156,9 @@ std::shared_ptr<const Mesh> mesh_from_graph(std::int64_t ncells, const double *c
 std::shared_ptr<const Mesh> mesh_from_dual(std::int64_t nnodes, const double *node_xy, std::int64_t ntriangles,
                                            const std::int64_t *triangle_nodes, const char *function, int base,
                                            bool geographic = false);
-// A rank's part of a distributed mesh, from the same arrays plus, per host
-// cell, its global id and whether it is a ghost; checked as the builders
-// above check, except that a ghost's faces need not close it. Not finished:
-// the caller (mpi/distributed_mesh.cpp) learns from the other ranks what
-// finish_part needs.
-struct PartOfMesh {
-    const std::int64_t *global_id;
-    const std::uint8_t *ghost;
-};
-std::shared_ptr<Mesh> part_from_polygons(std::int64_t nnodes, const double *node_xy, std::int64_t ncells,
-                                         const std::int64_t *cell_start, const std::int64_t *cell_nodes,
-                                         const PartOfMesh &part, const char *function, int base);
-std::shared_ptr<Mesh> part_from_graph(std::int64_t ncells, const double *cell_xy, const double *cell_area,
-                                      std::int64_t nfaces, const std::int64_t *face_cells, const double *face_xy,
-                                      const double *face_length, const PartOfMesh &part, const char *function,
-                                      int base);
-// The same part again from what a restart file kept, for the rank `rank`.
-std::shared_ptr<Mesh> part_from_input(const MeshInput &input, int rank, const char *function);
 // Whether the least-squares gradients use two rings of neighbours: where
 // cells have fewer than 4 faces on average over the whole mesh.
 bool gradients_over_two_rings(std::int64_t cell_faces, std::int64_t cells);
-// Finishes a part: the gradients of its owned cells over `rings` rings (the
-// second through a ghost n over ghost_neighbours[ghost_start[n - owned] ..
-// ghost_start[n - owned + 1]), library indices, as n's owner has them), the
-// faces of each ghost over the whole mesh (ghost_faces[n - owned]), and the
-// sub-step's scale over the owned cells; the caller makes step_scale and
-// min_distance global.
-void finish_part(Mesh &m, int rings, const std::vector<std::int64_t> &ghost_start,
-                 const std::vector<std::int64_t> &ghost_neighbours, const std::vector<double> &ghost_faces);
 
 // The same mesh again from what a restart file kept.
 std::shared_ptr<const Mesh> mesh_from_input(const MeshInput &input, const char *function);

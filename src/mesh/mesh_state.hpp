@@ -1,0 +1,92 @@
+// What the mesh engine keeps of its own on a grid between calls
+// (model/engine.hpp): the cells the next sub-step must look at, the passes'
+// scratch, and on a part of a distributed mesh its exchange with the ranks
+// around it. It hears of every change the host makes (model/changes.hpp).
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "model/grid.hpp"
+#include "model/switches.hpp"
+
+namespace dpsm {
+
+class GhostExchange;
+
+// Which cells the next sub-step must look at, kept between steps: a face
+// can start to carry sand only where a cell within one face of its cells
+// changed (its slope reads its cells' least-squares gradients).
+struct MeshActivity {
+    std::vector<std::uint8_t> hot;      // per cell; meaningless while all_hot
+    std::vector<std::int64_t> hot_list;  // the cells with hot == 1
+    bool all_hot = true;
+
+    // While all_hot, every hot flag is 0.
+    void wake_all() {
+        for (const std::int64_t c : hot_list) hot[c] = 0;
+        hot_list.clear();
+        all_hot = true;
+    }
+    // Starts a list of hot cells from none.
+    void cool_all() {
+        for (const std::int64_t c : hot_list) hot[c] = 0;
+        hot_list.clear();
+        all_hot = false;
+    }
+    void wake(std::int64_t c) {
+        if (all_hot || hot[c]) return;
+        hot[c] = 1;
+        hot_list.push_back(c);
+    }
+    // A cell that changed and the cells whose gradients read it: a face
+    // reads its cells' heights and gradients.
+    void wake_around(const Mesh &mesh, std::int64_t c) {
+        if (all_hot) return;
+        wake(c);
+        for (std::int64_t k = mesh.grad_start[c]; k < mesh.grad_start[c + 1]; ++k) wake(mesh.grad_cells[k]);
+    }
+    bool may_move() const { return all_hot || !hot_list.empty(); }
+};
+
+struct MeshState final : EngineState {
+    explicit MeshState(const Grid &grid);
+
+    void changed(const Grid &grid, unsigned what, const ChangedCells *cells) override;
+    bool wants_changed_cells() const override { return true; }
+
+    MeshActivity activity;
+    // The switches of tests (model/switches.hpp), read at the start of each step's work.
+    Switches switches;
+    // On a part of a distributed mesh: its exchange with the ranks around it
+    // (the grid's Distribution), found at the start of each step.
+    GhostExchange *exchange = nullptr;
+
+    // The passes' scratch.
+    std::vector<double> gx, gy;   // least-squares gradients
+    std::vector<double> flux;     // per face, volume per unit time from a to b; 0 outside a sub-step's faces
+    std::vector<std::uint32_t> face_seen, cell_seen;
+    std::uint32_t stamp = 0;
+    std::vector<std::int64_t> faces, gradient_cells, update_cells;
+    std::vector<std::int64_t> changed_ghosts;  // a part's ghosts whose owners sent new values
+    std::vector<double> available;         // bed: the sand (a volume) a cell's faces may take
+    std::vector<std::uint8_t> carried;     // dense: per cell, a face of it carried sand
+    bool flux_clean = true;
+    // A part that takes several sub-steps per exchange: the owned cells
+    // updated since the last exchange (all of them when batch_all).
+    std::vector<std::int64_t> batch_cells;
+    std::vector<std::uint8_t> in_batch;
+    bool batch_all = false;
+
+    // What the host's masks, sources and edges make of the mesh, found again
+    // after the host changed them (lists_current false).
+    std::vector<std::int64_t> source_cells;        // owned sand cells with a source
+    std::vector<std::int64_t> ghost_source_cells;  // a part's ghosts with a source, stepped where they are in reach
+    std::vector<std::int64_t> sink_faces;          // faces onto open edges or open cells
+    bool lists_current = false;
+};
+
+MeshState &mesh_state(Grid &grid);
+const MeshState &mesh_state(const Grid &grid);
+
+}  // namespace dpsm
