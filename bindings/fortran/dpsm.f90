@@ -1376,7 +1376,19 @@ contains
                          ' values but the grid has '//itoa(nx*ny)//' cells: pass cell_area('//itoa(nx*ny)//')')
       end if
     end if
-    if (status == DPSM_OK) status = c_dpsm_get_cell_centres(g%ptr, cell_xy, cell_area)
+    ! An absent assumed-shape array has no descriptor to take the address of:
+    ! each case is its own call (absent arguments reach C as NULL).
+    if (status == DPSM_OK) then
+      if (present(cell_xy) .and. present(cell_area)) then
+        status = c_dpsm_get_cell_centres(g%ptr, cell_xy, cell_area)
+      else if (present(cell_xy)) then
+        status = c_dpsm_get_cell_centres(g%ptr, cell_xy=cell_xy)
+      else if (present(cell_area)) then
+        status = c_dpsm_get_cell_centres(g%ptr, cell_area=cell_area)
+      else
+        status = c_dpsm_get_cell_centres(g%ptr)
+      end if
+    end if
     call finish(status, ierr, 'dpsm_get_cell_centres', g)
   end subroutine dpsm_get_cell_centres
 
