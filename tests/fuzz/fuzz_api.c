@@ -2401,7 +2401,8 @@ static void mesh_operation(mesh_state_t *ms, reader_t *r) {
             /* Where each cell lies: the harness's own centroids (a graph's
              * centres, the dual's nodes) and areas, in the host's order. */
             double *xy = xcalloc((size_t)(2 * n), sizeof(double)), *area = xcalloc((size_t)n, sizeof(double));
-            MESH_CALL(ms, DPSM_OK, "dpsm_get_cell_centres",
+            /* Either array may be NULL; both NULL is refused. */
+            MESH_CALL(ms, (b & 24) == 24 ? DPSM_ERR_NULL_POINTER : DPSM_OK, "dpsm_get_cell_centres",
                       dpsm_get_cell_centres(ms->g, b & 8 ? NULL : xy, b & 16 ? NULL : area));
             MESH_CALL(ms, DPSM_ERR_NULL_POINTER, "dpsm_get_cell_centres", dpsm_get_cell_centres(ms->g, NULL, NULL));
             for (int64_t c = 0; c < n; ++c) {
