@@ -272,8 +272,9 @@ static const command kCommands[] = {
      "[n [runs]]  2 n^2 (n = 708: 1,002,528) jittered triangles: a fully active sub-step on 1 and 2 threads against the"
      " plain face loop; ridges on ~1 % of cells and a mesh at rest against a fully active sub-step"},
     {"mesh-accuracy", cmd_mesh_accuracy,
-     "[threads [levels [mesh]]]  column collapse (a = 0.5, 30 deg) to rest on quadrilaterals, jittered triangles, hexagons and"
-     " the median dual at about 4,000, 16,000, 65,000 cells: L1 error, order, runout; the cone on triangles"},
+     "[threads [levels [mesh]]]  column collapse (a = 0.5, 30 deg) to rest on quadrilaterals, jittered triangles, hexagons,"
+     " the median dual (and a gmsh disk) at about 4,000, 16,000, 65,000, 262,000 cells (levels, 4): L1 error, order, runout,"
+     " rest time, beside the 2D grid of the same cell size and the mesh turned by 30 degrees; the cone on triangles"},
     {"lts", cmd_lts,
      "[m]  local time stepping study: quadtree meshes of cells h..8h (m = 256 fine cells across) against uniform"
      " squares of the same count, column collapse to rest: sub-steps, cell updates now and with local time steps"},

@@ -347,6 +347,18 @@ void scene_disk_fractions(const mesh_scene *s, double radius, double *share) {
     free(total);
 }
 
+void scene_rotate(mesh_scene *s, double angle) {
+    const double c = cos(angle), n = sin(angle);
+    for (int64_t k = 0; k < s->nnodes; ++k) {
+        const double x = s->node_xy[2 * k], y = s->node_xy[2 * k + 1];
+        s->node_xy[2 * k] = c * x - n * y, s->node_xy[2 * k + 1] = n * x + c * y;
+    }
+    for (int64_t k = 0; k < s->cells; ++k) {
+        const double x = s->cx[k], y = s->cy[k];
+        s->cx[k] = c * x - n * y, s->cy[k] = n * x + c * y;
+    }
+}
+
 double scene_mean_size(const mesh_scene *s) {
     double total = 0.0;
     for (int64_t c = 0; c < s->cells; ++c) total += s->area[c];

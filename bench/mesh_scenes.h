@@ -36,6 +36,9 @@ mesh_scene scene_read_msh(const char *path);
 int scene_create(const mesh_scene *s, dpsm_grid **out);
 /* The share of every cell inside the disk of radius r about the origin. */
 void scene_disk_fractions(const mesh_scene *s, double r, double *share);
+/* Turns the scene by `angle` radians about the origin: its nodes and its
+ * cells' centres (the same cells, in the same order). */
+void scene_rotate(mesh_scene *s, double angle);
 /* The mean cell size: the square root of the mean area. */
 double scene_mean_size(const mesh_scene *s);
 const char *scene_name(scene_kind kind);

@@ -2,11 +2,14 @@
  *
  * mesh-accuracy: the column collapse of the 2D validation (a = 0.5, 30
  * degrees, open table, the exact deposit a truncated cone) on every mesh
- * kind of mesh_scenes.h at three refinements, stepped in time to rest: the
+ * kind of mesh_scenes.h at four refinements, stepped in time to rest: the
  * L1 difference over the column's volume, the observed order, the runout in
- * 16 directions against the exact foot, the time at which it rested; and the
- * cone (40 high, slope 1.5, 33 degrees) on jittered triangles, its top
- * against 22.89.
+ * 16 directions against the exact foot, the time at which it rested; beside
+ * each, the same column on the 2D grid of squares of the same mean size (the
+ * grid engine's error and rest time) and, at the two coarsest levels, on the
+ * same mesh turned by 30 degrees (the deposits' difference, cell by cell,
+ * against the error); and the cone (40 high, slope 1.5, 33 degrees) on
+ * jittered triangles, its top against 22.89.
  *
  * mesh: a fully active jittered triangle mesh (steep plane, every face over
  * the threshold) against the plain face loop below (one pass over faces
@@ -35,6 +38,11 @@ typedef struct {
     double seconds, cell_updates;
     int64_t cells;
     double size;
+    /* The same column on the 2D grid of squares of this mean size, and on
+     * this mesh turned by 30 degrees (the L1 difference of the deposits, cell
+     * by cell, over the L1 error; NAN where not run). */
+    int64_t grid_cells;
+    double grid_l1, grid_rest_time, rotated;
 } mesh_result;
 
 static double column_foot(double alpha) { return (0.5 + sqrt(4.0 * alpha * alpha - 0.25 / 3.0)) / (2.0 * alpha); }
@@ -71,44 +79,109 @@ static dpsm_grid *open_mesh(const mesh_scene *s, double theta, int threads, cons
     return g;
 }
 
-static mesh_result column_on(scene_kind kind, int n, int threads) {
-    const double theta = 30.0 * kPi / 180.0, alpha = tan(theta), foot = column_foot(alpha);
-    const double half = 1.25 * fmax(2.0, foot);
-    mesh_scene s = scene_make(kind, n, half, 12345u);
-    mesh_result r;
-    memset(&r, 0, sizeof r);
-    if (s.cells == 0) return r; /* gmsh or its .geo not found */
-    double *share = xcalloc((size_t)s.cells, sizeof(double)), *h = xcalloc((size_t)s.cells, sizeof(double));
-    scene_disk_fractions(&s, 1.0, share);
-    for (int64_t c = 0; c < s.cells; ++c) h[c] = 0.5 * share[c];
-    r.cells = s.cells;
-    r.size = scene_mean_size(&s);
-    const double t0 = now_seconds();
-    dpsm_grid *g = open_mesh(&s, theta, threads, h);
-    step_to_rest(g, 0.1, 20.0, &r);
-    CHECK(g, dpsm_get_heights(g, h));
-    r.seconds = now_seconds() - t0;
-    double err = 0.0, volume = kPi * 0.5, top = 0.0;
-    double runout[16] = {0};
-    for (int64_t c = 0; c < s.cells; ++c) {
-        const double radius = hypot(s.cx[c], s.cy[c]);
+/* The column (a = 0.5, 30 degrees, radius 1 about the origin) poured on the
+ * scene's cells as cell averages; the square it stands on. */
+static const double kColumnTheta = 30.0 * 3.14159265358979323846 / 180.0;
+static double column_half(void) { return 1.25 * fmax(2.0, column_foot(tan(kColumnTheta))); }
+static double *poured_column(const mesh_scene *s) {
+    double *h = xcalloc((size_t)s->cells, sizeof(double));
+    scene_disk_fractions(s, 1.0, h);
+    for (int64_t c = 0; c < s->cells; ++c) h[c] *= 0.5;
+    return h;
+}
+
+/* The L1 error of the deposit h on the scene's cells over the column's
+ * volume, its runout in 16 directions against the exact foot, its top. */
+static void score_column(const mesh_scene *s, const double *h, mesh_result *r) {
+    const double alpha = tan(kColumnTheta), foot = column_foot(alpha);
+    double err = 0.0, top = 0.0, runout[16] = {0};
+    for (int64_t c = 0; c < s->cells; ++c) {
+        const double radius = hypot(s->cx[c], s->cy[c]);
         const double exact = fmin(0.5, fmax(0.0, alpha * (foot - radius)));
-        err += fabs(h[c] - exact) * s.area[c];
+        err += fabs(h[c] - exact) * s->area[c];
         top = fmax(top, h[c]);
         if (h[c] > 1e-6) {
-            const double angle = atan2(s.cy[c], s.cx[c]);
+            const double angle = atan2(s->cy[c], s->cx[c]);
             const int sector = ((int)lround(angle / (2.0 * kPi / 16.0)) + 16) % 16;
-            const double along = s.cx[c] * cos(sector * 2.0 * kPi / 16.0) + s.cy[c] * sin(sector * 2.0 * kPi / 16.0);
+            const double along = s->cx[c] * cos(sector * 2.0 * kPi / 16.0) + s->cy[c] * sin(sector * 2.0 * kPi / 16.0);
             /* within half a cell of the ray */
-            const double across = fabs(-s.cx[c] * sin(sector * 2.0 * kPi / 16.0) + s.cy[c] * cos(sector * 2.0 * kPi / 16.0));
-            if (across <= r.size && along > runout[sector]) runout[sector] = along;
+            const double across =
+                fabs(-s->cx[c] * sin(sector * 2.0 * kPi / 16.0) + s->cy[c] * cos(sector * 2.0 * kPi / 16.0));
+            if (across <= r->size && along > runout[sector]) runout[sector] = along;
         }
     }
-    r.l1 = err / volume;
-    r.top = top;
-    for (int k = 0; k < 16; ++k) r.runout_error = fmax(r.runout_error, fabs(runout[k] - foot));
+    r->l1 = err / (kPi * 0.5);
+    r->top = top;
+    r->runout_error = 0.0;
+    for (int k = 0; k < 16; ++k) r->runout_error = fmax(r->runout_error, fabs(runout[k] - foot));
+}
+
+/* The column on the scene's mesh, stepped to rest; the deposit in h. */
+static void collapse_on_mesh(const mesh_scene *s, int threads, double *h, mesh_result *r) {
+    double *poured = poured_column(s);
+    const double t0 = now_seconds();
+    dpsm_grid *g = open_mesh(s, kColumnTheta, threads, poured);
+    step_to_rest(g, 0.1, 20.0, r);
+    CHECK(g, dpsm_get_heights(g, h));
+    r->seconds = now_seconds() - t0;
     dpsm_destroy(g);
-    free(share);
+    free(poured);
+}
+
+/* The same column on the 2D grid of n x n squares over the same square,
+ * every side open: the grid engine's L1 error and rest time. */
+static void collapse_on_grid(int n, int threads, mesh_result *r) {
+    mesh_scene squares = scene_make(SCENE_QUADS, n, column_half(), 1u); /* the grid's cells, x fastest */
+    double *h = poured_column(&squares);
+    const double d = 2.0 * column_half() / n;
+    dpsm_grid *g = NULL;
+    CHECK(NULL, dpsm_create_2d(n, n, d, d, &g));
+    CHECK(g, dpsm_set_threads(g, threads));
+    CHECK(g, dpsm_set_repose_angle(g, kColumnTheta));
+    for (int side = DPSM_XMIN; side <= DPSM_YMAX; ++side) CHECK(g, dpsm_set_boundary(g, side, DPSM_OPEN));
+    CHECK(g, dpsm_set_heights(g, h));
+    mesh_result grid;
+    memset(&grid, 0, sizeof grid);
+    grid.size = d;
+    step_to_rest(g, 0.1, 20.0, &grid);
+    CHECK(g, dpsm_get_heights(g, h));
+    score_column(&squares, h, &grid);
+    r->grid_cells = squares.cells;
+    r->grid_l1 = grid.l1;
+    r->grid_rest_time = grid.rest_time;
+    dpsm_destroy(g);
+    free(h);
+    scene_free(&squares);
+}
+
+/* The column on `kind` at refinement n, beside the grid's; with `turned`,
+ * also on the same mesh turned by 30 degrees about the column's axis. */
+static mesh_result column_on(scene_kind kind, int n, int threads, int turned) {
+    mesh_scene s = scene_make(kind, n, column_half(), 12345u);
+    mesh_result r;
+    memset(&r, 0, sizeof r);
+    r.rotated = NAN;
+    if (s.cells == 0) return r; /* gmsh or its .geo not found */
+    r.cells = s.cells;
+    r.size = scene_mean_size(&s);
+    double *h = xcalloc((size_t)s.cells, sizeof(double));
+    collapse_on_mesh(&s, threads, h, &r);
+    score_column(&s, h, &r);
+    if (turned) {
+        /* A turned copy of a mesh is the same mesh: only a choice bound to
+         * the axes could make its deposit differ beyond rounding. */
+        mesh_scene t = scene_make(kind, n, column_half(), 12345u);
+        scene_rotate(&t, 30.0 * kPi / 180.0);
+        double *ht = xcalloc((size_t)t.cells, sizeof(double));
+        mesh_result rt = r;
+        collapse_on_mesh(&t, threads, ht, &rt);
+        double difference = 0.0;
+        for (int64_t c = 0; c < s.cells; ++c) difference += fabs(h[c] - ht[c]) * s.area[c];
+        r.rotated = difference / (kPi * 0.5) / r.l1;
+        free(ht);
+        scene_free(&t);
+    }
+    collapse_on_grid((int)lround(2.0 * column_half() / r.size), threads, &r);
     free(h);
     scene_free(&s);
     return r;
@@ -138,42 +211,44 @@ static mesh_result cone_on(scene_kind kind, int n, int threads) {
 
 int cmd_mesh_accuracy(int argc, char **argv) {
     const int threads = argc > 0 ? atoi(argv[0]) : 0;
-    const int levels = argc > 1 ? atoi(argv[1]) : 3;
+    const int levels = argc > 1 ? atoi(argv[1]) : 4;
     const char *only = argc > 2 ? argv[2] : NULL; /* one mesh kind (its name) or "columns", without the cone */
-    /* about 4,000, 16,000 and 65,000 cells on each kind */
+    /* about 4,000, 16,000, 65,000 and 262,000 cells on each kind */
     static const struct {
         scene_kind kind;
         int n;
     } kinds[] = {{SCENE_QUADS, 64}, {SCENE_TRIANGLES, 45}, {SCENE_HEXAGONS, 59}, {SCENE_DUAL, 64}, {SCENE_GMSH_DISK, 64}};
-    const double alpha = tan(30.0 * kPi / 180.0);
     fprintf(stderr, "mesh-accuracy: column collapse a = 0.5, 30 deg, open edges; exact foot %.4f; threads %d\n",
-            column_foot(alpha), threads);
-    printf("scene,mesh,cells,mean_size,l1_error,order,runout_error_cells,at_rest,rest_time,cell_updates,seconds\n");
+            column_foot(tan(kColumnTheta)), threads);
+    printf("scene,mesh,cells,mean_size,l1_error,order,runout_error_cells,at_rest,rest_time,cell_updates,seconds,"
+           "grid_cells,grid_l1_error,grid_rest_time,rest_time_ratio,turned_difference\n");
     fflush(stdout);
     for (size_t k = 0; k < sizeof kinds / sizeof *kinds; ++k) {
         if (only && strcmp(only, "columns") != 0 && strcmp(only, scene_name(kinds[k].kind)) != 0) continue;
         double previous = 0.0;
         for (int level = 0; level < levels; ++level) {
             const int n = kinds[k].n << level;
-            const mesh_result r = column_on(kinds[k].kind, n, threads);
+            /* The turned copy at the two coarsest levels: it doubles a level's cost. */
+            const mesh_result r = column_on(kinds[k].kind, n, threads, level < 2);
             if (r.cells == 0) {
                 fprintf(stderr, "mesh-accuracy: %s skipped: gmsh not found or DPSM_DISK_GEO (bench/data/disk.geo) not set\n",
                         scene_name(kinds[k].kind));
                 break;
             }
             const double order = level > 0 ? log2(previous / r.l1) : NAN;
-            printf("column,%s,%lld,%.5f,%.4e,%.2f,%.2f,%d,%.3f,%.4g,%.3f\n", scene_name(kinds[k].kind),
-                   (long long)r.cells, r.size, r.l1, order, r.runout_error / r.size, r.at_rest, r.rest_time,
-                   r.cell_updates, r.seconds);
+            printf("column,%s,%lld,%.5f,%.4e,%.2f,%.2f,%d,%.3f,%.4g,%.3f,%lld,%.4e,%.3f,%.3f,%.2e\n",
+                   scene_name(kinds[k].kind), (long long)r.cells, r.size, r.l1, order, r.runout_error / r.size,
+                   r.at_rest, r.rest_time, r.cell_updates, r.seconds, (long long)r.grid_cells, r.grid_l1,
+                   r.grid_rest_time, r.rest_time / r.grid_rest_time, r.rotated);
             fflush(stdout);
             previous = r.l1;
         }
     }
     if (only) return 0;
     const mesh_result cone = cone_on(SCENE_TRIANGLES, 72, threads);
-    printf("cone,%s,%lld,%.5f,top %.4f against 22.89 (%+.3f %%),,,%d,%.3f,%.4g,%.3f\n", scene_name(SCENE_TRIANGLES),
-           (long long)cone.cells, cone.size, cone.top, 100.0 * (cone.top / 22.89 - 1.0), cone.at_rest, cone.rest_time,
-           cone.cell_updates, cone.seconds);
+    printf("cone,%s,%lld,%.5f,top %.4f against 22.89 (%+.3f %%),,,%d,%.3f,%.4g,%.3f,,,,,\n",
+           scene_name(SCENE_TRIANGLES), (long long)cone.cells, cone.size, cone.top, 100.0 * (cone.top / 22.89 - 1.0),
+           cone.at_rest, cone.rest_time, cone.cell_updates, cone.seconds);
     return 0;
 }
 

@@ -297,21 +297,21 @@ private:
         double max_excess = 0.0;
         bool moved = false;
         const CellUpdate update_cell{m, s.flux.data(), kind.data(), q, grid.bed(), h, residual, dt};
+        // On a part that steps its ghosts in reach: their gradients, faces and cells too.
+        const BatchReach reach{m, in_batch};
 
         if (dense) {
             // The owned cells and the faces that touch them: all of a serial mesh.
             const std::int64_t n = m.owned, nf = m.live_faces;
             const bool parallel = threads > 1 && n >= kCellsForThreads;
-            // The ghosts in reach, in a part that steps them (none otherwise).
-            const std::int64_t *extra_cells = in_batch ? m.ghosts_by_reach.data() : nullptr;
-            const std::int64_t extra_count = in_batch ? m.ghosts_with_reach[static_cast<std::size_t>(in_batch)] : 0;
+            const std::int64_t *extra_cells = reach.ghosts();
+            const std::int64_t extra_count = reach.ghost_count();
             if (law.isotropic) {
 #pragma omp parallel for num_threads(threads) if (parallel) schedule(static)
                 for (std::int64_t c = 0; c < n; ++c) gradient_of(m, h.data(), kind.data(), c, s.gx.data(), s.gy.data());
                 if (in_batch) {
-                    for (std::int64_t k = 0; k < m.ghosts_with_gradient_reach[static_cast<std::size_t>(in_batch)]; ++k)
-                        gradient_of(m, h.data(), kind.data(), m.ghosts_by_gradient_reach[static_cast<std::size_t>(k)],
-                                    s.gx.data(), s.gy.data());
+                    for (std::int64_t k = 0; k < reach.ghost_gradient_count(); ++k)
+                        gradient_of(m, h.data(), kind.data(), reach.ghost_gradients()[k], s.gx.data(), s.gy.data());
                 } else if (parts) {
                     exchange_ghost_gradients(s, nullptr, changed_ghosts);
                 }
@@ -327,13 +327,11 @@ private:
                     max_excess = std::max(max_excess, excess);
                 }
             }
-            if (in_batch) {
-                // The faces beyond the owned cells' that the ghosts in reach need; they count for nothing here.
-                for (std::int64_t k = 0; k < m.faces_with_reach[static_cast<std::size_t>(in_batch)]; ++k) {
-                    const std::int64_t f = m.faces_by_reach[static_cast<std::size_t>(k)];
-                    double excess = 0.0;
-                    flux[f] = law(f, excess);
-                }
+            // The faces beyond the owned cells' that the ghosts in reach need; they count for nothing here.
+            for (std::int64_t k = 0; k < reach.face_count(); ++k) {
+                const std::int64_t f = reach.faces()[k];
+                double excess = 0.0;
+                flux[f] = law(f, excess);
             }
             s.flux_clean = false;
             std::uint8_t *changed = s.carried.data();
@@ -357,7 +355,7 @@ private:
             }
             changed_ghosts.clear();
             if (in_batch)
-                s.batch_all = true;
+                note_batch_updates_everywhere(s);
             else if (parts)
                 exchange_ghost_heights(grid, s, nullptr, changed_ghosts);
             // The next sub-step looks at the cells that changed and those whose
@@ -385,24 +383,14 @@ private:
             std::uint32_t stamp = next_stamp(s);
             s.faces.clear();
             s.gradient_cells.clear();
-            // On a part that steps its ghosts in reach: their faces and gradients too.
-            const auto face_in_reach = [&](std::int64_t f) {
-                return f < m.live_faces || (in_batch && m.face_reach[static_cast<std::size_t>(f)] >= in_batch);
-            };
-            const auto gradient_in_reach = [&](std::int64_t c) {
-                return c < m.owned || (in_batch && m.gradient_reach[static_cast<std::size_t>(c)] >= in_batch);
-            };
-            const auto cell_in_reach = [&](std::int64_t c) {
-                return c < m.owned || (in_batch && m.reach[static_cast<std::size_t>(c)] >= in_batch);
-            };
             const auto look_at_faces_of = [&](std::int64_t c) {
                 for (std::int64_t k = m.cell_face_start[c]; k < m.cell_face_start[c + 1]; ++k) {
                     const std::int64_t f = m.cell_faces[k];
-                    if (!face_in_reach(f) || s.face_seen[f] == stamp) continue;
+                    if (!reach.face(f) || s.face_seen[f] == stamp) continue;
                     s.face_seen[f] = stamp;
                     s.faces.push_back(f);
                     for (const std::int64_t e : {m.face_a[f], m.face_b[f]})
-                        if (e >= 0 && gradient_in_reach(e) && s.cell_seen[e] != stamp) {
+                        if (e >= 0 && reach.gradient(e) && s.cell_seen[e] != stamp) {
                             s.cell_seen[e] = stamp;
                             s.gradient_cells.push_back(e);
                         }
@@ -427,7 +415,7 @@ private:
             const std::uint32_t update_stamp = next_stamp(s);
             s.update_cells.clear();
             const auto to_update = [&](std::int64_t c) {
-                if (cell_in_reach(c) && s.cell_seen[c] != update_stamp) {
+                if (reach.cell(c) && s.cell_seen[c] != update_stamp) {
                     s.cell_seen[c] = update_stamp;
                     s.update_cells.push_back(c);
                 }
@@ -451,8 +439,7 @@ private:
             for (const std::int64_t c : s.update_cells) update_cell(c);
             visited = static_cast<double>(s.gradient_cells.size() + s.update_cells.size() - carried_cells);
             if (in_batch) {
-                for (const std::int64_t c : s.update_cells)
-                    if (c < m.owned && !s.in_batch[c]) s.in_batch[c] = 1, s.batch_cells.push_back(c);
+                note_batch_updates(s, m, s.update_cells);
             } else if (parts) {
                 exchange_ghost_heights(grid, s, &s.update_cells, changed_ghosts);
             }

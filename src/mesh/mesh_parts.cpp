@@ -34,6 +34,13 @@ void exchange_ghost_heights(Grid &grid, MeshState &s, const std::vector<std::int
     s.exchange->send_changed(GhostExchange::kEveryGhost, height_fields(grid), computed, changed_ghosts);
 }
 
+void note_batch_updates(MeshState &s, const Mesh &m, const std::vector<std::int64_t> &cells) {
+    for (const std::int64_t c : cells)
+        if (c < m.owned && !s.in_batch[c]) s.in_batch[c] = 1, s.batch_cells.push_back(c);
+}
+
+void note_batch_updates_everywhere(MeshState &s) { s.batch_all = true; }
+
 void end_batch(Grid &grid, const Mesh &m, MeshState &s) {
     std::vector<std::int64_t> &changed_ghosts = s.changed_ghosts;
     changed_ghosts.clear();

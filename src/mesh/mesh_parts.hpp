@@ -17,12 +17,40 @@
 #include <cstdint>
 #include <vector>
 
+#include "model/mesh.hpp"
+
 namespace dpsm {
 
 class Grid;
 class GhostExchange;
-struct Mesh;
 struct MeshState;
+
+// What the j-th sub-step after an exchange (j from 1; 0: a sub-step that
+// exchanges, and steps the owned cells alone) steps beyond the owned cells:
+// the ghosts, gradients and faces whose reach is at least j (Mesh::reach),
+// which the part then computes as their owners do.
+struct BatchReach {
+    const Mesh &m;
+    int j;
+
+    bool face(std::int64_t f) const {
+        return f < m.live_faces || (j && m.face_reach[static_cast<std::size_t>(f)] >= j);
+    }
+    bool gradient(std::int64_t c) const {
+        return c < m.owned || (j && m.gradient_reach[static_cast<std::size_t>(c)] >= j);
+    }
+    bool cell(std::int64_t c) const { return c < m.owned || (j && m.reach[static_cast<std::size_t>(c)] >= j); }
+    // The ghosts, ghost gradients and faces beyond the owned cells' in reach: the
+    // first count(...) of each list.
+    const std::int64_t *ghosts() const { return m.ghosts_by_reach.data(); }
+    std::int64_t ghost_count() const { return j ? m.ghosts_with_reach[static_cast<std::size_t>(j)] : 0; }
+    const std::int64_t *ghost_gradients() const { return m.ghosts_by_gradient_reach.data(); }
+    std::int64_t ghost_gradient_count() const {
+        return j ? m.ghosts_with_gradient_reach[static_cast<std::size_t>(j)] : 0;
+    }
+    const std::int64_t *faces() const { return m.faces_by_reach.data(); }
+    std::int64_t face_count() const { return j ? m.faces_with_reach[static_cast<std::size_t>(j)] : 0; }
+};
 
 // Whether this part steps its ghosts in reach (several sub-steps per exchange).
 bool steps_ghosts(const Grid &grid);
@@ -37,6 +65,10 @@ void exchange_ghost_gradients(MeshState &s, const std::vector<std::int64_t> *com
 // steps its ghosts their residuals) once the owned cells changed.
 void exchange_ghost_heights(Grid &grid, MeshState &s, const std::vector<std::int64_t> *computed,
                             std::vector<std::int64_t> &changed_ghosts);
+// In a batch: the owned cells a sub-step updated go to the batch's exchange
+// (all of them with `every_cell`).
+void note_batch_updates(MeshState &s, const Mesh &m, const std::vector<std::int64_t> &cells);
+void note_batch_updates_everywhere(MeshState &s);
 // The end of a batch: the owned cells' heights that changed since the last
 // exchange go to the ranks that hold them as ghosts; ghosts that were beyond
 // reach, and so differ from their owners' values, wake the cells that read them.

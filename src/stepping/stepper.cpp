@@ -168,7 +168,7 @@ void step_in_time(Grid &grid, double dt, std::int64_t most) {
     plan.sub_dt = bounded ? dt / static_cast<double>(plan.substeps) : dt_max;
 
     // A source is applied lazily where it cannot make a face steep within
-    // the step (structured/tiled_sweep.hpp), with the physics of real scenes at every
+    // the step (structured/lazy_sources.hpp), with the physics of real scenes at every
     // sub-step; `driven`: a source may keep sand moving in this step.
     const bool source_active = state.source_active;
     const bool lazy = source_active && bounded && !grid.uses_physics();

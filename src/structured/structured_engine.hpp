@@ -1,4 +1,4 @@
-// The structured engine behind the Engine interface (stepping/engine.hpp):
+// The structured engine behind the Engine interface (model/engine.hpp):
 // the tiled sweep with its active set for 2D grids, the line sweep for 1D
 // and axisymmetric ones.
 #pragma once

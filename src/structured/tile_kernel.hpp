@@ -75,7 +75,7 @@ struct TileLevelStats {
 struct TileBuffers {
     int width = 0, height = 0;  // of the buffer, cells
     std::vector<double> h[2], residual[2], source;
-    // Lazy sources (structured/tiled_sweep.hpp): per cell, the sub-step of the step
+    // Lazy sources (structured/lazy_sources.hpp): per cell, the sub-step of the step
     // after which its stored height h is current; and, per level, the height
     // now (true_h, what faces see) and what its source added since (lag).
     std::vector<double> since[2], true_h, lag;
@@ -160,7 +160,7 @@ using TileKernel = void (*)(TileBuffers &buffers, const LevelCells &cells, const
 // changes only in a sub-step in which one of its faces carries sand: then it
 // takes its source since it was last current (lag) and for this sub-step,
 // and becomes current. Elsewhere it keeps its stored height, and what its
-// source adds is applied later in closed form (structured/tiled_sweep.hpp), so the bits
+// source adds is applied later in closed form (structured/lazy_sources.hpp), so the bits
 // of a cell do not depend on which sweeps visit it. With the physics of real
 // scenes the source is applied at every sub-step (a bed caps erosion).
 TileKernel select_tile_kernel(bool masked, bool isotropic, bool source, bool grid_in = false, bool grid_out = false,

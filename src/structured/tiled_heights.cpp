@@ -18,67 +18,71 @@ void heights_changed(StructuredState &state, const CellBox &box) {
     if (state.has_tiled_workspace()) tiled_workspace_changed(state.tiled_workspace(), *state.active, box);
 }
 
+// Calls part(box) with the part of `within` in each tile it meets, clipped
+// to the grid: the relaxation's writes, as the host's edits, cost the tiles
+// they touch.
+template <class Part>
+void for_tile_parts(const Geometry &geo, const CellBox &within, Part &&part) {
+    const std::int64_t side = ActiveSet::kTile;
+    const CellBox clipped = within.grown_within(0, CellBox{0, geo.nx, 0, geo.ny});
+    if (clipped.empty()) return;
+    for (std::int64_t tj = clipped.j0 - clipped.j0 % side; tj < clipped.j1; tj += side)
+        for (std::int64_t ti = clipped.i0 - clipped.i0 % side; ti < clipped.i1; ti += side) {
+            CellBox box;
+            box.add(std::max(ti, clipped.i0), std::min(ti + side, clipped.i1), std::max(tj, clipped.j0),
+                    std::min(tj + side, clipped.j1));
+            part(box);
+        }
+}
+
 }  // namespace
 
 void set_heights_between_sweeps(Grid &grid, const double *y, const CellBox &within) {
     StructuredState &state = structured_state(grid);
-    const Geometry &geo = grid.geometry();
-    const std::int64_t nx = geo.nx, ny = geo.ny, side = ActiveSet::kTile;
-    const std::int64_t wi0 = std::max<std::int64_t>(within.i0, 0), wi1 = std::min(within.i1, nx);
-    const std::int64_t wj0 = std::max<std::int64_t>(within.j0, 0), wj1 = std::min(within.j1, ny);
-    if (wi0 >= wi1 || wj0 >= wj1) return;
+    const std::int64_t nx = grid.geometry().nx, ny = grid.geometry().ny;
     std::vector<double> &heights = grid.heights_for_stepping();
     std::vector<float> &residuals = grid.residuals_for_stepping();
-    for (std::int64_t tj = wj0 - wj0 % side; tj < wj1; tj += side)
-        for (std::int64_t ti = wi0 - wi0 % side; ti < wi1; ti += side) {
-            // Per tile, so that a pile in one corner wakes only its own cells.
-            const std::int64_t i_begin = std::max(ti, wi0), i_end = std::min(ti + side, wi1);
-            const std::int64_t j_begin = std::max(tj, wj0), j_end = std::min(tj + side, wj1);
-            std::int64_t i0 = nx, i1 = -1, j0 = ny, j1 = -1;
-            for (std::int64_t j = j_begin; j < j_end; ++j) {
-                const double *row_y = y + nx * j;
-                double *row_h = heights.data() + nx * j;
-                float *row_r = residuals.data() + nx * j;
-                auto differs = [&](std::int64_t i) { return row_h[i] != row_y[i] || row_r[i] != 0.0f; };
-                // The first and the last cell that differ; those between are
-                // simply overwritten (where they agree, with the same values).
-                std::int64_t first = i_begin;
-                while (first < i_end && !differs(first)) ++first;
-                if (first == i_end) continue;
-                std::int64_t last = i_end - 1;
-                while (!differs(last)) --last;
-                for (std::int64_t i = first; i <= last; ++i) {
-                    row_h[i] = row_y[i];
-                    row_r[i] = 0.0f;
-                }
-                i0 = std::min(i0, first);
-                i1 = std::max(i1, last);
-                j0 = std::min(j0, j);
-                j1 = j;
+    // Per tile, so that a pile in one corner wakes only its own cells.
+    for_tile_parts(grid.geometry(), within, [&](const CellBox &part) {
+        std::int64_t i0 = nx, i1 = -1, j0 = ny, j1 = -1;
+        for (std::int64_t j = part.j0; j < part.j1; ++j) {
+            const double *row_y = y + nx * j;
+            double *row_h = heights.data() + nx * j;
+            float *row_r = residuals.data() + nx * j;
+            auto differs = [&](std::int64_t i) { return row_h[i] != row_y[i] || row_r[i] != 0.0f; };
+            // The first and the last cell that differ; those between are
+            // simply overwritten (where they agree, with the same values).
+            std::int64_t first = part.i0;
+            while (first < part.i1 && !differs(first)) ++first;
+            if (first == part.i1) continue;
+            std::int64_t last = part.i1 - 1;
+            while (!differs(last)) --last;
+            for (std::int64_t i = first; i <= last; ++i) {
+                row_h[i] = row_y[i];
+                row_r[i] = 0.0f;
             }
-            if (i1 < 0) continue;
-            CellBox box;
-            box.add(i0, i1 + 1, j0, j1 + 1);
-            heights_changed(state, box);
+            i0 = std::min(i0, first);
+            i1 = std::max(i1, last);
+            j0 = std::min(j0, j);
+            j1 = j;
         }
+        if (i1 < 0) return;
+        CellBox box;
+        box.add(i0, i1 + 1, j0, j1 + 1);
+        heights_changed(state, box);
+    });
 }
 
 void copy_heights_between_sweeps(Grid &grid, const double *y, const CellBox &within) {
     StructuredState &state = structured_state(grid);
-    const Geometry &geo = grid.geometry();
-    const std::int64_t nx = geo.nx, ny = geo.ny, side = ActiveSet::kTile;
-    const std::int64_t wi0 = std::max<std::int64_t>(within.i0, 0), wi1 = std::min(within.i1, nx);
-    const std::int64_t wj0 = std::max<std::int64_t>(within.j0, 0), wj1 = std::min(within.j1, ny);
-    if (wi0 >= wi1 || wj0 >= wj1) return;
+    const std::int64_t nx = grid.geometry().nx;
     std::vector<double> &heights = grid.heights_for_stepping();
-    for (std::int64_t j = wj0; j < wj1; ++j) std::copy(y + nx * j + wi0, y + nx * j + wi1, heights.data() + nx * j + wi0);
     // Per tile, as the host's edits are.
-    for (std::int64_t tj = wj0 - wj0 % side; tj < wj1; tj += side)
-        for (std::int64_t ti = wi0 - wi0 % side; ti < wi1; ti += side) {
-            CellBox box;
-            box.add(std::max(ti, wi0), std::min(ti + side, wi1), std::max(tj, wj0), std::min(tj + side, wj1));
-            heights_changed(state, box);
-        }
+    for_tile_parts(grid.geometry(), within, [&](const CellBox &part) {
+        for (std::int64_t j = part.j0; j < part.j1; ++j)
+            std::copy(y + nx * j + part.i0, y + nx * j + part.i1, heights.data() + nx * j + part.i0);
+        heights_changed(state, part);
+    });
 }
 
 SavedResiduals drop_residuals(Grid &grid) {
