@@ -447,14 +447,25 @@ void refuse_coincident_nodes(const double *node_xy, const std::int64_t *nodes, s
     }
 }
 
-// A geographic mesh's nodes in the plane of `projection`, 2 per node.
-std::vector<double> to_plane(const Stereographic &projection, const double *node_lonlat, std::int64_t nnodes) {
-    std::vector<double> plane(static_cast<std::size_t>(2 * nnodes));
+// A geographic mesh is built in the plane of its projection, then its
+// lengths and areas are taken on the sphere: its projection, and its nodes in
+// that plane (2 per node), to which node_xy is pointed. A planar mesh: none.
+struct PlaneNodes {
+    std::shared_ptr<const Stereographic> projection;
+    std::vector<double> xy;
+};
+PlaneNodes into_plane_if_geographic(bool geographic, const double *&node_xy, std::int64_t nnodes,
+                                    const char *function, int base) {
+    PlaneNodes in_plane;
+    if (!geographic) return in_plane;
+    in_plane.projection = std::make_shared<const Stereographic>(node_xy, nnodes, function, base);
+    in_plane.xy.resize(static_cast<std::size_t>(2 * nnodes));
     for (std::int64_t n = 0; n < nnodes; ++n) {
-        const PlanePoint p = projection.forward(node_lonlat[2 * n], node_lonlat[2 * n + 1]);
-        plane[2 * n] = p.x, plane[2 * n + 1] = p.y;
+        const PlanePoint p = in_plane.projection->forward(node_xy[2 * n], node_xy[2 * n + 1]);
+        in_plane.xy[2 * n] = p.x, in_plane.xy[2 * n + 1] = p.y;
     }
-    return plane;
+    node_xy = in_plane.xy.data();  // a moved vector keeps its buffer
+    return in_plane;
 }
 }  // namespace
 
@@ -495,15 +506,9 @@ std::shared_ptr<Mesh> assemble_polygons(std::int64_t nnodes, const double *node_
         node_xy, cell_nodes, total,
         [&](std::int64_t at) { return std::upper_bound(cell_start, cell_start + ncells + 1, at) - cell_start - 1; },
         "cells", function, base);
-    // A geographic mesh is built in the plane of its projection, then its
-    // lengths and areas are taken on the sphere (below).
-    std::shared_ptr<const Stereographic> projection;
-    std::vector<double> plane;
-    if (geographic) {
-        projection = std::make_shared<const Stereographic>(node_xy, nnodes, function, base);
-        plane = to_plane(*projection, node_xy, nnodes);
-        node_xy = plane.data();
-    }
+    // Lengths and areas of a geographic mesh are taken on the sphere (below).
+    const PlaneNodes in_plane = into_plane_if_geographic(geographic, node_xy, nnodes, function, base);
+    const std::shared_ptr<const Stereographic> &projection = in_plane.projection;
     const auto node = [&](std::int64_t n) { return Vec{node_xy[2 * n], node_xy[2 * n + 1]}; };
 
     RawCells cells;
@@ -792,13 +797,8 @@ std::shared_ptr<const Mesh> mesh_from_dual(std::int64_t nnodes, const double *no
     refuse_coincident_nodes(
         node_xy, triangle_nodes, 3 * ntriangles, [](std::int64_t at) { return at / 3; }, "triangles", function, base);
     // A geographic mesh: as in assemble_polygons, the plane, then the sphere.
-    std::shared_ptr<const Stereographic> projection;
-    std::vector<double> plane;
-    if (geographic) {
-        projection = std::make_shared<const Stereographic>(node_xy, nnodes, function, base);
-        plane = to_plane(*projection, node_xy, nnodes);
-        node_xy = plane.data();
-    }
+    const PlaneNodes in_plane = into_plane_if_geographic(geographic, node_xy, nnodes, function, base);
+    const std::shared_ptr<const Stereographic> &projection = in_plane.projection;
     const auto node = [&](std::int64_t n) { return Vec{node_xy[2 * n], node_xy[2 * n + 1]}; };
     // Lengths and areas: in the plane, or on the sphere.
     const auto point = [](Vec v) { return PlanePoint{v.x, v.y}; };
