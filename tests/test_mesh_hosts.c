@@ -420,6 +420,20 @@ static void test_geographic_refusals_and_restart(void **state) {
     REQUIRE(strstr(dpsm_last_error(NULL), "within 90 degrees of arc of their centre"), "%s", dpsm_last_error(NULL));
     EXPECT_CREATE_FAIL(dpsm_create_mesh_geographic(2, 4, lonlat, 1, start, nodes, &g), g, DPSM_ERR_INVALID_VALUE,
                        "start_index = 2");
+    /* The median dual's geographic constructor, counting from 0. */
+    const int64_t triangles[6] = {0, 1, 2, 0, 2, 3}, beyond[6] = {0, 1, 2, 0, 2, 7};
+    lonlat[5] = 90.5;
+    EXPECT_CREATE_FAIL(dpsm_create_dual_mesh_geographic(0, 4, lonlat, 2, triangles, &g), g, DPSM_ERR_INVALID_VALUE,
+                       "dpsm_create_dual_mesh_geographic: node_lonlat[5] (latitude of node 2) = 90.5 is not within [-90, 90]");
+    lonlat[5] = 50.01;
+    EXPECT_CREATE_FAIL(dpsm_create_dual_mesh_geographic(2, 4, lonlat, 2, triangles, &g), g, DPSM_ERR_INVALID_VALUE,
+                       "start_index = 2");
+    EXPECT_CREATE_FAIL(dpsm_create_dual_mesh_geographic(0, 4, lonlat, 2, beyond, &g), g, DPSM_ERR_INVALID_VALUE,
+                       "triangle_nodes[5] (triangle 1) = 7 is not a node index in [0, 3]");
+    EXPECT_CREATE_FAIL(dpsm_create_dual_mesh_geographic(0, 4, NULL, 2, triangles, &g), g, DPSM_ERR_NULL_POINTER,
+                       "node_lonlat is NULL");
+    REQUIRE(dpsm_create_dual_mesh_geographic(0, 4, lonlat, 2, triangles, NULL) == DPSM_ERR_NULL_POINTER,
+            "a NULL out is not refused");
 
     /* A restart file keeps the mesh in degrees: the loaded copy steps bit for bit. */
     CHECK_OK(NULL, dpsm_create_mesh_geographic(1, 4, lonlat, 1, start, nodes, &g));
