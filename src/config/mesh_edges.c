@@ -113,11 +113,9 @@ static int levels_from_file(const struct config *c, struct config_scene *s, cons
     double *values = NULL;
     int64_t count = 0;
     enum config_location where;
-    char reading[CONFIG_MESSAGE_MAX];
-    if (config_read_mesh_variable(&s->mesh, c->level_file, c->level_variable,
-                                  s->cells_at_nodes ? CONFIG_AT_NODES : CONFIG_AT_FACES, &values, &count, &where,
-                                  reading, sizeof reading))
-        return scene_refuse(c, c->level_line, "boundaries.level", message, size, "%s", reading);
+    if (scene_read_mesh_values(c, s, c->level_file, c->level_variable, c->level_line, "boundaries.level", &values,
+                               &count, &where, message, size))
+        return 1;
     const struct config_mesh *m = &s->mesh;
     int failed = 0;
     for (int64_t f = 0; f < s->face_count && !failed; ++f) {

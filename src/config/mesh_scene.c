@@ -21,6 +21,16 @@ int scene_refuse(const struct config *c, unsigned long line, const char *key, ch
     return 1;
 }
 
+int scene_read_mesh_values(const struct config *c, const struct config_scene *s, const char *file,
+                           const char *variable, unsigned long line, const char *key, double **values,
+                           int64_t *count, enum config_location *where, char *message, size_t size) {
+    char reading[CONFIG_MESSAGE_MAX];
+    if (config_read_mesh_variable(&s->mesh, file, variable, s->cells_at_nodes ? CONFIG_AT_NODES : CONFIG_AT_FACES,
+                                  values, count, where, reading, sizeof reading))
+        return scene_refuse(c, line, key, message, size, "%s", reading);
+    return 0;
+}
+
 double scene_sphere_distance(double lon0, double lat0, double lon1, double lat1) {
     const double d = 3.14159265358979323846 / 180.0;
     const double a = sin(0.5 * (lat1 - lat0) * d), b = sin(0.5 * (lon1 - lon0) * d);

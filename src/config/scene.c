@@ -68,11 +68,9 @@ static int field_from_file(const struct config *c, const struct config_scene *s,
     double *read = NULL;
     int64_t count = 0;
     enum config_location where;
-    char reading[CONFIG_MESSAGE_MAX];
-    if (config_read_mesh_variable(&s->mesh, field->file, field->variable,
-                                  s->cells_at_nodes ? CONFIG_AT_NODES : CONFIG_AT_FACES, &read, &count, &where,
-                                  reading, sizeof reading))
-        return scene_refuse(c, field->line, key, message, size, "%s", reading);
+    if (scene_read_mesh_values(c, s, field->file, field->variable, field->line, key, &read, &count, &where, message,
+                               size))
+        return 1;
     const enum config_location cells = s->cells_at_nodes ? CONFIG_AT_NODES : CONFIG_AT_FACES;
     if (where != cells || count != s->cell_count) {
         free(read);

@@ -19,6 +19,13 @@ int scene_refuse(const struct config *c, unsigned long line, const char *key, ch
  * the file says; fills s->mesh with the BMI's edges and s->grid. */
 int scene_create_mesh(const struct config *c, struct config_scene *s, char *message, size_t size);
 
+/* Reads `variable` of `file` on the scene's mesh, at the nodes of a dual
+ * mesh's cells or the faces of a mesh's; a failure is refused for `key` at
+ * `line`. The caller frees *values and checks *where against its need. */
+int scene_read_mesh_values(const struct config *c, const struct config_scene *s, const char *file,
+                           const char *variable, unsigned long line, const char *key, double **values,
+                           int64_t *count, enum config_location *where, char *message, size_t size);
+
 /* The great-circle distance in metres between two points in degrees. */
 double scene_sphere_distance(double lon0, double lat0, double lon1, double lat1);
 
