@@ -98,7 +98,7 @@ def main():
     for _ in range(steps):
         grid.step(0.25)
     grid.set_source(None)
-    grid.step(5.0)  # and let it come to rest
+    grid.step(20.0)  # and let it come to rest: the step ends where the sand does (at t = 6.0 after the pour)
 
     h = list(grid.get_heights())
     top = max(h)

@@ -1015,10 +1015,9 @@ DPSM_API int dpsm_get_grid_kind(const dpsm_grid *g, int *kind);
  * The surface is at rest when no face slope exceeds `tan(theta) * (1 + tol)`.
  * Supercritical slopes relax exponentially, so a smaller tolerance costs a
  * little more time to rest; the final heights are off by at most about
- * `tol * tan(theta) * L` over a slope of length `L`. On a mesh the tolerance
- * is at least `1e-4`, and a face nearly parallel to the slope rests up to 1 %
- * above the angle of repose: its slope comes from reconstructed gradients,
- * whose error is of the order of the cell size (see `docs/guide_meshes.md`).
+ * `tol * tan(theta) * L` over a slope of length `L`. On a mesh a face's slope
+ * takes its part along the face from the cells' least-squares gradients, and
+ * the same tolerance holds for every face (see `docs/guarantees.md`).
  *
  * @param g    the grid.
  * @param tol  finite and positive; default ::DPSM_DEFAULT_REST_TOLERANCE.

@@ -23,6 +23,18 @@ constexpr std::int64_t kCellsForThreads = 32768;
 // A sub-step over more hot cells than this share of the mesh runs the plain
 // passes over every cell: the lists would cost more than they save.
 constexpr double kDenseShare = 0.125;
+// The share of the room to its bounds a cell's limiter lets the gradient
+// flow's excess fill.
+constexpr double kLimiterRoom = 1.0 - 1e-9;
+
+// What a face's own slope gives it in a sub-step (FaceLaw::terms).
+struct FaceTerms {
+    double low = 0.0;        // the monotone two-point flux, a to b
+    double two_point = 0.0;  // the gradient flow's two-point part, a to b
+    double pull = 0.0;       // V g t: what the face asks of its cells' gradients along t
+    double excess = 0.0;     // its slope beyond tan(theta)
+    bool steep = false;      // its slope exceeds its threshold
+};
 
 // One sub-step's view of the grid: what every pass reads.
 struct FaceLaw {
@@ -39,63 +51,91 @@ struct FaceLaw {
     double nu, tan_theta, tolerance, tan_static, p, dt;
     bool isotropic;
 
-    // The volume per unit time from a to b over face f, and its excess slope.
-    double operator()(std::int64_t f, double &excess) const {
+    // Whether face f may carry sand at all: no wall on it, a sand cell on
+    // it, and on the domain edge an open edge.
+    bool carries(std::int64_t f) const {
+        const std::int64_t a = m.face_a[f], b = m.face_b[f];
+        const std::uint8_t ka = kind[a];
+        if (b < 0) return ka == kSand && (edge_open ? edge_open[f] != 0 : open_edges);
+        const std::uint8_t kb = kind[b];
+        return ka != kWall && kb != kWall && (ka == kSand || kb == kSand);
+    }
+
+    // Face f's slope and what it gives the sub-step's fluxes.
+    //
+    // The step is the gradient flow of the faces' energy E = sum_f V_f
+    // Phi(|G_f|) (docs/guarantees.md, "Meshes"): G_f is the two-point slope
+    // along e plus the mean of the cells' least-squares gradients along t,
+    // V_f = L n.e d / 2 (a quarter on the domain edge), Phi' = the slide
+    // flux. Its derivative in the heights has a two-point part on the face
+    // itself and a pull V g t on its cells' gradients, which their stencils'
+    // pairs carry (the pass over cells). The monotone flux, limited towards
+    // the gradient flow's, is the two-point law C (h_a - h_b) with C held
+    // in [0, |L n| / d].
+    FaceTerms terms(std::int64_t f) const {
+        FaceTerms out;
+        if (!carries(f)) return out;
         const std::int64_t a = m.face_a[f], b = m.face_b[f];
         const std::uint8_t ka = kind[a];
         double hb, tangential = 0.0;
         std::uint8_t kb;
         if (b >= 0) {
             kb = kind[b];
-            if (ka == kWall || kb == kWall || (ka != kSand && kb != kSand)) return 0.0;
             hb = h[b];
             if (isotropic)
                 tangential = 0.5 * ((gx[a] + gx[b]) * m.tangent_x[f] + (gy[a] + gy[b]) * m.tangent_y[f]);
         } else {
-            if (ka != kSand || !(edge_open ? edge_open[f] != 0 : open_edges)) return 0.0;
             kb = kOutside;
             hb = edge_level ? edge_level[f] : 0.0;
             if (isotropic) tangential = gx[a] * m.tangent_x[f] + gy[a] * m.tangent_y[f];
         }
-        const double normal = (h[a] - hb) / m.distance[f];
+        const double distance = m.distance[f];
+        const double normal = (h[a] - hb) / distance;
         const double tan_face =
             tan_field ? law::face_tan(tan_field[a], b >= 0 ? tan_field[b] : tan_field[a], ka == kSand, kb == kSand)
                       : tan_theta;
         double threshold = tan_face * (1.0 + tolerance);
         if (moving) threshold = law::threshold(threshold, !moving[a] && !(b >= 0 && moving[b]), tan_static);
         const double s = std::sqrt(normal * normal + tangential * tangential);
-        if (!(s > threshold)) return 0.0;
+        if (!(s > threshold)) return out;
+        out.steep = true;
+        out.excess = s - tan_face;
+        const double g = slide_flux(nu, tan_face, s, p) / s;
+        const double diamond = (b >= 0 ? 0.5 : 0.25) * m.orthogonal[f] * distance;
+        out.two_point = diamond * g * normal / distance;
+        // dG_f/d(gradient of a cell) along t: 1/2 each between cells, 1 on the edge.
+        out.pull = diamond * g * tangential * (b >= 0 ? 0.5 : 1.0);
+        // A cell whose sand is down to its bed cannot lower the face's slope
+        // by giving sand: the face keeps out of the gradient flow, whose pull
+        // would otherwise drive sand round its neighbours for ever, and
+        // carries the monotone flux alone.
+        const bool on_bed = available && (bare(a) || bare(b));
+        if (on_bed) out.two_point = out.pull = 0.0;
         const double abs_normal = std::fabs(normal);
-        if (!(abs_normal > tolerance * tan_face)) return 0.0;
-        // The flux across the face's normal, -nu f(s)/s grad h . L n, with
-        // grad h . e from the two points and grad h . t reconstructed, written
-        // as C (h_a - h_b): its factor C d / (nu f(s)/s) is held in [0, |L n|]
-        // (a face never carries sand up its two-point slope, nor more than
-        // the stable sub-step allows).
+        if (!(abs_normal > tolerance * tan_face)) return out;
         double factor = m.orthogonal[f];
         if (m.skew[f] != 0.0) factor -= tangential * m.skew[f] / normal;
-        const double most = m.conductance[f] * m.distance[f];
+        const double most = m.conductance[f] * distance;
         factor = std::min(factor, most);
-        // The slope across the face. Near rest, a face nearly parallel to the
-        // slope (across it at most kMeshDeadZone tan(theta)) carries nothing
-        // unless its slope is clearly steep, and none carries sand with a
-        // slope across it below the rest tolerance (mesh_engine.hpp,
-        // docs/guarantees.md).
         const double across = factor * abs_normal / most;
-        if (!(across > tolerance * tan_face)) return 0.0;
-        if (!(across > kMeshDeadZone * tan_face) && !(s > tan_face * (1.0 + kMeshNearRest))) return 0.0;
-        excess = s - tan_face;
-        double flux = slide_flux(nu, tan_face, s, p) / s * factor * normal;
-        if (available) {
-            // A face takes from its sand cell at most its share of the sand there.
-            const double unlimited = std::numeric_limits<double>::infinity();
-            const auto share = [&](std::int64_t c) {
-                return c >= 0 && kind[c] == kSand ? law::share_of_sand(available[c], m.face_count[c], dt, 1.0)
-                                                  : unlimited;
-            };
-            flux = law::capped(flux, share(a), -share(b));
-        }
-        return flux;
+        if (!(across > tolerance * tan_face)) return out;
+        out.low = capped(g * factor * normal, a, b);
+        if (on_bed) out.two_point = out.low;
+        return out;
+    }
+
+    // A sand cell whose faces may take none of its sand (a bed, at most a film above it).
+    bool bare(std::int64_t c) const { return c >= 0 && kind[c] == kSand && !(available[c] > 0.0); }
+
+    // A flux from a to b within what a bed lets each sand cell give.
+    double capped(double flux, std::int64_t a, std::int64_t b) const {
+        if (!available) return flux;
+        // A face takes from its sand cell at most its share of the sand there.
+        const double unlimited = std::numeric_limits<double>::infinity();
+        const auto share = [&](std::int64_t c) {
+            return c >= 0 && kind[c] == kSand ? law::share_of_sand(available[c], m.face_count[c], dt, 1.0) : unlimited;
+        };
+        return law::capped(flux, share(a), -share(b));
     }
 };
 
@@ -129,6 +169,83 @@ inline double net_rate(const Mesh &m, const double *flux, std::int64_t c, bool &
     return rate / m.area[c];
 }
 
+// Cell c's pull: M_c^-1 P_c, with P_c the sum of its faces' pulls along
+// their tangents, in the cell's face order (0 without a stencil).
+inline void pull_of(const Mesh &m, const double *pull, std::int64_t c, double *pull_x, double *pull_y) {
+    double x = 0.0, y = 0.0;
+    for (std::int64_t k = m.cell_face_start[c]; k < m.cell_face_start[c + 1]; ++k) {
+        const std::int64_t f = m.cell_faces[k];
+        x += pull[f] * m.tangent_x[f];
+        y += pull[f] * m.tangent_y[f];
+    }
+    pull_x[c] = m.grad_ixx[c] * x + m.grad_ixy[c] * y;
+    pull_y[c] = m.grad_ixy[c] * x + m.grad_iyy[c] * y;
+}
+
+// The gradient flow's flux over face f from a to b: its two-point part and
+// the pair terms of both cells' stencils across it. Cell c's gradient reads
+// n with the weight M_c^-1 o/|o|^2, so E's derivative puts w_cn . P_c on n
+// and takes it from c: a flux w_cn . P_c from n to c over their face.
+inline double gradient_flow_flux(const Mesh &m, const FaceLaw &law, std::int64_t f, double two_point,
+                                 const double *pull_x, const double *pull_y) {
+    if (!law.carries(f)) return 0.0;
+    const std::int64_t a = m.face_a[f], b = m.face_b[f];
+    if (b < 0) return two_point;
+    // Added so that the face read from b to a gives exactly the opposite.
+    const double pairs = (m.pair_bx[f] * pull_x[b] + m.pair_by[f] * pull_y[b]) -
+                         (m.pair_ax[f] * pull_x[a] + m.pair_ay[f] * pull_y[a]);
+    return two_point + pairs;
+}
+
+// Zalesak's limiter for cell c: the shares of the gradient flow's excess
+// over the monotone flux (high - low) that may enter and leave it, so that
+// its height stays within its own and its neighbours' (open edges' levels
+// included; with a bed, not below it) after the monotone update.
+inline void limits_of(const Mesh &m, const FaceLaw &law, const double *low, const double *high, const double *bed,
+                      std::int64_t c, double *limit_in, double *limit_out) {
+    limit_in[c] = limit_out[c] = 1.0;
+    if (law.kind[c] != kSand) return;
+    if (law.available && law.bare(c)) {
+        // Sand down to its bed takes the monotone flux alone (FaceLaw::terms).
+        limit_in[c] = limit_out[c] = 0.0;
+        return;
+    }
+    bool ignored = false;
+    const double h = law.h[c];
+    const double monotone = h + law.dt * net_rate(m, low, c, ignored);
+    double highest = h, lowest = h, entering = 0.0, leaving = 0.0;
+    for (std::int64_t k = m.cell_face_start[c]; k < m.cell_face_start[c + 1]; ++k) {
+        const std::int64_t f = m.cell_faces[k];
+        if (!law.carries(f)) continue;
+        const std::int64_t o = m.other[k];
+        const double v = o >= 0 ? law.h[o] : (law.edge_level ? law.edge_level[f] : 0.0);
+        highest = std::max(highest, v);
+        lowest = std::min(lowest, v);
+        const double enters = m.into[k] * (high[f] - low[f]);
+        if (enters > 0.0)
+            entering += enters;
+        else
+            leaving -= enters;
+    }
+    if (bed) lowest = std::max(lowest, bed[c]);
+    // A hair short of the bounds, so that the update's rounding does not cross them.
+    const double room = kLimiterRoom * m.area[c] / law.dt;
+    const double room_up = (highest - monotone) * room, room_down = (monotone - lowest) * room;
+    if (entering > 0.0) limit_in[c] = std::min(1.0, std::max(0.0, room_up / entering));
+    if (leaving > 0.0) limit_out[c] = std::min(1.0, std::max(0.0, room_down / leaving));
+}
+
+// The limited flux over face f from a to b.
+inline double limited_flux(const Mesh &m, const FaceLaw &law, std::int64_t f, double low, double high,
+                           const double *limit_in, const double *limit_out) {
+    const double excess = high - low;
+    if (excess == 0.0) return low;
+    const std::int64_t a = m.face_a[f], b = m.face_b[f];
+    double share = excess > 0.0 ? limit_out[a] : limit_in[a];
+    if (b >= 0) share = std::min(share, excess > 0.0 ? limit_in[b] : limit_out[b]);
+    return law.capped(low + share * excess, a, b);
+}
+
 class MeshEngine final : public Engine {
 public:
     std::unique_ptr<EngineState> make_state(const Grid &grid) const override {
@@ -148,7 +265,19 @@ public:
         s.exchange = dynamic_cast<GhostExchange *>(grid.distribution());
         const std::size_t n = static_cast<std::size_t>(m.cells), nf = static_cast<std::size_t>(m.faces);
         s.gx.resize(n, 0.0), s.gy.resize(n, 0.0);
-        if (s.flux.size() != nf) s.flux.assign(nf, 0.0);
+        if (s.flux.size() != nf) {
+            s.flux.assign(nf, 0.0), s.low.assign(nf, 0.0), s.high.assign(nf, 0.0), s.pull.assign(nf, 0.0);
+            s.excess.assign(nf, 0.0);
+            s.steep.assign(nf, 0);
+            s.steep_faces.clear();
+        }
+        if (s.pull_x.size() != n) {
+            s.pull_x.assign(n, 0.0), s.pull_y.assign(n, 0.0);
+            s.limit_in.assign(n, 1.0), s.limit_out.assign(n, 1.0);
+            // A ghost's values start as the exchange's record of what was sent to it: 0.
+            std::fill(s.limit_in.begin() + m.owned, s.limit_in.end(), 0.0);
+            std::fill(s.limit_out.begin() + m.owned, s.limit_out.end(), 0.0);
+        }
         s.face_seen.resize(nf, 0), s.cell_seen.resize(n, 0);
         s.carried.resize(n, 0);
         if (s.exchange) s.in_batch.resize(n, 0);
@@ -252,16 +381,22 @@ private:
     };
 
     // `in_batch`: the sub-step's place after the last exchange (from 1) on a
-    // part that takes several per exchange; 0: two exchanges in this one.
+    // part that takes several per exchange; 0: exchanges in this one.
+    //
+    // The passes: gradients; faces (slope, monotone flux, two-point part,
+    // pull); cells (pull M^-1 P); faces (gradient flow's flux); cells
+    // (limiters); faces (limited flux); cells (update). Each is a gather in
+    // an order that does not depend on the threads, the library's order or
+    // the partition.
     SubstepSummary substep(Grid &grid, const Mesh &m, MeshState &s, double dt, bool record, double &visited,
                            int in_batch) const {
         MeshActivity &act = s.activity;
         const bool physics = grid.hysteresis() || !grid.bed().empty();
         // A part of a distributed mesh steps its owned cells and the faces
-        // that touch them; its ghosts' heights and gradients come from their
-        // owners, only where they changed (mesh/mesh_parts.hpp).
-        const bool parts = s.exchange != nullptr;
-        const bool dense = physics || act.all_hot || s.switches.visit_all_cells ||
+        // that touch them; its ghosts' values come from their owners
+        // (mesh/mesh_parts.hpp), or in a batch it steps them too, densely.
+        const bool parts = s.exchange != nullptr, exchanges = parts && !in_batch;
+        const bool dense = (in_batch && m.cells > m.owned) || physics || act.all_hot || s.switches.visit_all_cells ||
                            static_cast<double>(act.hot_list.size()) > kDenseShare * static_cast<double>(m.owned);
         std::vector<std::int64_t> &changed_ghosts = s.changed_ghosts;
         changed_ghosts.clear();
@@ -284,7 +419,7 @@ private:
                     nullptr,
                     grid.mobility(),
                     grid.tan_repose(),
-                    std::max(grid.rest_tolerance(), kMeshRestTolerance),
+                    grid.rest_tolerance(),
                     grid.tan_static(),
                     grid.flux_exponent(),
                     dt,
@@ -293,47 +428,69 @@ private:
             prepare_bed(grid, m, s, dt, did);
             law.available = s.available.data();
         }
+        const double *bed = grid.bed().empty() ? nullptr : grid.bed().data();
         const int threads = grid.step_threads();
         double max_excess = 0.0;
         bool moved = false;
         const CellUpdate update_cell{m, s.flux.data(), kind.data(), q, grid.bed(), h, residual, dt};
-        // On a part that steps its ghosts in reach: their gradients, faces and cells too.
-        const BatchReach reach{m, in_batch};
+        double *low = s.low.data(), *high = s.high.data(), *pull = s.pull.data(), *flux = s.flux.data();
+        double *pull_x = s.pull_x.data(), *pull_y = s.pull_y.data();
+        double *limit_in = s.limit_in.data(), *limit_out = s.limit_out.data();
+        double *excess = s.excess.data();
+        std::uint8_t *steep = s.steep.data();
+        const auto face_terms = [&](std::int64_t f) {
+            const FaceTerms t = law.terms(f);
+            low[f] = t.low, high[f] = t.two_point, pull[f] = t.pull, excess[f] = t.excess;
+            steep[f] = t.steep;
+            return t;
+        };
 
         if (dense) {
-            // The owned cells and the faces that touch them: all of a serial mesh.
-            const std::int64_t n = m.owned, nf = m.live_faces;
+            // The owned cells and the faces that touch them: all of a serial
+            // mesh. On a part that steps its ghosts, the passes before the
+            // update run over every ghost and face too (those beyond reach
+            // compute what nothing in reach reads); the update steps the
+            // ghosts in reach alone.
+            const BatchReach reach{m, in_batch};
+            const std::int64_t n = m.owned;
+            const std::int64_t pass_cells = in_batch ? m.cells : n, pass_faces = in_batch ? m.faces : m.live_faces;
             const bool parallel = threads > 1 && n >= kCellsForThreads;
             const std::int64_t *extra_cells = reach.ghosts();
             const std::int64_t extra_count = reach.ghost_count();
             if (law.isotropic) {
 #pragma omp parallel for num_threads(threads) if (parallel) schedule(static)
-                for (std::int64_t c = 0; c < n; ++c) gradient_of(m, h.data(), kind.data(), c, s.gx.data(), s.gy.data());
-                if (in_batch) {
-                    for (std::int64_t k = 0; k < reach.ghost_gradient_count(); ++k)
-                        gradient_of(m, h.data(), kind.data(), reach.ghost_gradients()[k], s.gx.data(), s.gy.data());
-                } else if (parts) {
-                    exchange_ghost_gradients(s, nullptr, changed_ghosts);
-                }
+                for (std::int64_t c = 0; c < pass_cells; ++c) gradient_of(m, h.data(), kind.data(), c, s.gx.data(), s.gy.data());
+                if (parts && !in_batch) exchange_ghost_gradients(s, changed_ghosts);
             }
-            double *flux = s.flux.data();
+#pragma omp parallel for num_threads(threads) if (parallel) schedule(static)
+            for (std::int64_t f = 0; f < pass_faces; ++f) face_terms(f);
+#pragma omp parallel for num_threads(threads) if (parallel) schedule(static)
+            for (std::int64_t c = 0; c < pass_cells; ++c) pull_of(m, pull, c, pull_x, pull_y);
+            if (parts && !in_batch) {
+                exchange_ghost_pulls(s, changed_ghosts);
+                changed_ghosts.clear();
+                s.pulling_ghosts.clear();
+                for (std::int64_t c = m.owned; c < m.cells; ++c)
+                    if (pull_x[c] != 0.0 || pull_y[c] != 0.0) s.pulling_ghosts.push_back(c);
+            }
+#pragma omp parallel for num_threads(threads) if (parallel) schedule(static)
+            for (std::int64_t f = 0; f < pass_faces; ++f) high[f] = gradient_flow_flux(m, law, f, high[f], pull_x, pull_y);
+#pragma omp parallel for num_threads(threads) if (parallel) schedule(static)
+            for (std::int64_t c = 0; c < pass_cells; ++c) limits_of(m, law, low, high, bed, c, limit_in, limit_out);
+            if (parts && !in_batch) exchange_ghost_limits(s);
 #pragma omp parallel for num_threads(threads) if (parallel) schedule(static) reduction(max : max_excess) reduction(|| : moved)
-            for (std::int64_t f = 0; f < nf; ++f) {
-                double excess = 0.0;
-                const double v = law(f, excess);
+            for (std::int64_t f = 0; f < pass_faces; ++f) {
+                const double v = limited_flux(m, law, f, low[f], high[f], limit_in, limit_out);
                 flux[f] = v;
-                if (v != 0.0) {
+                if (v != 0.0 && f < m.live_faces) {
                     moved = true;
-                    max_excess = std::max(max_excess, excess);
+                    max_excess = std::max(max_excess, excess[f]);
                 }
-            }
-            // The faces beyond the owned cells' that the ghosts in reach need; they count for nothing here.
-            for (std::int64_t k = 0; k < reach.face_count(); ++k) {
-                const std::int64_t f = reach.faces()[k];
-                double excess = 0.0;
-                flux[f] = law(f, excess);
             }
             s.flux_clean = false;
+            s.steep_faces.clear();
+            for (std::int64_t f = 0; f < m.live_faces; ++f)
+                if (steep[f]) s.steep_faces.push_back(f);
             std::uint8_t *changed = s.carried.data();
             std::int64_t changed_cells = 0;
 #pragma omp parallel for num_threads(threads) if (parallel) schedule(static) reduction(+ : changed_cells)
@@ -378,19 +535,25 @@ private:
                     for (const std::int64_t c : s.ghost_source_cells) act.wake_around(m, c);
             }
         } else {
-            // The faces of the hot cells, the owned cells whose gradients they
-            // read (a ghost's comes from its owner).
+            // A few moving cells. The faces whose slopes may have changed
+            // (those of the hot cells) are looked at again; with the faces
+            // still steep they set every pass's reach: the steep faces' cells
+            // pull, the faces of the pulling cells carry the gradient flow's
+            // flux, their cells limit it. Everything beyond holds 0 (the
+            // limiters 1). A part computes its owned cells and the faces that
+            // touch them; its ghosts' gradients, pulls and limiters come from
+            // their owners.
             std::uint32_t stamp = next_stamp(s);
             s.faces.clear();
             s.gradient_cells.clear();
             const auto look_at_faces_of = [&](std::int64_t c) {
                 for (std::int64_t k = m.cell_face_start[c]; k < m.cell_face_start[c + 1]; ++k) {
                     const std::int64_t f = m.cell_faces[k];
-                    if (!reach.face(f) || s.face_seen[f] == stamp) continue;
+                    if (f >= m.live_faces || s.face_seen[f] == stamp) continue;
                     s.face_seen[f] = stamp;
                     s.faces.push_back(f);
                     for (const std::int64_t e : {m.face_a[f], m.face_b[f]})
-                        if (e >= 0 && reach.gradient(e) && s.cell_seen[e] != stamp) {
+                        if (e >= 0 && e < m.owned && s.cell_seen[e] != stamp) {
                             s.cell_seen[e] = stamp;
                             s.gradient_cells.push_back(e);
                         }
@@ -399,63 +562,130 @@ private:
             for (const std::int64_t c : act.hot_list) look_at_faces_of(c);
             if (!s.flux_clean) {
                 std::fill(s.flux.begin(), s.flux.end(), 0.0);
+                std::fill(s.low.begin(), s.low.end(), 0.0);
+                std::fill(s.high.begin(), s.high.end(), 0.0);
+                std::fill(s.pull.begin(), s.pull.end(), 0.0);
+                std::fill(s.pull_x.begin(), s.pull_x.begin() + m.owned, 0.0);
+                std::fill(s.pull_y.begin(), s.pull_y.begin() + m.owned, 0.0);
+                std::fill(s.limit_in.begin(), s.limit_in.begin() + m.owned, 1.0);
+                std::fill(s.limit_out.begin(), s.limit_out.begin() + m.owned, 1.0);
                 s.flux_clean = true;
             }
             if (law.isotropic) {
                 for (const std::int64_t c : s.gradient_cells) gradient_of(m, h.data(), kind.data(), c, s.gx.data(), s.gy.data());
-                if (parts && !in_batch) {
+                if (exchanges) {
                     // A ghost whose gradient changed makes its faces steep or flat
                     // whether or not anything near them here changed.
-                    exchange_ghost_gradients(s, &s.gradient_cells, changed_ghosts);
+                    exchange_ghost_gradients(s, changed_ghosts);
                     for (const std::int64_t c : changed_ghosts) look_at_faces_of(c);
                     changed_ghosts.clear();
                 }
             }
+            // The steep faces: those looked at again as they are now, the others as they were.
+            std::vector<std::int64_t> &steep_faces = s.steep_faces;
+            for (const std::int64_t f : s.faces) {
+                const bool was = steep[f] != 0;
+                if (face_terms(f).steep && !was) steep_faces.push_back(f);
+            }
+            std::size_t kept = 0;
+            for (const std::int64_t f : steep_faces)
+                if (steep[f]) steep_faces[kept++] = f;
+            steep_faces.resize(kept);
+            const std::uint32_t looked = stamp;
+            for (const std::int64_t f : steep_faces)
+                if (s.face_seen[f] != looked) face_terms(f);
+            // Pulls: the owned cells of steep faces.
+            stamp = next_stamp(s);
+            s.pull_cells.clear();
+            for (const std::int64_t f : steep_faces)
+                for (const std::int64_t e : {m.face_a[f], m.face_b[f]})
+                    if (e >= 0 && e < m.owned && s.cell_seen[e] != stamp) {
+                        s.cell_seen[e] = stamp;
+                        s.pull_cells.push_back(e);
+                    }
+            for (const std::int64_t c : s.pull_cells) pull_of(m, pull, c, pull_x, pull_y);
+            if (exchanges) {
+                // The ghosts that pull: those whose pull changed, and those that pulled before and still do.
+                exchange_ghost_pulls(s, changed_ghosts);
+                std::vector<std::int64_t> &ghosts = s.pulling_ghosts;
+                ghosts.insert(ghosts.end(), changed_ghosts.begin(), changed_ghosts.end());
+                changed_ghosts.clear();
+                const std::uint32_t listed = next_stamp(s);
+                std::size_t still = 0;
+                for (const std::int64_t c : ghosts)
+                    if ((pull_x[c] != 0.0 || pull_y[c] != 0.0) && s.cell_seen[c] != listed) {
+                        s.cell_seen[c] = listed;
+                        ghosts[still++] = c;
+                    }
+                ghosts.resize(still);
+            }
+            // The gradient flow's flux: the steep faces and the faces of the pulling cells.
+            const std::uint32_t carrying = next_stamp(s);
+            s.faces.clear();
+            const auto carry = [&](std::int64_t f) {
+                if (f >= m.live_faces || s.face_seen[f] == carrying) return;
+                s.face_seen[f] = carrying;
+                s.faces.push_back(f);
+                high[f] = gradient_flow_flux(m, law, f, high[f], pull_x, pull_y);
+            };
+            const auto carry_faces_of = [&](std::int64_t c) {
+                for (std::int64_t k = m.cell_face_start[c]; k < m.cell_face_start[c + 1]; ++k) carry(m.cell_faces[k]);
+            };
+            for (const std::int64_t f : steep_faces) carry(f);
+            for (const std::int64_t c : s.pull_cells) carry_faces_of(c);
+            for (const std::int64_t c : s.pulling_ghosts) carry_faces_of(c);
+            // Limiters: the owned cells of those faces.
+            stamp = next_stamp(s);
+            s.limit_cells.clear();
+            for (const std::int64_t f : s.faces)
+                for (const std::int64_t e : {m.face_a[f], m.face_b[f]})
+                    if (e >= 0 && e < m.owned && s.cell_seen[e] != stamp) {
+                        s.cell_seen[e] = stamp;
+                        s.limit_cells.push_back(e);
+                    }
+            for (const std::int64_t c : s.limit_cells) limits_of(m, law, low, high, bed, c, limit_in, limit_out);
+            if (exchanges) exchange_ghost_limits(s);
             // The cells to update: those of faces that carried sand, and the sources.
             const std::uint32_t update_stamp = next_stamp(s);
             s.update_cells.clear();
             const auto to_update = [&](std::int64_t c) {
-                if (reach.cell(c) && s.cell_seen[c] != update_stamp) {
+                if (c < m.owned && s.cell_seen[c] != update_stamp) {
                     s.cell_seen[c] = update_stamp;
                     s.update_cells.push_back(c);
                 }
             };
             for (const std::int64_t f : s.faces) {
-                double excess = 0.0;
-                const double v = law(f, excess);
-                s.flux[f] = v;
+                const double v = limited_flux(m, law, f, low[f], high[f], limit_in, limit_out);
+                flux[f] = v;
                 if (v == 0.0) continue;
-                if (f < m.live_faces) {
-                    moved = true;
-                    max_excess = std::max(max_excess, excess);
-                }
+                moved = true;
+                max_excess = std::max(max_excess, excess[f]);
                 for (const std::int64_t e : {m.face_a[f], m.face_b[f]})
                     if (e >= 0) to_update(e);
             }
-            const std::size_t carried_cells = s.update_cells.size();
             for (const std::int64_t c : s.source_cells) to_update(c);
-            if (in_batch)
-                for (const std::int64_t c : s.ghost_source_cells) to_update(c);
             for (const std::int64_t c : s.update_cells) update_cell(c);
-            visited = static_cast<double>(s.gradient_cells.size() + s.update_cells.size() - carried_cells);
-            if (in_batch) {
-                note_batch_updates(s, m, s.update_cells);
-            } else if (parts) {
-                exchange_ghost_heights(grid, s, &s.update_cells, changed_ghosts);
-            }
+            // Every cell a pass read or wrote, once.
+            const std::uint32_t counted = next_stamp(s);
+            double cells_visited = 0.0;
+            for (const std::vector<std::int64_t> *list : {&s.gradient_cells, &s.pull_cells, &s.limit_cells, &s.update_cells})
+                for (const std::int64_t c : *list)
+                    if (s.cell_seen[c] != counted) s.cell_seen[c] = counted, cells_visited += 1.0;
+            visited = cells_visited;
+            if (exchanges) exchange_ghost_heights(grid, s, &s.update_cells, changed_ghosts);
             act.cool_all();
             for (const std::int64_t c : s.update_cells) act.wake_around(m, c);
             for (const std::int64_t c : changed_ghosts) act.wake_around(m, c);
+            for (const std::int64_t c : s.pull_cells) pull_x[c] = pull_y[c] = 0.0;
+            for (const std::int64_t c : s.limit_cells) limit_in[c] = limit_out[c] = 1.0;
         }
         // What went into sinks, face by face in one order whatever the threads.
         for (const std::int64_t f : s.sink_faces) {
             const double v = s.flux[f];
             if (v == 0.0) continue;
-            const std::int64_t a = m.face_a[f], b = m.face_b[f];
-            const double into_sink = b < 0 ? v * 1.0 : (kind[b] == kOpen ? v : -v);
-            did.outflow_rate += into_sink;
+            const std::int64_t b = m.face_b[f];
+            did.outflow_rate += b < 0 ? v : (kind[b] == kOpen ? v : -v);
             if (b < 0) did.side_outflow_rate[0] += v;
-            (void)a;
         }
         if (record) {
             std::vector<double> &faces = grid.face_fluxes().x;
@@ -463,14 +693,11 @@ private:
             if (dense) {
                 for (std::int64_t f = 0; f < m.live_faces; ++f) faces[f] += s.flux[f] * dt;
             } else {
-                for (const std::int64_t f : s.faces)
-                    if (f < m.live_faces) faces[f] += s.flux[f] * dt;
+                for (const std::int64_t f : s.faces) faces[f] += s.flux[f] * dt;
             }
         }
         if (!dense)
-            for (const std::int64_t f : s.faces) s.flux[f] = 0.0;
-        else
-            s.flux_clean = false;
+            for (const std::int64_t f : s.faces) flux[f] = low[f] = high[f] = pull[f] = 0.0;
         did.moved = moved;
         did.max_excess_slope = max_excess;
         return did;

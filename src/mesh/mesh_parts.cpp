@@ -23,10 +23,29 @@ std::vector<GhostField> height_fields(Grid &grid) {
 
 bool steps_ghosts(const Grid &grid) { return grid.geometry().mesh->substeps_per_exchange > 0; }
 
-void exchange_ghost_gradients(MeshState &s, const std::vector<std::int64_t> *computed,
-                              std::vector<std::int64_t> &changed_ghosts) {
-    s.exchange->send_changed(GhostExchange::kFaceGhosts, {GhostField{s.gx.data()}, GhostField{s.gy.data()}}, computed,
-                             changed_ghosts);
+// The fields across a face from an owned cell, in their places: the
+// gradient, the pull (M^-1 P), the limiter's factors; each exchange sends
+// its own and leaves the others absent.
+namespace {
+void exchange_face_fields(MeshState &s, int first, double *x, double *y, std::vector<std::int64_t> &changed_ghosts) {
+    std::vector<GhostField> fields(6);
+    fields[static_cast<std::size_t>(first)].f64 = x;
+    fields[static_cast<std::size_t>(first) + 1].f64 = y;
+    s.exchange->send_changed(GhostExchange::kFaceGhosts, fields, nullptr, changed_ghosts);
+}
+}  // namespace
+
+void exchange_ghost_gradients(MeshState &s, std::vector<std::int64_t> &changed_ghosts) {
+    exchange_face_fields(s, 0, s.gx.data(), s.gy.data(), changed_ghosts);
+}
+
+void exchange_ghost_pulls(MeshState &s, std::vector<std::int64_t> &changed_ghosts) {
+    exchange_face_fields(s, 2, s.pull_x.data(), s.pull_y.data(), changed_ghosts);
+}
+
+void exchange_ghost_limits(MeshState &s) {
+    std::vector<std::int64_t> ignored;
+    exchange_face_fields(s, 4, s.limit_in.data(), s.limit_out.data(), ignored);
 }
 
 void exchange_ghost_heights(Grid &grid, MeshState &s, const std::vector<std::int64_t> *computed,
@@ -117,7 +136,9 @@ void take_owners_edges(Grid &grid, GhostExchange &exchange, int most_edge_faces)
     const std::vector<std::uint8_t> open_before = open;
     const std::vector<double> level_before = level;
     for (std::int64_t c = m.owned; c < m.cells; ++c) {
-        if (m.reach[static_cast<std::size_t>(c)] < 1) continue;  // not stepped here
+        // Only a ghost whose faces are all here orders them as its owner does;
+        // the passes before the update read the others' faces for nothing.
+        if (static_cast<double>(m.cell_face_start[c + 1] - m.cell_face_start[c]) != m.face_count[c]) continue;
         edge_faces(c, faces);
         for (std::size_t k = 0; k < faces.size(); ++k) {
             open[faces[k]] = values[2 * k][static_cast<std::size_t>(c)] != 0.0;

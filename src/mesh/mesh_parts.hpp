@@ -1,8 +1,10 @@
 // What a part of a distributed mesh adds to the mesh engine: its ghosts take
 // their owners' values through the part's GhostExchange (mesh/ghost_exchange.hpp).
 //
-//  - In a sub-step, two exchanges: the owned cells' gradients (for the faces
-//    between an owned cell and a ghost) and, after the update, their heights.
+//  - In a sub-step, four exchanges: the owned cells' gradients (for the
+//    faces between an owned cell and a ghost), their pulls and their
+//    limiters' factors (mesh/mesh_engine.cpp), and after the update their
+//    heights.
 //  - Where the host's ghost layer is deep enough, a part steps the ghosts in
 //    reach too (Mesh::reach, model/mesh_part.hpp) and exchanges heights once
 //    per batch of that many sub-steps; the step ends with an exchange.
@@ -55,12 +57,12 @@ struct BatchReach {
 // Whether this part steps its ghosts in reach (several sub-steps per exchange).
 bool steps_ghosts(const Grid &grid);
 
-// In a sub-step that exchanges twice: the ghosts' gradients once the owned
-// cells' are known; `computed`: the owned cells whose gradients this
-// sub-step computed (null: any). The ghosts whose gradients changed are
-// appended to `changed_ghosts`.
-void exchange_ghost_gradients(MeshState &s, const std::vector<std::int64_t> *computed,
-                              std::vector<std::int64_t> &changed_ghosts);
+// In a sub-step that exchanges: the ghosts' gradients once the owned
+// cells' are known, then their pulls (the ghosts whose values changed are
+// appended to `changed_ghosts`), then their limiters' factors.
+void exchange_ghost_gradients(MeshState &s, std::vector<std::int64_t> &changed_ghosts);
+void exchange_ghost_pulls(MeshState &s, std::vector<std::int64_t> &changed_ghosts);
+void exchange_ghost_limits(MeshState &s);
 // The ghosts' heights (with hysteresis their moving flags, on a part that
 // steps its ghosts their residuals) once the owned cells changed.
 void exchange_ghost_heights(Grid &grid, MeshState &s, const std::vector<std::int64_t> *computed,

@@ -62,9 +62,22 @@ struct MeshState final : EngineState {
     // (the grid's Distribution), found at the start of each step.
     GhostExchange *exchange = nullptr;
 
-    // The passes' scratch.
+    // The passes' scratch (mesh/mesh_engine.cpp). Per face, as volumes per
+    // unit time from a to b: the monotone flux, the gradient flow's, the
+    // limited one; the pull V g t; the slope beyond tan(theta). Per cell: M^-1 P, the limiter's factors
+    // for what enters and what leaves. Outside a sub-step's faces and cells
+    // each holds 0 (the limiters 1).
     std::vector<double> gx, gy;   // least-squares gradients
-    std::vector<double> flux;     // per face, volume per unit time from a to b; 0 outside a sub-step's faces
+    std::vector<double> flux;     // the limited flux
+    std::vector<double> low, high, pull, excess;
+    std::vector<double> pull_x, pull_y;
+    std::vector<double> limit_in, limit_out;
+    // Per face, whether its slope exceeds its threshold; the steep faces (a
+    // list that may hold faces no longer steep, dropped as it is read).
+    std::vector<std::uint8_t> steep;
+    std::vector<std::int64_t> steep_faces;
+    std::vector<std::int64_t> pull_cells, limit_cells;
+    std::vector<std::int64_t> pulling_ghosts;  // a part's ghosts whose pulls are not 0
     std::vector<std::uint32_t> face_seen, cell_seen;
     std::uint32_t stamp = 0;
     std::vector<std::int64_t> faces, gradient_cells, update_cells;

@@ -148,15 +148,18 @@ void order_each_cells_faces(Mesh &m, const std::vector<RawFace> &faces) {
 }  // namespace
 
 // The least-squares gradient weights of every owned cell, weighted by
-// inverse distance squared, over one ring of neighbours across faces or two
-// (gradients_over_two_rings); a cell whose neighbours do not span the plane
-// gets none (its faces use the two-point slope alone). The neighbours of a
-// ghost n are ghost_neighbours[ghost_start[n - owned] .. ghost_start[n -
-// owned + 1]), as n's owner knows them (-1: not on this rank). A ghost whose
-// rings are all on this rank gets its weights too, as its owner has them
+// inverse distance squared, over the cells across its faces; a cell whose
+// neighbours do not span the plane gets none (its faces use the two-point
+// slope alone). The neighbours of a ghost n are
+// ghost_neighbours[ghost_start[n - owned] .. ghost_start[n - owned + 1]), as
+// n's owner knows them (-1: not on this rank). A ghost whose neighbours are
+// all on this rank gets its weights too, as its owner has them
 // (has_stencil); another ghost's list holds the cells whose gradients read
-// it (weights 0), so that a change of its height wakes them.
-void gradient_weights(Mesh &m, int rings, const std::vector<std::int64_t> &ghost_start,
+// it (weights 0), so that a change of its height wakes them. With the
+// weights: each cell's inverse least-squares matrix and each face's pair
+// offsets (Mesh::grad_ixx, Mesh::pair_ax), what the gradient flow's pair
+// terms read.
+void gradient_weights(Mesh &m, const std::vector<std::int64_t> &ghost_start,
                       const std::vector<std::int64_t> &ghost_neighbours, std::vector<std::uint8_t> &has_stencil) {
     std::vector<std::int64_t> stencil_start(static_cast<std::size_t>(m.cells) + 1, 0), stencil;
     has_stencil.assign(static_cast<std::size_t>(m.cells), 0);
@@ -180,12 +183,7 @@ void gradient_weights(Mesh &m, int rings, const std::vector<std::int64_t> &ghost
             }
             return all_here;
         };
-        bool complete = visit_neighbours(c);
-        if (rings > 1) {
-            const std::size_t first = ring.size();
-            for (std::size_t r = 0; r < first; ++r) complete = visit_neighbours(ring[r]) && complete;
-        }
-        if (complete) {
+        if (visit_neighbours(c)) {
             has_stencil[static_cast<std::size_t>(c)] = 1;
             std::sort(ring.begin(), ring.end(),
                       [&](std::int64_t l, std::int64_t r) { return m.global_id[l] < m.global_id[r]; });
@@ -214,20 +212,22 @@ void gradient_weights(Mesh &m, int rings, const std::vector<std::int64_t> &ghost
     }
     m.grad_wx.assign(m.grad_cells.size(), 0.0);
     m.grad_wy.assign(m.grad_cells.size(), 0.0);
+    m.grad_ixx.assign(static_cast<std::size_t>(m.cells), 0.0);
+    m.grad_ixy.assign(static_cast<std::size_t>(m.cells), 0.0);
+    m.grad_iyy.assign(static_cast<std::size_t>(m.cells), 0.0);
+    // The neighbours' offsets: in the plane, or on a geographic mesh as seen
+    // from the cell on the sphere (great-circle distance and direction), so
+    // that the gradient is the true one in metres.
+    const auto offset = [&](std::int64_t c, std::int64_t n) {
+        if (!m.projection) return PlanePoint{m.x[n] - m.x[c], m.y[n] - m.y[c]};
+        return m.projection->offset({m.x[c], m.y[c]}, {m.x[n], m.y[n]});
+    };
     for (std::int64_t c = 0; c < m.cells; ++c) {
         if (!has_stencil[static_cast<std::size_t>(c)]) continue;
         double sxx = 0.0, sxy = 0.0, syy = 0.0;
         const std::int64_t k0 = m.grad_start[c], k1 = m.grad_start[c + 1];
-        // The neighbours' offsets: in the plane, or on a geographic mesh as
-        // seen from the cell on the sphere (great-circle distance and
-        // direction), so that the gradient is the true one in metres.
-        const auto offset = [&](std::int64_t n) {
-            if (!m.projection) return PlanePoint{m.x[n] - m.x[c], m.y[n] - m.y[c]};
-            return m.projection->offset({m.x[c], m.y[c]}, {m.x[n], m.y[n]});
-        };
         for (std::int64_t k = k0; k < k1; ++k) {
-            const std::int64_t n = m.grad_cells[k];
-            const PlanePoint o = offset(n);
+            const PlanePoint o = offset(c, m.grad_cells[k]);
             const double dx = o.x, dy = o.y;
             const double w = 1.0 / (dx * dx + dy * dy);
             sxx += w * dx * dx, sxy += w * dx * dy, syy += w * dy * dy;
@@ -235,14 +235,29 @@ void gradient_weights(Mesh &m, int rings, const std::vector<std::int64_t> &ghost
         const double det = sxx * syy - sxy * sxy;
         const double trace = sxx + syy;
         if (!(det > 1e-6 * trace * trace)) continue;
+        m.grad_ixx[static_cast<std::size_t>(c)] = syy / det;
+        m.grad_ixy[static_cast<std::size_t>(c)] = -sxy / det;
+        m.grad_iyy[static_cast<std::size_t>(c)] = sxx / det;
         for (std::int64_t k = k0; k < k1; ++k) {
-            const std::int64_t n = m.grad_cells[k];
-            const PlanePoint o = offset(n);
+            const PlanePoint o = offset(c, m.grad_cells[k]);
             const double dx = o.x, dy = o.y;
             const double w = 1.0 / (dx * dx + dy * dy);
             m.grad_wx[k] = w * (syy * dx - sxy * dy) / det;
             m.grad_wy[k] = w * (sxx * dy - sxy * dx) / det;
         }
+    }
+    const std::size_t nf = static_cast<std::size_t>(m.faces);
+    m.pair_ax.assign(nf, 0.0), m.pair_ay.assign(nf, 0.0), m.pair_bx.assign(nf, 0.0), m.pair_by.assign(nf, 0.0);
+    const auto over_square = [](PlanePoint o) {
+        const double w = 1.0 / (o.x * o.x + o.y * o.y);
+        return PlanePoint{w * o.x, w * o.y};
+    };
+    for (std::size_t f = 0; f < nf; ++f) {
+        const std::int64_t a = m.face_a[f], b = m.face_b[f];
+        if (b < 0) continue;
+        const PlanePoint toward_b = over_square(offset(a, b)), toward_a = over_square(offset(b, a));
+        m.pair_ax[f] = toward_b.x, m.pair_ay[f] = toward_b.y;
+        m.pair_bx[f] = toward_a.x, m.pair_by[f] = toward_a.y;
     }
 }
 
@@ -390,9 +405,8 @@ namespace {
 
 std::shared_ptr<const Mesh> finish_serial(std::shared_ptr<Mesh> mesh) {
     Mesh &m = *mesh;
-    const int rings = gradients_over_two_rings(static_cast<std::int64_t>(m.cell_faces.size()), m.cells) ? 2 : 1;
     std::vector<std::uint8_t> has_stencil;
-    gradient_weights(m, rings, {}, {}, has_stencil);
+    gradient_weights(m, {}, {}, has_stencil);
     set_step_scale(m);
     return mesh;
 }
@@ -766,11 +780,6 @@ std::shared_ptr<const Mesh> mesh_from_graph(std::int64_t ncells, const double *c
                                             int base) {
     return finish_serial(
         assemble_graph(ncells, cell_xy, cell_area, nfaces, face_cells, face_xy, face_length, nullptr, function, base));
-}
-
-bool gradients_over_two_rings(std::int64_t cell_faces, std::int64_t cells) {
-    // Edges count: an upper figure of the neighbours.
-    return static_cast<double>(cell_faces) / static_cast<double>(cells) < 4.0;
 }
 
 std::shared_ptr<const Mesh> mesh_from_dual(std::int64_t nnodes, const double *node_xy, std::int64_t ntriangles,

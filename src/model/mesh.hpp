@@ -62,10 +62,10 @@ struct Mesh {
     std::vector<double> into;
     // The least-squares gradient of cell c is the sum over
     // grad_cells[grad_start[c] .. grad_start[c + 1]) of (grad_wx, grad_wy) *
-    // (h_n - h_c): over the cells across its faces, and on meshes whose
-    // cells have fewer than 4 neighbours (triangles) also over theirs, so
-    // that the fit is not set by 3 points alone; none where they do not span
-    // the plane; in the order of the host's cell numbers, as the faces. The
+    // (h_n - h_c), over the cells across its faces (none where they do not
+    // span the plane), in the order of the host's cell numbers, as the
+    // faces. One ring, so that every pair of a stencil shares a face, over
+    // which the gradient flow's pair term runs (mesh/mesh_engine.cpp). The
     // cells a change of height reaches through gradients are
     // the same list (the stencil is symmetric), which the active set wakes.
     // A ghost of a distributed mesh's part takes its gradient from its owner:
@@ -73,6 +73,14 @@ struct Mesh {
     // that a change of its height wakes them.
     std::vector<std::int64_t> grad_start, grad_cells;
     std::vector<double> grad_wx, grad_wy;
+    // Per cell, the inverse of its least-squares matrix M = sum w o o^T (0
+    // without a stencil); per face, the offset o from a to b as a's fit sees
+    // it over |o|^2 (pair_ax, pair_ay), and from b to a as b's sees it
+    // (pair_bx, pair_by; 0 on the domain edge). The weight of b in a's
+    // gradient is M_a^-1 (pair_ax, pair_ay), so a vector P_a enters a face as
+    // pair_a . (M_a^-1 P_a) and a part needs its ghosts' M^-1 P alone.
+    std::vector<double> grad_ixx, grad_ixy, grad_iyy;
+    std::vector<double> pair_ax, pair_ay, pair_bx, pair_by;
 
     // Per face, in the library's order: cells a < b (b == -1 on the domain
     // edge), the centre-to-centre distance d (on the domain edge twice the
@@ -156,9 +164,6 @@ std::shared_ptr<const Mesh> mesh_from_graph(std::int64_t ncells, const double *c
 std::shared_ptr<const Mesh> mesh_from_dual(std::int64_t nnodes, const double *node_xy, std::int64_t ntriangles,
                                            const std::int64_t *triangle_nodes, const char *function, int base,
                                            bool geographic = false);
-// Whether the least-squares gradients use two rings of neighbours: where
-// cells have fewer than 4 faces on average over the whole mesh.
-bool gradients_over_two_rings(std::int64_t cell_faces, std::int64_t cells);
 
 // The same mesh again from what a restart file kept.
 std::shared_ptr<const Mesh> mesh_from_input(const MeshInput &input, const char *function);

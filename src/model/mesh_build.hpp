@@ -27,9 +27,9 @@ std::shared_ptr<Mesh> assemble_graph(std::int64_t ncells, const double *cell_xy,
                                      int base);
 
 // The least-squares gradient weights of every cell whose stencil lies on
-// this rank, over `rings` rings of neighbours; `has_stencil` says which
+// this rank, over the cells across its faces; `has_stencil` says which
 // (model/mesh.cpp).
-void gradient_weights(Mesh &m, int rings, const std::vector<std::int64_t> &ghost_start,
+void gradient_weights(Mesh &m, const std::vector<std::int64_t> &ghost_start,
                       const std::vector<std::int64_t> &ghost_neighbours, std::vector<std::uint8_t> &has_stencil);
 
 // The smallest area over summed conductance of any owned cell (1 where no

@@ -12,21 +12,39 @@ namespace {
 
 // How many sub-steps after an exchange each cell, gradient and face of a
 // part stays its owner's when stepped here (Mesh::reach), and the lists by
-// reach. Valid after 0 sub-steps: every cell. In sub-step j a gradient is
-// exact when its cell has its own stencil and every cell of it was exact
-// after j - 1; a face's flux when its cells and their gradients were; a
-// cell's new height when it was exact, all its faces over the whole mesh
-// are here (ghost_faces: as its owner counts them) and their fluxes exact.
-// Sets substeps_per_exchange to the highest j at which every owned cell is
-// exact (the caller takes the smallest over ranks).
+// reach. Valid after 0 sub-steps: every cell. A sub-step's passes
+// (mesh/mesh_engine.cpp) read outward: in sub-step j a gradient is exact
+// when its cell has its own stencil and every cell of it was exact after j -
+// 1; a face's slope and fluxes of its own when its cells and their
+// gradients were; a cell's pull (M^-1 P) when it has its own stencil, all
+// its faces over the whole mesh are here (ghost_faces: as its owner counts
+// them) and their slopes exact; a face's gradient-flow flux when its slope
+// and its cells' pulls are; a cell's limiter when it was exact, all its
+// faces are here and their gradient-flow fluxes exact; a face's limited flux
+// when its cells' limiters are; a cell's new height when all its faces'
+// limited fluxes are. Sets substeps_per_exchange to the highest j at which
+// every owned cell is exact (the caller takes the smallest over ranks).
 void set_reach(Mesh &m, const std::vector<std::uint8_t> &has_stencil, const std::vector<double> &ghost_faces) {
     const std::size_t n = static_cast<std::size_t>(m.cells), nf = static_cast<std::size_t>(m.faces);
-    std::vector<std::uint8_t> valid(n, 1), gradient(n, 0), flux(nf, 0), faces_here(n, 1);
+    std::vector<std::uint8_t> valid(n, 1), gradient(n, 0), slope(nf, 0), pull(n, 0), high(nf, 0), limiter(n, 0),
+        flux(nf, 0), faces_here(n, 1);
     for (std::int64_t c = m.owned; c < m.cells; ++c)
         faces_here[static_cast<std::size_t>(c)] =
             static_cast<double>(m.cell_face_start[c + 1] - m.cell_face_start[c]) == ghost_faces[c - m.owned];
     m.reach.assign(n, 0), m.gradient_reach.assign(n, 0), m.face_reach.assign(nf, 0);
     m.substeps_per_exchange = 0;
+    // Whether every face of c is here and `exact` for it.
+    const auto all_faces = [&](std::size_t c, const std::vector<std::uint8_t> &exact) {
+        bool all = faces_here[c] != 0;
+        for (std::int64_t k = m.cell_face_start[c]; all && k < m.cell_face_start[c + 1]; ++k)
+            all = exact[static_cast<std::size_t>(m.cell_faces[k])] != 0;
+        return all;
+    };
+    // Whether both cells of f are `exact`.
+    const auto both_cells = [&](std::size_t f, const std::vector<std::uint8_t> &exact) {
+        const std::int64_t b = m.face_b[f];
+        return exact[static_cast<std::size_t>(m.face_a[f])] && (b < 0 || exact[static_cast<std::size_t>(b)]);
+    };
     for (int j = 1; j <= Mesh::kMaxReach; ++j) {
         for (std::size_t c = 0; c < n; ++c) {
             bool exact = has_stencil[c] && valid[c];
@@ -36,17 +54,16 @@ void set_reach(Mesh &m, const std::vector<std::uint8_t> &has_stencil, const std:
             if (exact) m.gradient_reach[c] = static_cast<std::int8_t>(j);
         }
         for (std::size_t f = 0; f < nf; ++f) {
-            const std::size_t a = static_cast<std::size_t>(m.face_a[f]);
-            const std::int64_t b = m.face_b[f];
-            flux[f] = valid[a] && gradient[a] &&
-                      (b < 0 || (valid[static_cast<std::size_t>(b)] && gradient[static_cast<std::size_t>(b)]));
-            if (flux[f]) m.face_reach[f] = static_cast<std::int8_t>(j);
+            slope[f] = both_cells(f, valid) && both_cells(f, gradient);
+            if (slope[f]) m.face_reach[f] = static_cast<std::int8_t>(j);
         }
+        for (std::size_t c = 0; c < n; ++c) pull[c] = has_stencil[c] && all_faces(c, slope);
+        for (std::size_t f = 0; f < nf; ++f) high[f] = slope[f] && both_cells(f, pull);
+        for (std::size_t c = 0; c < n; ++c) limiter[c] = valid[c] && all_faces(c, high);
+        for (std::size_t f = 0; f < nf; ++f) flux[f] = high[f] && both_cells(f, limiter);
         bool owned_exact = true;
         for (std::size_t c = 0; c < n; ++c) {
-            bool exact = valid[c] && faces_here[c];
-            for (std::int64_t k = m.cell_face_start[c]; exact && k < m.cell_face_start[c + 1]; ++k)
-                exact = flux[static_cast<std::size_t>(m.cell_faces[k])] != 0;
+            const bool exact = valid[c] && all_faces(c, flux);
             valid[c] = exact;
             if (exact) m.reach[c] = static_cast<std::int8_t>(j);
             if (static_cast<std::int64_t>(c) < m.owned) owned_exact = owned_exact && exact;
@@ -113,10 +130,10 @@ std::shared_ptr<Mesh> part_from_input(const MeshInput &input, int rank, const ch
     return mesh;
 }
 
-void finish_part(Mesh &m, int rings, const std::vector<std::int64_t> &ghost_start,
+void finish_part(Mesh &m, const std::vector<std::int64_t> &ghost_start,
                  const std::vector<std::int64_t> &ghost_neighbours, const std::vector<double> &ghost_faces) {
     std::vector<std::uint8_t> has_stencil;
-    gradient_weights(m, rings, ghost_start, ghost_neighbours, has_stencil);
+    gradient_weights(m, ghost_start, ghost_neighbours, has_stencil);
     set_reach(m, has_stencil, ghost_faces);
     for (std::int64_t c = m.owned; c < m.cells; ++c) m.face_count[c] = ghost_faces[c - m.owned];
     set_step_scale(m);

@@ -33,13 +33,14 @@ std::shared_ptr<Mesh> part_from_graph(std::int64_t ncells, const double *cell_xy
 // The same part again from what a restart file kept, for the rank `rank`.
 std::shared_ptr<Mesh> part_from_input(const MeshInput &input, int rank, const char *function);
 
-// Finishes a part: the gradients of its owned cells over `rings` rings (the
-// second through a ghost n over ghost_neighbours[ghost_start[n - owned] ..
-// ghost_start[n - owned + 1]), library indices, as n's owner has them), the
+// Finishes a part: the gradients of its owned cells and of the ghosts whose
+// neighbours are all here (a ghost n's over ghost_neighbours[ghost_start[n -
+// owned] .. ghost_start[n - owned + 1]), library indices, as n's owner has
+// them), the
 // faces of each ghost over the whole mesh (ghost_faces[n - owned]), the
 // ghosts' reach, and the sub-step's scale over the owned cells; the caller
 // makes step_scale, min_distance and substeps_per_exchange global.
-void finish_part(Mesh &m, int rings, const std::vector<std::int64_t> &ghost_start,
+void finish_part(Mesh &m, const std::vector<std::int64_t> &ghost_start,
                  const std::vector<std::int64_t> &ghost_neighbours, const std::vector<double> &ghost_faces);
 
 }  // namespace dpsm

@@ -10,9 +10,8 @@
 //    check together that the owners agree (each global id owned once, every
 //    ghost held by the rank that claims to own it, faces seen alike from both
 //    sides), learn each ghost's neighbours and face count from its owner, and
-//    agree on what a serial mesh decides over all cells (one or two rings of
-//    neighbours for the gradients, the sub-step's scale, the smallest face
-//    distance). Each cell's faces and gradient neighbours are summed in the
+//    agree on what a serial mesh decides over all cells (the sub-step's
+//    scale, the smallest face distance). Each cell's faces and gradient neighbours are summed in the
 //    order of their global ids, so an owned cell is computed from the same
 //    values by the same arithmetic as in the serial mesh: bit for bit;
 //  - sub-steps: exchanges with the ranks that own this part's ghosts or
@@ -246,7 +245,6 @@ PartLinks link_parts(MPI_Comm comm, Mesh &m, const std::vector<int> &owner_of_ce
 
     // The ghosts' neighbours as library indices (-1: not on this rank); faces
     // seen alike from both sides; the second ring complete where it is used.
-    const int rings = gradients_over_two_rings(sums[1], n_global) ? 2 : 1;
     const std::size_t nghosts = static_cast<std::size_t>(m.cells - m.owned);
     std::vector<std::int64_t> ghost_start(nghosts + 1, 0), ghost_neighbours;
     std::vector<double> ghost_faces(nghosts, 0.0);
@@ -285,20 +283,13 @@ PartLinks link_parts(MPI_Comm comm, Mesh &m, const std::vector<int> &owner_of_ce
                     fail(DPSM_ERR_INVALID_VALUE, fn, "owned ", name_cell(m, c), " has a face with ghost ",
                          name_cell(m, n), ", which the ghost's owner, rank ", owner_of_cell[static_cast<std::size_t>(n)],
                          ", does not have");
-                if (rings < 2) continue;
-                for (const std::int64_t far : of_n)
-                    if (far < 0)
-                        fail(DPSM_ERR_INVALID_VALUE, fn, "the neighbourhood of owned ", name_cell(m, c),
-                             " is incomplete: its gradient reads the cells within two faces, and ghost ",
-                             name_cell(m, n), " has a neighbour that this rank does not hold; on meshes whose "
-                             "cells have fewer than 4 faces on average dpsm needs two layers of ghost cells");
             }
     });
     for (std::size_t g = 0; g < nghosts; ++g) {
         ghost_neighbours.insert(ghost_neighbours.end(), neighbours_of[g].begin(), neighbours_of[g].end());
         ghost_start[g + 1] = static_cast<std::int64_t>(ghost_neighbours.size());
     }
-    finish_part(m, rings, ghost_start, ghost_neighbours, ghost_faces);
+    finish_part(m, ghost_start, ghost_neighbours, ghost_faces);
     double smallest[2] = {m.step_scale, m.min_distance};
     check_mpi(MPI_Allreduce(MPI_IN_PLACE, smallest, 2, MPI_DOUBLE, MPI_MIN, comm), "MPI_Allreduce of the scales");
     m.step_scale = smallest[0];

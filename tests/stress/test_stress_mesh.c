@@ -66,9 +66,6 @@
 static const double kPi = 3.14159265358979323846;
 static double deg(double d) { return d * kPi / 180.0; }
 
-/* The smallest rest tolerance of a mesh (dpsm_set_rest_tolerance()). */
-static const double kMeshRestTolerance = 1e-4;
-
 static void *zeroed(size_t n, size_t size) {
     void *p = calloc(n ? n : 1, size);
     REQUIRE(p != NULL, "out of memory");
@@ -526,7 +523,7 @@ static void check_step(mscene_t *s, const start_t *st, mesh_worst_t *w) {
     SCENE_OK(s, dpsm_get_step_info(s->g, DPSM_INFO_AT_REST, &at_rest));
     if (at_rest == 1.0) {
         ++w->rest_checks;
-        const double tol = fmax(s->tol, kMeshRestTolerance), tan_theta = tan(s->theta);
+        const double tol = s->tol, tan_theta = tan(s->theta);
         double excess = 0.0;
         SCENE_OK(s, dpsm_get_step_info(s->g, DPSM_INFO_MAX_EXCESS_SLOPE, &excess));
         note(w, FIG_REST_EXCESS, excess / (tol * tan_theta), s->name);
@@ -535,8 +532,7 @@ static void check_step(mscene_t *s, const start_t *st, mesh_worst_t *w) {
                 s->name, excess, tol * tan_theta);
         if (s->orthogonal) {
             /* A face's part across it is its two-point slope: one steeper than
-             * tan(theta)(1 + tol) carries sand (docs/guarantees.md, "Meshes",
-             * (i) to (iv)) unless it cannot: a wall, two held cells, sand on
+             * tan(theta)(1 + tol) carries sand (docs/guarantees.md, "Meshes") unless it cannot: a wall, two held cells, sand on
              * its bed thinner than the film dpsm leaves. */
             const double threshold = tan_theta * (1.0 + tol), film = 2.0 * tol * tan_theta * s->longest;
             for (int64_t f = 0; f < s->nf; ++f) {
