@@ -812,6 +812,47 @@ static void test_turned_mesh_same_deposit(void **state) {
     }
 }
 
+/* The column (radius 1, height 0.5, 30 degrees, open edge) on the scene's
+ * mesh stepped to rest: its L1 difference from the exact deposit (a
+ * truncated cone whose foot keeps the volume) over the column's volume. */
+static double column_error(const mesh_scene *s) {
+    const double pi = 3.14159265358979323846, alpha = tan(30.0 * kDeg);
+    const double foot = (0.5 + sqrt(4.0 * alpha * alpha - 0.25 / 3.0)) / (2.0 * alpha);
+    dpsm_grid *g = column_mesh(s, 1, 0);
+    int rested = 0;
+    for (int call = 0; call < 400 && !rested; ++call) {
+        CHECK_OK(g, dpsm_step(g, 0.05));
+        rested = step_info_of(g, DPSM_INFO_AT_REST) > 0.0;
+    }
+    REQUIRE(rested, "%s, %lld cells: the column did not rest by t = 20", scene_name(s->kind), (long long)s->cells);
+    double *h = calloc((size_t)s->cells, sizeof(double)), error = 0.0;
+    CHECK_OK(g, dpsm_get_heights(g, h));
+    for (int64_t c = 0; c < s->cells; ++c)
+        error += fabs(h[c] - fmin(0.5, fmax(0.0, alpha * (foot - hypot(s->cx[c], s->cy[c]))))) * s->area[c];
+    free(h);
+    dpsm_destroy(g);
+    return error / (pi * 0.5);
+}
+
+/* The deposit converges: on every kind of mesh, halving the cells' size
+ * divides the error by at least 2 (an order-1 method's factor). */
+static void test_error_falls_with_the_cells(void **state) {
+    (void)state;
+    const scene_kind kinds[4] = {SCENE_QUADS, SCENE_TRIANGLES, SCENE_HEXAGONS, SCENE_DUAL};
+    for (int k = 0; k < 4; ++k) {
+        double error[2];
+        for (int level = 0; level < 2; ++level) {
+            mesh_scene s = scene_make(kinds[k], 24 << level, 2.5, 7u);
+            error[level] = column_error(&s);
+            scene_free(&s);
+        }
+        printf("  %s: L1 error over the volume %.4f %% at 24, %.4f %% at 48 (order %.2f)\n", scene_name(kinds[k]),
+               100.0 * error[0], 100.0 * error[1], log2(error[0] / error[1]));
+        REQUIRE(error[1] * 2.0 <= error[0], "%s: halving the cells took the error from %.4g only to %.4g",
+                scene_name(kinds[k]), error[0], error[1]);
+    }
+}
+
 /* The same mesh with its cells given in reverse order steps to the same heights, cell by cell. */
 static void test_host_order(void **state) {
     (void)state;
@@ -1145,6 +1186,7 @@ int main(void) {
         cmocka_unit_test(test_exact_states),
         cmocka_unit_test(test_plane_at_the_angle_of_repose_rests),
         cmocka_unit_test(test_turned_mesh_same_deposit),
+        cmocka_unit_test(test_error_falls_with_the_cells),
         cmocka_unit_test(test_host_order),
         cmocka_unit_test(test_graph_steps_as_polygons),
         cmocka_unit_test(test_active_set_same_bits),

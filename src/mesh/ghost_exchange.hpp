@@ -44,7 +44,8 @@ public:
     // nothing). `computed` names the owned cells whose values may have
     // changed (null: any). The ghosts whose values changed are appended to
     // `changed_ghosts`. A list keeps its fields in the same places from one
-    // call to the next.
+    // call to the next; calls that follow each other over one set of ghosts
+    // send different first fields, so that their messages never mix.
     virtual void send_changed(Ghosts ghosts, const std::vector<GhostField> &fields,
                               const std::vector<std::int64_t> *computed, std::vector<std::int64_t> &changed_ghosts) = 0;
     // Collective: every ghost of `ghosts` takes its owner's values of

@@ -26,6 +26,8 @@ constexpr double kDenseShare = 0.125;
 // The share of the room to its bounds a cell's limiter lets the gradient
 // flow's excess fill.
 constexpr double kLimiterRoom = 1.0 - 1e-9;
+// What counts as the round-off of a sum, relative to its terms' magnitudes.
+constexpr double kRoundOff = 64.0 * std::numeric_limits<double>::epsilon();
 
 // What a face's own slope gives it in a sub-step (FaceLaw::terms).
 struct FaceTerms {
@@ -169,6 +171,13 @@ inline double net_rate(const Mesh &m, const double *flux, std::int64_t c, bool &
     return rate / m.area[c];
 }
 
+// A sum whose terms' magnitudes add up to `scale`, or 0 where it is within
+// their round-off: where the parts of a flux cancel (a state the bed holds
+// still) the rounding must not keep a face carrying sand for ever.
+inline double beyond_round_off(double sum, double scale) {
+    return std::fabs(sum) > kRoundOff * scale ? sum : 0.0;
+}
+
 // Cell c's pull: M_c^-1 P_c, with P_c the sum of its faces' pulls along
 // their tangents, in the cell's face order (0 without a stencil).
 inline void pull_of(const Mesh &m, const double *pull, std::int64_t c, double *pull_x, double *pull_y) {
@@ -192,9 +201,9 @@ inline double gradient_flow_flux(const Mesh &m, const FaceLaw &law, std::int64_t
     const std::int64_t a = m.face_a[f], b = m.face_b[f];
     if (b < 0) return two_point;
     // Added so that the face read from b to a gives exactly the opposite.
-    const double pairs = (m.pair_bx[f] * pull_x[b] + m.pair_by[f] * pull_y[b]) -
-                         (m.pair_ax[f] * pull_x[a] + m.pair_ay[f] * pull_y[a]);
-    return two_point + pairs;
+    const double from_b = m.pair_bx[f] * pull_x[b] + m.pair_by[f] * pull_y[b];
+    const double from_a = m.pair_ax[f] * pull_x[a] + m.pair_ay[f] * pull_y[a];
+    return beyond_round_off(two_point + (from_b - from_a), std::fabs(two_point) + std::fabs(from_b) + std::fabs(from_a));
 }
 
 // Zalesak's limiter for cell c: the shares of the gradient flow's excess
@@ -243,7 +252,8 @@ inline double limited_flux(const Mesh &m, const FaceLaw &law, std::int64_t f, do
     const std::int64_t a = m.face_a[f], b = m.face_b[f];
     double share = excess > 0.0 ? limit_out[a] : limit_in[a];
     if (b >= 0) share = std::min(share, excess > 0.0 ? limit_in[b] : limit_out[b]);
-    return law.capped(low + share * excess, a, b);
+    const double limited = share * excess;
+    return law.capped(beyond_round_off(low + limited, std::fabs(low) + std::fabs(limited)), a, b);
 }
 
 class MeshEngine final : public Engine {

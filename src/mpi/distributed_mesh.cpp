@@ -407,7 +407,11 @@ public:
         if (sent.size() < fields.size()) sent.resize(fields.size());
         for (const std::size_t k : present) sent[k].resize(send.cells.size(), 0.0);
         const int width = static_cast<int>(present.size());
-        send_changes(send, slots_[ghosts], computed, width, kTags[ghosts],
+        // A tag of the set and the first field sent: a rank that has left
+        // one call's barrier may send the next call's values while another
+        // still takes this call's.
+        const int tag = kTags[ghosts] + 2 * static_cast<int>(present.empty() ? 0 : present[0]);
+        send_changes(send, slots_[ghosts], computed, width, tag,
                      [&](std::size_t slot, std::int64_t c, double *out) {
                          bool differs = false;
                          for (const std::size_t k : present) differs = differs || fields[k].get(c) != sent[k][slot];
@@ -416,7 +420,7 @@ public:
                              out[j] = sent[present[j]][slot] = fields[present[j]].get(c);
                          return true;
                      });
-        receive_changes(receive, width, kTags[ghosts], [&](std::int64_t c, const double *in) {
+        receive_changes(receive, width, tag, [&](std::int64_t c, const double *in) {
             // A ghost stepped here already holds its owner's values: it changed only beyond reach.
             bool differs = false;
             for (std::size_t j = 0; j < present.size(); ++j) {
@@ -647,7 +651,8 @@ private:
         }
     }
 
-    // Per set of ghosts (GhostExchange::Ghosts), the message tag of its values.
+    // Per set of ghosts (GhostExchange::Ghosts), the message tag of its values
+    // (send_changed adds twice the place of the first field sent).
     static constexpr int kTags[2] = {2, 1};
     // The first value of a message: (position, values) of the cells that
     // changed, or the values of every listed cell in order.
