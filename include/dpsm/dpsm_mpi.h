@@ -181,28 +181,25 @@ DPSM_API int dpsm_load_mpi_f(MPI_Fint comm, const char *path, dpsm_grid **out);
  * host's own local numbering, each with a global id and its owner.
  *
  *  - **Ghosts needed.** Every cell across a face from an owned cell must be on
- *    the rank (one layer of ghosts). On meshes whose cells have fewer than 4
- *    faces on average (triangles), whose gradients read the cells within two
- *    faces, so must every cell across a face from those (two layers). With
- *    fewer, the constructor fails on every rank, naming an owned cell whose
- *    neighbourhood is incomplete. Faces between two ghosts may be given or
- *    left out: dpsm learns each ghost's neighbours from its owner.
+ *    the rank (one layer of ghosts: a cell's gradient reads the cells across
+ *    its faces). Faces between two ghosts may be given or left out: dpsm
+ *    learns each ghost's neighbours from its owner.
  *  - **Deeper layers** save exchanges: where a rank holds the ghosts' own
  *    neighbourhoods too, it steps those ghosts itself, exactly as their
- *    owners do, and the ranks exchange once per K sub-steps instead of twice
- *    in every one. dpsm finds K from the layers given (the smallest over the
+ *    owners do, and the ranks exchange once per K sub-steps instead of four
+ *    times in every one. dpsm finds K from the layers given (the smallest over the
  *    ranks, at most 8 and at most the sub-steps of a step: every step ends
- *    with an exchange); ::DPSM_INFO_SUBSTEPS_PER_EXCHANGE tells it. On
- *    triangles each sub-step per exchange takes about two more layers
- *    (measured on METIS parts: 3 layers give K = 1, 6 to 8 give 2, 12 give
- *    4); on quads 2 layers give 1 and 5 give 2. A ghost counts only where
+ *    with an exchange); ::DPSM_INFO_SUBSTEPS_PER_EXCHANGE tells it. A
+ *    sub-step reads four faces out, so each sub-step per exchange takes about
+ *    four more layers (on METIS and strip parts of triangles 9 layers give
+ *    K = 2). A ghost counts only where
  *    all its faces are on the rank, domain edges included (on a graph, give
  *    its edge faces too) and between two ghosts (given or derived from the
  *    polygons). The price: the ghosts in reach are stepped on both ranks
  *    (about 1 % more cell updates on parts of 250,000 triangles with 8
  *    layers) and an exchange sends the heights of the whole deep layer. The
  *    environment variable DPSM_MPI_SUBSTEPS_PER_EXCHANGE, read when a part is
- *    made, caps K (0: two exchanges in every sub-step, as with two layers);
+ *    made, caps K (0: exchanges in every sub-step, as with one layer);
  *    the results are the same bit for bit whatever K.
  *  - **Global ids** number all cells of the mesh from 0 (from 1 in the `_f`
  *    constructors), each owned by exactly one rank; `owner[k]` is the rank of
@@ -231,9 +228,10 @@ DPSM_API int dpsm_load_mpi_f(MPI_Fint comm, const char *path, dpsm_grid **out);
  *    differs by round-off). Mass figures and step information are global,
  *    as on distributed 2D grids (their sums over ranks differ from the serial
  *    ones by round-off).
- *  - **Communication:** with two layers of ghosts on triangles, each sub-step
- *    sends the neighbouring ranks only the owned cells' gradients and, after
- *    the update, heights that changed since they were last sent (one message
+ *  - **Communication:** with one layer of ghosts, each sub-step sends the
+ *    neighbouring ranks only the owned cells' gradients, pulls and limiters'
+ *    factors (docs/guarantees.md, "Meshes") and, after the update, heights
+ *    that changed since they were last sent (one message
  *    per neighbour that has any; a non-blocking barrier tells every rank that
  *    all have arrived), plus one all-reduce of a few numbers; where the
  *    layer allows K sub-steps per exchange (above), one exchange of heights

@@ -9,8 +9,8 @@ namespace dpsm {
 
 class Engine;
 
-// The sub-step is this share of the largest monotone one, so that every
-// sub-step in which sand moves lowers sum A (h - L)^2 by a bounded amount.
+// The sub-step is this share of the largest one for which the monotone
+// flux's update is a weighted mean of the old heights (docs/guarantees.md).
 constexpr double kMeshStepSafety = 0.9;
 
 const Engine &mesh_engine();

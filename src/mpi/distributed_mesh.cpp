@@ -149,10 +149,9 @@ PartLinks link_parts(MPI_Comm comm, Mesh &m, const std::vector<int> &owner_of_ce
     MPI_Comm_size(comm, &size);
     const std::size_t ranks = static_cast<std::size_t>(size);
     PartLinks links;
-    std::int64_t sums[2] = {m.owned, m.cell_face_start[static_cast<std::size_t>(m.owned)]};
-    check_mpi(MPI_Allreduce(MPI_IN_PLACE, sums, 2, MPI_INT64_T, MPI_SUM, comm), "MPI_Allreduce of the cell counts");
-    links.global_cells = sums[0];
-    const std::int64_t n_global = sums[0];
+    std::int64_t n_global = m.owned;
+    check_mpi(MPI_Allreduce(MPI_IN_PLACE, &n_global, 1, MPI_INT64_T, MPI_SUM, comm), "MPI_Allreduce of the cell counts");
+    links.global_cells = n_global;
 
     // Each global id in [0, n_global), owned once, its ghosts held by their owner:
     // checked at a home rank for every id (id % size).

@@ -689,8 +689,8 @@ static void test_height_jumps(void **state) {
 }
 
 /* Angles of repose from 0.5 to 89.5 degrees: a column some times tan(theta)
- * high collapses to rest, at rest tolerances of 1e-9 (the mesh's floor of
- * 1e-4 acts) and 1e-3, edges closed or open (the sand above the outside). */
+ * high collapses to rest, at rest tolerances of 1e-9 and 1e-3, edges closed
+ * or open (the sand above the outside). */
 static void test_repose_angles(void **state) {
     (void)state;
     mesh_worst_t w;
