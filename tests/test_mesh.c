@@ -838,6 +838,12 @@ static double column_error(const mesh_scene *s) {
  * divides the error by at least 2 (an order-1 method's factor). */
 static void test_error_falls_with_the_cells(void **state) {
     (void)state;
+#ifdef DPSM_TESTS_UNDER_ASAN
+    /* A numerical claim, checked in the main stage; under AddressSanitizer its
+     * eight runs to rest would take 45 s of the stage for passes that
+     * test_column_rests_with_mass_and_bounds already runs. */
+    skip();
+#endif
     const scene_kind kinds[4] = {SCENE_QUADS, SCENE_TRIANGLES, SCENE_HEXAGONS, SCENE_DUAL};
     for (int k = 0; k < 4; ++k) {
         double error[2];
