@@ -28,30 +28,17 @@ class GhostExchange;
 struct MeshState;
 
 // What the j-th sub-step after an exchange (j from 1; 0: a sub-step that
-// exchanges, and steps the owned cells alone) steps beyond the owned cells:
-// the ghosts, gradients and faces whose reach is at least j (Mesh::reach),
-// which the part then computes as their owners do.
+// exchanges, and steps the owned cells alone) updates beyond the owned
+// cells: the ghosts whose reach is at least j (Mesh::reach), which the part
+// then steps as their owners do (the passes before the update run over
+// every ghost and face).
 struct BatchReach {
     const Mesh &m;
     int j;
 
-    bool face(std::int64_t f) const {
-        return f < m.live_faces || (j && m.face_reach[static_cast<std::size_t>(f)] >= j);
-    }
-    bool gradient(std::int64_t c) const {
-        return c < m.owned || (j && m.gradient_reach[static_cast<std::size_t>(c)] >= j);
-    }
-    bool cell(std::int64_t c) const { return c < m.owned || (j && m.reach[static_cast<std::size_t>(c)] >= j); }
-    // The ghosts, ghost gradients and faces beyond the owned cells' in reach: the
-    // first count(...) of each list.
+    // The ghosts in reach: the first ghost_count() of the list.
     const std::int64_t *ghosts() const { return m.ghosts_by_reach.data(); }
     std::int64_t ghost_count() const { return j ? m.ghosts_with_reach[static_cast<std::size_t>(j)] : 0; }
-    const std::int64_t *ghost_gradients() const { return m.ghosts_by_gradient_reach.data(); }
-    std::int64_t ghost_gradient_count() const {
-        return j ? m.ghosts_with_gradient_reach[static_cast<std::size_t>(j)] : 0;
-    }
-    const std::int64_t *faces() const { return m.faces_by_reach.data(); }
-    std::int64_t face_count() const { return j ? m.faces_with_reach[static_cast<std::size_t>(j)] : 0; }
 };
 
 // Whether this part steps its ghosts in reach (several sub-steps per exchange).

@@ -120,18 +120,16 @@ struct Mesh {
     // ghost layer is deep, ghosts near the owned cells can then be stepped
     // here exactly as their owners step them, for a few sub-steps, and the
     // ranks exchange once per that many sub-steps. In the j-th sub-step
-    // after an exchange (from 1), cell c's gradient is its owner's if
-    // gradient_reach[c] >= j, face f's flux if face_reach[f] >= j, and cell
-    // c's new height if reach[c] >= j (owned cells: kMaxReach). Ghosts and
-    // faces beyond the owned ones are listed by reach, highest first, in
-    // ghosts_by_reach, ghosts_by_gradient_reach and faces_by_reach; every
-    // list's first count[j] entries are those whose reach is at least j.
+    // after an exchange (from 1), cell c's new height is its owner's if
+    // reach[c] >= j (owned cells: kMaxReach). The ghosts in reach are listed
+    // by reach, highest first, in ghosts_by_reach; its first
+    // ghosts_with_reach[j] entries are those whose reach is at least j.
     // substeps_per_exchange: the sub-steps all ranks take per exchange (0:
-    // two exchanges in every sub-step, gradients then heights).
+    // exchanges in every sub-step).
     static constexpr int kMaxReach = 8;
-    std::vector<std::int8_t> reach, gradient_reach, face_reach;
-    std::vector<std::int64_t> ghosts_by_reach, ghosts_by_gradient_reach, faces_by_reach;
-    std::vector<std::int64_t> ghosts_with_reach, ghosts_with_gradient_reach, faces_with_reach;  // per j, 0 .. kMaxReach
+    std::vector<std::int8_t> reach;
+    std::vector<std::int64_t> ghosts_by_reach;
+    std::vector<std::int64_t> ghosts_with_reach;  // per j, 0 .. kMaxReach
     int substeps_per_exchange = 0;
 
     // A geographic mesh (MeshInput::geographic): the plane its x and y lie in

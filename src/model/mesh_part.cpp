@@ -10,9 +10,8 @@ namespace dpsm {
 
 namespace {
 
-// How many sub-steps after an exchange each cell, gradient and face of a
-// part stays its owner's when stepped here (Mesh::reach), and the lists by
-// reach. Valid after 0 sub-steps: every cell. A sub-step's passes
+// How many sub-steps after an exchange each cell of a part stays its
+// owner's when stepped here (Mesh::reach), and the ghosts by reach. Valid after 0 sub-steps: every cell. A sub-step's passes
 // (mesh/mesh_engine.cpp) read outward: in sub-step j a gradient is exact
 // when its cell has its own stencil and every cell of it was exact after j -
 // 1; a face's slope and fluxes of its own when its cells and their
@@ -31,7 +30,7 @@ void set_reach(Mesh &m, const std::vector<std::uint8_t> &has_stencil, const std:
     for (std::int64_t c = m.owned; c < m.cells; ++c)
         faces_here[static_cast<std::size_t>(c)] =
             static_cast<double>(m.cell_face_start[c + 1] - m.cell_face_start[c]) == ghost_faces[c - m.owned];
-    m.reach.assign(n, 0), m.gradient_reach.assign(n, 0), m.face_reach.assign(nf, 0);
+    m.reach.assign(n, 0);
     m.substeps_per_exchange = 0;
     // Whether every face of c is here and `exact` for it.
     const auto all_faces = [&](std::size_t c, const std::vector<std::uint8_t> &exact) {
@@ -51,12 +50,8 @@ void set_reach(Mesh &m, const std::vector<std::uint8_t> &has_stencil, const std:
             for (std::int64_t k = m.grad_start[c]; exact && k < m.grad_start[c + 1]; ++k)
                 exact = valid[static_cast<std::size_t>(m.grad_cells[k])] != 0;
             gradient[c] = exact;
-            if (exact) m.gradient_reach[c] = static_cast<std::int8_t>(j);
         }
-        for (std::size_t f = 0; f < nf; ++f) {
-            slope[f] = both_cells(f, valid) && both_cells(f, gradient);
-            if (slope[f]) m.face_reach[f] = static_cast<std::int8_t>(j);
-        }
+        for (std::size_t f = 0; f < nf; ++f) slope[f] = both_cells(f, valid) && both_cells(f, gradient);
         for (std::size_t c = 0; c < n; ++c) pull[c] = has_stencil[c] && all_faces(c, slope);
         for (std::size_t f = 0; f < nf; ++f) high[f] = slope[f] && both_cells(f, pull);
         for (std::size_t c = 0; c < n; ++c) limiter[c] = valid[c] && all_faces(c, high);
@@ -71,21 +66,17 @@ void set_reach(Mesh &m, const std::vector<std::uint8_t> &has_stencil, const std:
         if (!owned_exact) break;
         m.substeps_per_exchange = j;
     }
-    const auto by_reach = [](const std::vector<std::int8_t> &reach, std::int64_t from, std::int64_t to,
-                             std::vector<std::int64_t> &list, std::vector<std::int64_t> &with) {
-        list.clear();
-        for (std::int64_t c = from; c < to; ++c)
-            if (reach[static_cast<std::size_t>(c)] > 0) list.push_back(c);
-        std::stable_sort(list.begin(), list.end(), [&](std::int64_t l, std::int64_t r) {
-            return reach[static_cast<std::size_t>(l)] > reach[static_cast<std::size_t>(r)];
-        });
-        with.assign(Mesh::kMaxReach + 1, 0);
-        for (const std::int64_t c : list)
-            for (int j = 0; j <= reach[static_cast<std::size_t>(c)]; ++j) ++with[static_cast<std::size_t>(j)];
-    };
-    by_reach(m.reach, m.owned, m.cells, m.ghosts_by_reach, m.ghosts_with_reach);
-    by_reach(m.gradient_reach, m.owned, m.cells, m.ghosts_by_gradient_reach, m.ghosts_with_gradient_reach);
-    by_reach(m.face_reach, m.live_faces, m.faces, m.faces_by_reach, m.faces_with_reach);
+    // The ghosts in reach, highest reach first, and per j how many reach j.
+    std::vector<std::int64_t> &list = m.ghosts_by_reach;
+    list.clear();
+    for (std::int64_t c = m.owned; c < m.cells; ++c)
+        if (m.reach[static_cast<std::size_t>(c)] > 0) list.push_back(c);
+    std::stable_sort(list.begin(), list.end(), [&](std::int64_t l, std::int64_t r) {
+        return m.reach[static_cast<std::size_t>(l)] > m.reach[static_cast<std::size_t>(r)];
+    });
+    m.ghosts_with_reach.assign(Mesh::kMaxReach + 1, 0);
+    for (const std::int64_t c : list)
+        for (int j = 0; j <= m.reach[static_cast<std::size_t>(c)]; ++j) ++m.ghosts_with_reach[static_cast<std::size_t>(j)];
 }
 
 }  // namespace
