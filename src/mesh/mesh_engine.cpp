@@ -553,7 +553,7 @@ private:
             // limiters 1). A part computes its owned cells and the faces that
             // touch them; its ghosts' gradients, pulls and limiters come from
             // their owners.
-            std::uint32_t stamp = next_stamp(s);
+            const std::uint32_t stamp = next_stamp(s);
             s.faces.clear();
             s.gradient_cells.clear();
             const auto look_at_faces_of = [&](std::int64_t c) {
@@ -601,18 +601,22 @@ private:
             for (const std::int64_t f : steep_faces)
                 if (steep[f]) steep_faces[kept++] = f;
             steep_faces.resize(kept);
-            const std::uint32_t looked = stamp;
+            // The steep faces not looked at again: as they were, with this sub-step's terms.
             for (const std::int64_t f : steep_faces)
-                if (s.face_seen[f] != looked) face_terms(f);
+                if (s.face_seen[f] != stamp) face_terms(f);
+            // The owned cells of `faces`, each once, into `cells`.
+            const auto owned_cells_of = [&](const std::vector<std::int64_t> &faces, std::vector<std::int64_t> &cells) {
+                const std::uint32_t listed = next_stamp(s);
+                cells.clear();
+                for (const std::int64_t f : faces)
+                    for (const std::int64_t e : {m.face_a[f], m.face_b[f]})
+                        if (e >= 0 && e < m.owned && s.cell_seen[e] != listed) {
+                            s.cell_seen[e] = listed;
+                            cells.push_back(e);
+                        }
+            };
             // Pulls: the owned cells of steep faces.
-            stamp = next_stamp(s);
-            s.pull_cells.clear();
-            for (const std::int64_t f : steep_faces)
-                for (const std::int64_t e : {m.face_a[f], m.face_b[f]})
-                    if (e >= 0 && e < m.owned && s.cell_seen[e] != stamp) {
-                        s.cell_seen[e] = stamp;
-                        s.pull_cells.push_back(e);
-                    }
+            owned_cells_of(steep_faces, s.pull_cells);
             for (const std::int64_t c : s.pull_cells) pull_of(m, pull, c, pull_x, pull_y);
             if (exchanges) {
                 // The ghosts that pull: those whose pull changed, and those that pulled before and still do.
@@ -645,14 +649,7 @@ private:
             for (const std::int64_t c : s.pull_cells) carry_faces_of(c);
             for (const std::int64_t c : s.pulling_ghosts) carry_faces_of(c);
             // Limiters: the owned cells of those faces.
-            stamp = next_stamp(s);
-            s.limit_cells.clear();
-            for (const std::int64_t f : s.faces)
-                for (const std::int64_t e : {m.face_a[f], m.face_b[f]})
-                    if (e >= 0 && e < m.owned && s.cell_seen[e] != stamp) {
-                        s.cell_seen[e] = stamp;
-                        s.limit_cells.push_back(e);
-                    }
+            owned_cells_of(s.faces, s.limit_cells);
             for (const std::int64_t c : s.limit_cells) limits_of(m, law, low, high, bed, c, limit_in, limit_out);
             if (exchanges) exchange_ghost_limits(s);
             // The cells to update: those of faces that carried sand, and the sources.
