@@ -34,6 +34,8 @@ static const double kPi = 3.14159265358979323846;
 
 typedef struct {
     double l1, runout_error, rest_time, top;
+    /* The cone: its top cell's distance from the axis and the exact resting cone's height there. */
+    double top_radius, exact_at_top;
     int at_rest;
     double seconds, cell_updates;
     int64_t cells;
@@ -202,7 +204,17 @@ static mesh_result cone_on(scene_kind kind, int n, int threads) {
     step_to_rest(g, 10.0, 1e5, &r);
     CHECK(g, dpsm_get_heights(g, h));
     r.seconds = now_seconds() - t0;
-    for (int64_t c = 0; c < s.cells; ++c) r.top = fmax(r.top, h[c]);
+    int64_t highest = 0;
+    for (int64_t c = 0; c < s.cells; ++c)
+        if (h[c] > h[highest]) highest = c;
+    r.top = h[highest];
+    /* Heights are cell values at the centres: the deposit's highest cell can
+     * be no higher than the exact cone at its centre, which lies off the
+     * apex by as much as the mesh puts it. */
+    const double alpha = tan(theta), volume = kPi / 3.0 * 40.0 * (40.0 / 1.5) * (40.0 / 1.5);
+    const double apex = alpha * cbrt(3.0 * volume / (kPi * alpha));
+    r.top_radius = hypot(s.cx[highest], s.cy[highest]);
+    r.exact_at_top = apex - alpha * r.top_radius;
     dpsm_destroy(g);
     free(h);
     scene_free(&s);
@@ -247,8 +259,10 @@ int cmd_mesh_accuracy(int argc, char **argv) {
     }
     if (only && strcmp(only, "cone") != 0) return 0;
     const mesh_result cone = cone_on(SCENE_TRIANGLES, 72, threads);
-    printf("cone,%s,%lld,%.5f,top %.4f against 22.89 (%+.3f %%),,,%d,%.3f,%.4g,%.3f,,,,,\n",
+    printf("cone,%s,%lld,%.5f,top %.4f against 22.89 (%+.3f %%); its cell %.3f off the axis where the exact cone is "
+           "%.4f (%+.3f %%),,,%d,%.3f,%.4g,%.3f,,,,,\n",
            scene_name(SCENE_TRIANGLES), (long long)cone.cells, cone.size, cone.top, 100.0 * (cone.top / 22.89 - 1.0),
+           cone.top_radius, cone.exact_at_top, 100.0 * (cone.top / cone.exact_at_top - 1.0),
            cone.at_rest, cone.rest_time, cone.cell_updates, cone.seconds);
     return 0;
 }
