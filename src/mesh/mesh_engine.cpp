@@ -37,8 +37,25 @@ inline double dense_share(int threads, std::int64_t cells) {
 // The share of the room to its bounds a cell's limiter lets the gradient
 // flow's excess fill.
 constexpr double kLimiterRoom = 1.0 - 1e-9;
+// MeshState::source_reach and MeshState::watch (lazy sources).
+constexpr std::uint8_t kSourceReach = 1, kSourceNear = 2;
+constexpr std::uint8_t kWatched = 1, kNearMoves = 2;
 // What counts as the round-off of a sum, relative to its terms' magnitudes.
 constexpr double kRoundOff = 64.0 * std::numeric_limits<double>::epsilon();
+
+// The heights a sub-step reads. With lazy sources a sand cell's stored
+// height is current after sub-step since[c] of the step, and what its source
+// added since is read, the same bits wherever it is read ("Sources in closed
+// form" below).
+struct Heights {
+    const double *h;
+    const double *q = nullptr;  // lazy sources: the sand cells' sources (0 elsewhere); null: none lags
+    const double *since = nullptr;
+    double dt = 0.0;   // the sub-step
+    double now = 0.0;  // the sub-step read, counted from the step's start
+
+    double operator[](std::int64_t c) const { return q ? h[c] + source_lag(q[c], dt, now - since[c]) : h[c]; }
+};
 
 // What a face's own slope gives it in a sub-step (FaceLaw::terms).
 struct FaceTerms {
@@ -52,7 +69,7 @@ struct FaceTerms {
 // One sub-step's view of the grid: what every pass reads.
 struct FaceLaw {
     const Mesh &m;
-    const double *h;
+    Heights h;
     const std::uint8_t *kind;
     const double *gx, *gy;
     const std::uint8_t *edge_open;  // per face; null: every edge as open_edges says
@@ -85,32 +102,55 @@ struct FaceLaw {
     // pairs carry (the pass over cells). The monotone flux, limited towards
     // the gradient flow's, is the two-point law C (h_a - h_b) with C held
     // in [0, |L n| / d].
+    // Face f's slope, where it carries sand.
+    struct Slope {
+        double ha, hb, normal, tangential, s, tan_face, threshold;
+    };
+    Slope slope(std::int64_t f) const {
+        const std::int64_t a = m.face_a[f], b = m.face_b[f];
+        const std::uint8_t ka = kind[a];
+        Slope out;
+        out.ha = h[a];
+        out.tangential = 0.0;
+        std::uint8_t kb;
+        if (b >= 0) {
+            kb = kind[b];
+            out.hb = h[b];
+            if (isotropic)
+                out.tangential = 0.5 * ((gx[a] + gx[b]) * m.tangent_x[f] + (gy[a] + gy[b]) * m.tangent_y[f]);
+        } else {
+            kb = kOutside;
+            out.hb = edge_level ? edge_level[f] : 0.0;
+            if (isotropic) out.tangential = gx[a] * m.tangent_x[f] + gy[a] * m.tangent_y[f];
+        }
+        out.normal = (out.ha - out.hb) / m.distance[f];
+        out.tan_face =
+            tan_field ? law::face_tan(tan_field[a], b >= 0 ? tan_field[b] : tan_field[a], ka == kSand, kb == kSand)
+                      : tan_theta;
+        out.threshold = out.tan_face * (1.0 + tolerance);
+        if (moving) out.threshold = law::threshold(out.threshold, !moving[a] && !(b >= 0 && moving[b]), tan_static);
+        out.s = std::sqrt(out.normal * out.normal + out.tangential * out.tangential);
+        return out;
+    }
+
+    // Whether face f may be steep, where the rounding of its heights and
+    // gradients could decide it: its slope within a band of rounding below
+    // its threshold counts.
+    bool may_be_steep(std::int64_t f) const {
+        if (!carries(f)) return false;
+        const Slope sl = slope(f);
+        const double band = 1e-9 * sl.threshold + kRoundOff * (std::fabs(sl.ha) + std::fabs(sl.hb)) / m.distance[f];
+        return sl.s > sl.threshold - band;
+    }
+
     FaceTerms terms(std::int64_t f) const {
         FaceTerms out;
         if (!carries(f)) return out;
         const std::int64_t a = m.face_a[f], b = m.face_b[f];
-        const std::uint8_t ka = kind[a];
-        double hb, tangential = 0.0;
-        std::uint8_t kb;
-        if (b >= 0) {
-            kb = kind[b];
-            hb = h[b];
-            if (isotropic)
-                tangential = 0.5 * ((gx[a] + gx[b]) * m.tangent_x[f] + (gy[a] + gy[b]) * m.tangent_y[f]);
-        } else {
-            kb = kOutside;
-            hb = edge_level ? edge_level[f] : 0.0;
-            if (isotropic) tangential = gx[a] * m.tangent_x[f] + gy[a] * m.tangent_y[f];
-        }
-        const double distance = m.distance[f];
-        const double normal = (h[a] - hb) / distance;
-        const double tan_face =
-            tan_field ? law::face_tan(tan_field[a], b >= 0 ? tan_field[b] : tan_field[a], ka == kSand, kb == kSand)
-                      : tan_theta;
-        double threshold = tan_face * (1.0 + tolerance);
-        if (moving) threshold = law::threshold(threshold, !moving[a] && !(b >= 0 && moving[b]), tan_static);
-        const double s = std::sqrt(normal * normal + tangential * tangential);
-        if (!(s > threshold)) return out;
+        const Slope sl = slope(f);
+        const double distance = m.distance[f], normal = sl.normal, tangential = sl.tangential, s = sl.s,
+                     tan_face = sl.tan_face;
+        if (!(s > sl.threshold)) return out;
         out.steep = true;
         out.excess = s - tan_face;
         const double g = slide_flux(nu, tan_face, s, p) / s;
@@ -152,7 +192,7 @@ struct FaceLaw {
     }
 };
 
-void gradient_of(const Mesh &m, const double *h, const std::uint8_t *kind, std::int64_t c, double *gx, double *gy) {
+void gradient_of(const Mesh &m, const Heights &h, const std::uint8_t *kind, std::int64_t c, double *gx, double *gy) {
     double x = 0.0, y = 0.0;
     const double hc = h[c];
     for (std::int64_t k = m.grad_start[c]; k < m.grad_start[c + 1]; ++k) {
@@ -301,6 +341,8 @@ public:
         }
         s.face_seen.resize(nf, 0), s.cell_seen.resize(n, 0);
         s.carried.resize(n, 0);
+        s.watch.resize(n, 0);
+        s.lazy = false;
         if (s.exchange) s.in_batch.resize(n, 0);
         if (!grid.bed().empty()) s.available.resize(n, 0.0);
         if (s.lists_current) return;
@@ -321,16 +363,42 @@ public:
         const std::vector<double> &q = grid.source();
         for (std::int64_t c = 0; c < static_cast<std::int64_t>(q.size()); ++c)
             if (kind[c] == kSand && q[c] != 0.0) (c < m.owned ? s.source_cells : s.ghost_source_cells).push_back(c);
+        list_source_faces(m, s);
     }
 
-    bool may_move(const Grid &grid) const override { return mesh_state(grid).activity.may_move(); }
+    // After a step that added sources in closed form, the next one must look
+    // at the faces those cells' new heights steepened: with lazy sources its
+    // look under the sources does, else every cell is hot (advance).
+    // Not with a bed (erosion stops at it, so a source's part depends on the
+    // sand there) nor with a static angle (a cell's threshold depends on
+    // whether it moved).
+    bool takes_lazy_sources(const Grid &grid) const override { return grid.bed().empty() && !grid.hysteresis(); }
 
-    // Every source cell takes its source at every sub-step and counts as driven.
-    bool drive_sources(Grid &, double, double, bool, double &reach) const override {
+    bool may_move(const Grid &grid) const override {
+        const MeshState &s = mesh_state(grid);
+        return s.activity.may_move() || s.caught_up;
+    }
+
+    // Without lazy sources every source cell takes its source at every
+    // sub-step and counts as driven. With them, the faces a source may make
+    // steep within the step keep their cells hot ("Sources in closed form").
+    bool drive_sources(Grid &grid, double dt, double sub_dt, bool lazy, double &reach) const override {
         reach = std::numeric_limits<double>::infinity();
-        return true;
+        if (!lazy) return true;
+        MeshState &s = mesh_state(grid);
+        s.lazy = true;
+        s.caught_up = false;
+        s.lazy_substeps = std::round(dt / sub_dt);
+        s.moved_since_look = s.source_may_steepen = false;
+        const Mesh &m = *grid.geometry().mesh;
+        look_under_sources(grid, m, s, sub_dt, 0.0, true);
+        return look_under_sources(grid, m, s, sub_dt, s.lazy_substeps, true);
     }
-    void forget_driven(Grid &) const override {}
+    void forget_driven(Grid &grid) const override {
+        MeshState &s = mesh_state(grid);
+        forget_watches(s);
+        s.lazy = false;
+    }
 
     void advance(Grid &grid, const SubstepPlan &plan, const BookSubstep &book, StepInfo &info) const override {
         const Mesh &m = *grid.geometry().mesh;
@@ -339,9 +407,14 @@ public:
         if (record) std::fill(grid.face_fluxes().x.begin(), grid.face_fluxes().x.end(), 0.0);
         if (!plan.something_may_move) {
             info.at_rest = true;
+            if (s.lazy) catch_up_sources(grid, s, plan.sub_dt);
             return;
         }
         s.switches = read_switches();
+        if (s.caught_up) s.activity.wake_all();
+        s.caught_up = false;
+        if (s.lazy)
+            for (const std::int64_t c : s.watched_cells) s.activity.wake(c);
         const Distribution *parts = grid.distribution();
         // A part whose ghost layer is deep enough steps its ghosts in reach
         // too and exchanges once per batch of sub-steps (mesh/mesh_parts.hpp);
@@ -350,7 +423,7 @@ public:
         for (std::int64_t k = 0; k < plan.substeps; ++k) {
             double visited = 0.0;
             const int in_batch = per_exchange > 0 ? static_cast<int>(k % per_exchange) + 1 : 0;
-            SubstepSummary did = substep(grid, m, s, plan.sub_dt, record, visited, in_batch);
+            SubstepSummary did = substep(grid, m, s, plan.sub_dt, static_cast<double>(k), record, visited, in_batch);
             info.cell_updates += visited;
             if (parts) {
                 // Every rank takes the same sub-steps and stops at the same one.
@@ -358,10 +431,12 @@ public:
                 parts->agree_on_substeps(agreed);
                 did = agreed[0];
             }
+            if (s.lazy) did.source_may_steepen = source_may_steepen(grid, m, s, plan.sub_dt, did.moved, k + 1);
             const bool go_on = book(did);
             if (in_batch > 0 && (!go_on || in_batch == per_exchange || k + 1 == plan.substeps)) end_batch(grid, m, s);
             if (!go_on) break;
         }
+        if (s.lazy) catch_up_sources(grid, s, plan.sub_dt);
     }
 
     // Meshes relax by time-accurate sub-steps to rest: the stepper takes over.
@@ -386,11 +461,25 @@ private:
         std::vector<double> &h;
         std::vector<float> &residual;
         double dt;
+        // Lazy sources: the heights as read (null: sources at every sub-step),
+        // and where a cell's clock is kept.
+        const Heights *lazy;
+        double *since;
 
         bool operator()(std::int64_t c) const {
             bool carried = false;
             double rate = net_rate(m, flux, c, carried);
             if (kind[c] != kSand) return carried;
+            if (lazy) {
+                // The stored height changes only where a face carries sand,
+                // and then takes what the source added since it was current.
+                if (!carried) return false;
+                const double q_c = lazy->q[c];
+                const double increment = dt * (rate + q_c) + source_lag(q_c, dt, lazy->now - since[c]);
+                if (increment != 0.0) add_with_residual(h[c], residual[c], increment);
+                if (q_c != 0.0) since[c] = lazy->now + 1.0;
+                return true;
+            }
             if (!q.empty()) rate += zb.empty() ? q[c] : source_applied(zb, h, q, c, dt);
             if (rate != 0.0) add_with_residual(h[c], residual[c], dt * rate);
             if (!zb.empty() && h[c] < zb[c]) {
@@ -409,8 +498,9 @@ private:
     // (limiters); faces (limited flux); cells (update). Each is a gather in
     // an order that does not depend on the threads, the library's order or
     // the partition.
-    SubstepSummary substep(Grid &grid, const Mesh &m, MeshState &s, double dt, bool record, double &visited,
-                           int in_batch) const {
+    // `now`: the sub-step's place in the step, from 0.
+    SubstepSummary substep(Grid &grid, const Mesh &m, MeshState &s, double dt, double now, bool record,
+                           double &visited, int in_batch) const {
         MeshActivity &act = s.activity;
         const bool physics = grid.hysteresis() || !grid.bed().empty();
         // A part of a distributed mesh steps its owned cells and the faces
@@ -429,24 +519,7 @@ private:
         const std::vector<double> &q = grid.source();
         SubstepSummary did;
 
-        FaceLaw law{m,
-                    h.data(),
-                    kind.data(),
-                    s.gx.data(),
-                    s.gy.data(),
-                    grid.edge_open_flags().empty() ? nullptr : grid.edge_open_flags().data(),
-                    grid.side_open(0),
-                    grid.side_levels(0).empty() ? nullptr : grid.side_levels(0).data(),
-                    grid.tan_field().empty() ? nullptr : grid.tan_field().data(),
-                    grid.hysteresis() ? grid.moving().data() : nullptr,
-                    nullptr,
-                    grid.mobility(),
-                    grid.tan_repose(),
-                    grid.rest_tolerance(),
-                    grid.tan_static(),
-                    grid.flux_exponent(),
-                    dt,
-                    grid.scheme() == kIsotropic};
+        FaceLaw law = law_of(grid, heights_read(grid, s, dt, now), s.gx.data(), s.gy.data(), dt);
         if (!grid.bed().empty()) {
             prepare_bed(grid, m, s, dt, did);
             law.available = s.available.data();
@@ -454,7 +527,8 @@ private:
         const double *bed = grid.bed().empty() ? nullptr : grid.bed().data();
         double max_excess = 0.0;
         bool moved = false;
-        const CellUpdate update_cell{m, s.flux.data(), kind.data(), q, grid.bed(), h, residual, dt};
+        const CellUpdate update_cell{m,        s.flux.data(), kind.data(), q, grid.bed(), h, residual, dt,
+                                     s.lazy ? &law.h : nullptr, s.since.data()};
         double *low = s.low.data(), *high = s.high.data(), *pull = s.pull.data(), *flux = s.flux.data();
         double *pull_x = s.pull_x.data(), *pull_y = s.pull_y.data();
         double *limit_in = s.limit_in.data(), *limit_out = s.limit_out.data();
@@ -481,8 +555,11 @@ private:
             const std::int64_t extra_count = reach.ghost_count();
             if (law.isotropic) {
 #pragma omp parallel for num_threads(threads) if (parallel) schedule(static)
-                for (std::int64_t c = 0; c < pass_cells; ++c) gradient_of(m, h.data(), kind.data(), c, s.gx.data(), s.gy.data());
-                if (parts && !in_batch) exchange_ghost_gradients(s, changed_ghosts);
+                for (std::int64_t c = 0; c < pass_cells; ++c) gradient_of(m, law.h, kind.data(), c, s.gx.data(), s.gy.data());
+                if (parts && !in_batch) {
+                    exchange_ghost_gradients(s, changed_ghosts);
+                    watch_near_moves(m, s, changed_ghosts);
+                }
             }
 #pragma omp parallel for num_threads(threads) if (parallel) schedule(static)
             for (std::int64_t f = 0; f < pass_faces; ++f) face_terms(f);
@@ -537,10 +614,18 @@ private:
                 note_batch_updates_everywhere(s);
             else if (parts)
                 exchange_ghost_heights(grid, s, nullptr, changed_ghosts);
+            if (s.lazy && changed_cells > 0)
+                for (std::int64_t c = 0; c < n; ++c)
+                    if (changed[c]) watch_near_moves(m, s, c);
+            if (s.lazy)
+                for (std::int64_t k = 0; k < extra_count; ++k)
+                    if (changed[extra_cells[k]]) watch_near_moves(m, s, extra_cells[k]);
+            watch_near_moves(m, s, changed_ghosts);
             // The next sub-step looks at the cells that changed and those whose
-            // gradients read them; where that is most of the mesh, at all.
+            // gradients read them, and the cells a source keeps hot; where that
+            // is most of the mesh, at all.
             const std::size_t most = static_cast<std::size_t>(share * static_cast<double>(n));
-            if (static_cast<std::size_t>(changed_cells) + s.source_cells.size() > most) {
+            if (static_cast<std::size_t>(changed_cells) + kept_hot_by_sources(s) > most) {
                 act.wake_all();
             } else {
                 act.cool_all();
@@ -549,12 +634,10 @@ private:
                         act.wake_around(m, c);
                         if (act.hot_list.size() > most) act.wake_all();
                     }
-                for (const std::int64_t c : s.source_cells) act.wake_around(m, c);
+                wake_what_sources_keep_hot(m, s, in_batch != 0);
                 for (const std::int64_t c : changed_ghosts) act.wake_around(m, c);
                 for (std::int64_t k = 0; k < extra_count && !act.all_hot; ++k)
                     if (changed[extra_cells[k]]) act.wake_around(m, extra_cells[k]);
-                if (in_batch)
-                    for (const std::int64_t c : s.ghost_source_cells) act.wake_around(m, c);
             }
         } else {
             // A few moving cells. The faces whose slopes may have changed
@@ -594,11 +677,12 @@ private:
                 s.flux_clean = true;
             }
             if (law.isotropic) {
-                for (const std::int64_t c : s.gradient_cells) gradient_of(m, h.data(), kind.data(), c, s.gx.data(), s.gy.data());
+                for (const std::int64_t c : s.gradient_cells) gradient_of(m, law.h, kind.data(), c, s.gx.data(), s.gy.data());
                 if (exchanges) {
                     // A ghost whose gradient changed makes its faces steep or flat
                     // whether or not anything near them here changed.
                     exchange_ghost_gradients(s, changed_ghosts);
+                    watch_near_moves(m, s, changed_ghosts);
                     for (const std::int64_t c : changed_ghosts) look_at_faces_of(c);
                     changed_ghosts.clear();
                 }
@@ -682,7 +766,9 @@ private:
                 for (const std::int64_t e : {m.face_a[f], m.face_b[f]})
                     if (e >= 0) to_update(e);
             }
-            for (const std::int64_t c : s.source_cells) to_update(c);
+            // Sources at every sub-step (not lazy): every source cell changes.
+            if (!s.lazy)
+                for (const std::int64_t c : s.source_cells) to_update(c);
             for (const std::int64_t c : s.update_cells) update_cell(c);
             // Every cell a pass read or wrote, once.
             const std::uint32_t counted = next_stamp(s);
@@ -692,9 +778,12 @@ private:
                     if (s.cell_seen[c] != counted) s.cell_seen[c] = counted, cells_visited += 1.0;
             visited = cells_visited;
             if (exchanges) exchange_ghost_heights(grid, s, &s.update_cells, changed_ghosts);
+            watch_near_moves(m, s, s.update_cells);
+            watch_near_moves(m, s, changed_ghosts);
             act.cool_all();
             for (const std::int64_t c : s.update_cells) act.wake_around(m, c);
             for (const std::int64_t c : changed_ghosts) act.wake_around(m, c);
+            wake_what_sources_keep_hot(m, s, false);
             for (const std::int64_t c : s.pull_cells) pull_x[c] = pull_y[c] = 0.0;
             for (const std::int64_t c : s.limit_cells) limit_in[c] = limit_out[c] = 1.0;
         }
@@ -720,6 +809,231 @@ private:
         did.moved = moved;
         did.max_excess_slope = max_excess;
         return did;
+    }
+
+
+    // Sources in closed form (lazy sources). A source that cannot make a
+    // face steep needs no sub-steps: the stored height of a sand cell
+    // changes only in a sub-step in which one of its faces carries sand (it
+    // then takes what its source added since it was current, and its clock,
+    // since, moves on), every pass reads a cell's stored height plus what its
+    // source added since (Heights), and at the end of the step every source
+    // cell takes the rest in closed form (catch_up_sources). A cell's stored
+    // height thus depends on when sand crossed its faces, not on which cells
+    // a sub-step visited: results stay independent of the active set, the
+    // threads and the partition.
+    //
+    // Which faces must still be looked at. Under the sources alone a face's
+    // slope vector (its two-point slope and its cells' gradients along t) is
+    // affine in time, so its length is convex: where a face is not steep at
+    // the start of the step nor at its end, it is not in between. So the
+    // step starts by looking at every face whose slope a source moves, now
+    // and at the end (look_under_sources), and keeps the cells of those steep
+    // at either end hot. Where sand moves, the faces that read the cells it
+    // changed no longer follow the sources alone: for the rest of the step
+    // the cells near those faces whose slopes a source moves are kept hot too
+    // (watch_near_moves). And a sub-step that moved nothing ends the step at
+    // rest only when no such face is steep then nor at the end.
+
+    // The heights sub-step `now` reads.
+    static Heights heights_read(Grid &grid, MeshState &s, double dt, double now) {
+        Heights hv{grid.heights_for_stepping().data()};
+        if (s.lazy) hv.q = s.sand_source.data(), hv.since = s.since.data(), hv.dt = dt, hv.now = now;
+        return hv;
+    }
+
+    // What the sources make of the mesh (after the host changed them): the
+    // sand cells' sources, which cells' slopes they move, the faces whose
+    // slopes they move and those faces' cells.
+    static void list_source_faces(const Mesh &m, MeshState &s) {
+        const std::size_t n = static_cast<std::size_t>(m.cells);
+        s.sand_source.assign(n, 0.0);
+        s.source_reach.assign(n, 0);
+        s.source_faces.clear();
+        s.source_face_cells.clear();
+        if (s.source_cells.empty() && s.ghost_source_cells.empty()) return;
+        // Set by hand below: the cells whose stored heights the source lists name.
+        for (const std::vector<std::int64_t> *list : {&s.source_cells, &s.ghost_source_cells})
+            for (const std::int64_t c : *list) s.sand_source[c] = 1.0;
+        // A cell's height moves under a source, or its gradient reads one.
+        for (std::int64_t c = 0; c < m.cells; ++c) {
+            bool reach = s.sand_source[c] != 0.0;
+            for (std::int64_t k = m.grad_start[c]; k < m.grad_start[c + 1] && !reach; ++k)
+                reach = s.sand_source[m.grad_cells[k]] != 0.0;
+            if (reach) s.source_reach[c] |= kSourceReach;
+        }
+        // A face's slope moves where it reads such a cell; the cells of its faces are near a source.
+        const std::uint32_t listed = next_stamp(s);
+        for (std::int64_t f = 0; f < m.live_faces; ++f) {
+            const std::int64_t a = m.face_a[f], b = m.face_b[f];
+            if (!((s.source_reach[a] & kSourceReach) || (b >= 0 && (s.source_reach[b] & kSourceReach)))) continue;
+            s.source_faces.push_back(f);
+            for (const std::int64_t e : {a, b}) {
+                if (e < 0) continue;
+                s.source_reach[e] |= kSourceNear;
+                if (s.cell_seen[e] != listed) s.cell_seen[e] = listed, s.source_face_cells.push_back(e);
+            }
+        }
+        std::sort(s.source_face_cells.begin(), s.source_face_cells.end());
+        s.sand_source.assign(n, 0.0);
+    }
+
+    // The grid's sources on the sand cells, as lazy sources read them (the
+    // lists hold which cells; the values may change without the lists).
+    static void read_sand_sources(const Grid &grid, MeshState &s) {
+        const std::vector<double> &q = grid.source();
+        for (const std::vector<std::int64_t> *list : {&s.source_cells, &s.ghost_source_cells})
+            for (const std::int64_t c : *list) s.sand_source[c] = q[c];
+    }
+
+    // Whether a face whose slope the sources move is steep (or within a
+    // band of rounding below its threshold) at sub-step `at` of the step,
+    // the sources alone acting from the heights now; with `watch`, the cells
+    // of those faces are kept hot for the rest of the step. Collective on a
+    // part with one layer of ghosts (their gradients at `at` come from their
+    // owners; a part that steps its ghosts holds their stencils); the answer
+    // is this part's.
+    bool look_under_sources(Grid &grid, const Mesh &m, MeshState &s, double dt, double at, bool watch) const {
+        read_sand_sources(grid, s);
+        const std::size_t n = static_cast<std::size_t>(m.cells);
+        s.look_gx.resize(n, 0.0), s.look_gy.resize(n, 0.0);
+        const std::vector<std::uint8_t> &kind = grid.kinds();
+        FaceLaw law = law_of(grid, heights_read(grid, s, dt, at), s.look_gx.data(), s.look_gy.data(), dt);
+        if (law.isotropic) {
+            if (s.exchange && !steps_ghosts(grid)) {
+                // Every owned cell: a ghost's owner reads the gradient of the cell across their face.
+                for (std::int64_t c = 0; c < m.owned; ++c) gradient_of(m, law.h, kind.data(), c, s.look_gx.data(), s.look_gy.data());
+                s.exchange->send_all(GhostExchange::kFaceGhosts, {GhostField{s.look_gx.data()}, GhostField{s.look_gy.data()}},
+                                     false);
+            } else {
+                for (const std::int64_t c : s.source_face_cells)
+                    gradient_of(m, law.h, kind.data(), c, s.look_gx.data(), s.look_gy.data());
+            }
+        }
+        bool steep = false;
+        for (const std::int64_t f : s.source_faces) {
+            if (!law.may_be_steep(f)) continue;
+            steep = true;
+            if (!watch) break;
+            for (const std::int64_t e : {m.face_a[f], m.face_b[f]})
+                if (e >= 0) watch_cell(s, e);
+        }
+        return steep;
+    }
+
+    static void watch_cell(MeshState &s, std::int64_t c) {
+        if (s.watch[c] & kWatched) return;
+        s.watch[c] |= kWatched;
+        s.watched_cells.push_back(c);
+    }
+
+    // Sand moved in cell c: the faces that read it no longer follow the
+    // sources alone, so the cells near a source among those whose faces read
+    // it are kept hot for the rest of the step (each cell looked at once).
+    static void watch_near_moves(const Mesh &m, MeshState &s, std::int64_t c) {
+        if (s.watch[c] & kNearMoves) return;
+        s.watch[c] |= kNearMoves;
+        s.moved_cells.push_back(c);
+        if (s.source_reach[c] & kSourceNear) watch_cell(s, c);
+        for (std::int64_t k = m.grad_start[c]; k < m.grad_start[c + 1]; ++k) {
+            const std::int64_t e = m.grad_cells[k];
+            if (s.source_reach[e] & kSourceNear) watch_cell(s, e);
+        }
+    }
+    static void watch_near_moves(const Mesh &m, MeshState &s, const std::vector<std::int64_t> &cells) {
+        if (!s.lazy) return;
+        for (const std::int64_t c : cells) watch_near_moves(m, s, c);
+    }
+
+    static void forget_watches(MeshState &s) {
+        for (const std::int64_t c : s.watched_cells) s.watch[c] = static_cast<std::uint8_t>(s.watch[c] & ~kWatched);
+        for (const std::int64_t c : s.moved_cells) s.watch[c] = static_cast<std::uint8_t>(s.watch[c] & ~kNearMoves);
+        s.watched_cells.clear();
+        s.moved_cells.clear();
+    }
+
+    // How many cells the sources keep hot in the next sub-step, and waking them.
+    static std::size_t kept_hot_by_sources(const MeshState &s) {
+        return s.lazy ? s.watched_cells.size() : s.source_cells.size();
+    }
+    static void wake_what_sources_keep_hot(const Mesh &m, MeshState &s, bool ghosts_too) {
+        MeshActivity &act = s.activity;
+        if (s.lazy) {
+            for (const std::int64_t c : s.watched_cells) act.wake(c);
+            return;
+        }
+        for (const std::int64_t c : s.source_cells) act.wake_around(m, c);
+        if (ghosts_too)
+            for (const std::int64_t c : s.ghost_source_cells) act.wake_around(m, c);
+    }
+
+    // After sub-step `done` (counted from 1) of a step with lazy sources:
+    // whether a source may still make a face steep before the step ends. Only
+    // a sub-step that moved nothing asks, and only where sand has moved
+    // since the last answer (else the sources alone acted since, and it
+    // stands; before any move, drive_sources gave it). Collective on a part.
+    bool source_may_steepen(Grid &grid, const Mesh &m, MeshState &s, double dt, bool moved, std::int64_t done) const {
+        if (moved) s.moved_since_look = true;
+        if (moved || !s.moved_since_look) return s.source_may_steepen;
+        s.moved_since_look = false;
+        const double now = static_cast<double>(done);
+        bool steep = look_under_sources(grid, m, s, dt, now, false) || look_under_sources(grid, m, s, dt, s.lazy_substeps, false);
+        if (grid.distribution()) steep = grid.global_sum(steep ? 1.0 : 0.0) > 0.0;
+        s.source_may_steepen = steep;
+        return steep;
+    }
+
+    // The end of a step with lazy sources: every owned source cell takes
+    // what its source added since it was current, a TwoSum with its
+    // residual as the sub-steps' updates; the clocks start again from 0. A
+    // part that steps its ghosts holds their owners' heights, residuals and
+    // clocks after the step's last exchange, and does the same to them;
+    // another takes them from their owners (collective).
+    void catch_up_sources(Grid &grid, MeshState &s, double dt) const {
+        std::vector<double> &h = grid.heights_for_stepping();
+        std::vector<float> &residual = grid.residuals_for_stepping();
+        read_sand_sources(grid, s);
+        const bool ghosts_here = s.exchange && steps_ghosts(grid);
+        for (const std::vector<std::int64_t> *list : {&s.source_cells, &s.ghost_source_cells}) {
+            if (list == &s.ghost_source_cells && !ghosts_here) break;
+            for (const std::int64_t c : *list) {
+                const double lag = source_lag(s.sand_source[c], dt, s.lazy_substeps - s.since[c]);
+                if (lag != 0.0) add_with_residual(h[c], residual[c], lag);
+                s.since[c] = 0.0;
+            }
+        }
+        if (s.exchange && !ghosts_here) {
+            std::vector<std::int64_t> &changed_ghosts = s.changed_ghosts;
+            changed_ghosts.clear();
+            exchange_ghost_heights(grid, s, &s.source_cells, changed_ghosts);
+            changed_ghosts.clear();
+        }
+        forget_watches(s);
+        s.lazy = false;
+        s.caught_up = true;
+    }
+
+    // One sub-step's law over the grid, reading heights `hv` and gradients gx, gy.
+    static FaceLaw law_of(Grid &grid, const Heights &hv, const double *gx, const double *gy, double dt) {
+        const Mesh &m = *grid.geometry().mesh;
+        return FaceLaw{m,
+                       hv,
+                       grid.kinds().data(),
+                       gx,
+                       gy,
+                       grid.edge_open_flags().empty() ? nullptr : grid.edge_open_flags().data(),
+                       grid.side_open(0),
+                       grid.side_levels(0).empty() ? nullptr : grid.side_levels(0).data(),
+                       grid.tan_field().empty() ? nullptr : grid.tan_field().data(),
+                       grid.hysteresis() ? grid.moving().data() : nullptr,
+                       nullptr,
+                       grid.mobility(),
+                       grid.tan_repose(),
+                       grid.rest_tolerance(),
+                       grid.tan_static(),
+                       grid.flux_exponent(),
+                       dt,
+                       grid.scheme() == kIsotropic};
     }
 
     static std::uint32_t next_stamp(MeshState &s) {

@@ -10,13 +10,15 @@ namespace dpsm {
 
 namespace {
 
-// A ghost's height, moving flag (with hysteresis) and residual (on a part
-// that steps its ghosts: the next update adds to it), in that place.
+// A ghost's height, moving flag (with hysteresis), residual (on a part
+// that steps its ghosts: the next update adds to it) and the sub-step its
+// height is current after (lazy sources: what its source added since is
+// read, not stored), in that place.
 std::vector<GhostField> height_fields(Grid &grid) {
     GhostField moving, residual;
     if (grid.hysteresis()) moving.u8 = grid.moving_for_stepping().data();
     if (steps_ghosts(grid)) residual.f32 = grid.residuals_for_stepping().data();
-    return {GhostField{grid.heights_for_stepping().data()}, moving, residual};
+    return {GhostField{grid.heights_for_stepping().data()}, moving, residual, GhostField{mesh_state(grid).since.data()}};
 }
 
 }  // namespace

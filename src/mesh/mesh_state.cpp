@@ -3,7 +3,10 @@
 namespace dpsm {
 
 MeshState::MeshState(const Grid &grid) {
-    activity.hot.assign(static_cast<std::size_t>(grid.geometry().cells()), 0);
+    const std::size_t cells = static_cast<std::size_t>(grid.geometry().cells());
+    activity.hot.assign(cells, 0);
+    // Every part sends it with the heights, so every part holds it (mesh/mesh_parts.cpp).
+    since.assign(cells, 0.0);
 }
 
 void MeshState::changed(const Grid &grid, unsigned what, const ChangedCells *cells) {

@@ -91,9 +91,36 @@ struct MeshState final : EngineState {
     std::vector<std::uint8_t> in_batch;
     bool batch_all = false;
 
+    // Lazy sources (mesh/mesh_engine.cpp, "Sources in closed form"), in a
+    // step that applies them: per cell, the sub-step of the step after which
+    // its stored height is current (0 at the start of every step; a ghost
+    // takes its owner's with its height); the cells a sub-step keeps hot
+    // because a source may make their faces steep, each flagged in `watch`
+    // (kWatched), and the cells whose moves put them there (kNearMoves).
+    bool lazy = false;
+    double lazy_substeps = 0.0;  // the step's sub-steps, over which the sources act
+    std::vector<double> since;
+    std::vector<std::uint8_t> watch;
+    std::vector<std::int64_t> watched_cells, moved_cells;
+    // A sub-step moved sand since the last look at whether a source may
+    // still make a face steep before the step ends; that look's answer.
+    bool moved_since_look = false, source_may_steepen = false;
+    // The last step added sources in closed form; the next one has not looked at what they steepened.
+    bool caught_up = false;
+    // Per face and cell, scratch of that look: gradients at one time.
+    std::vector<double> look_gx, look_gy;
+
     // What the host's masks, sources and edges make of the mesh, found again
     // after the host changed them (lists_current false).
     std::vector<std::int64_t> source_cells;        // owned sand cells with a source
+    // The sources of sand cells (0 elsewhere), as a lazy source's lag reads them.
+    std::vector<double> sand_source;
+    // Per cell, whether a source moves its height or its gradient's stencil
+    // (kSourceReach), and whether it or a cell across a face does
+    // (kSourceNear: its faces' slopes move under the sources alone).
+    std::vector<std::uint8_t> source_reach;
+    // The faces whose slopes move under the sources alone, and their cells.
+    std::vector<std::int64_t> source_faces, source_face_cells;
     std::vector<std::int64_t> ghost_source_cells;  // a part's ghosts with a source, stepped where they are in reach
     std::vector<std::int64_t> sink_faces;          // faces onto open edges or open cells
     bool lists_current = false;

@@ -67,6 +67,9 @@ public:
     // Whether anything can move with no source acting (an engine without an
     // active set answers true).
     virtual bool may_move(const Grid &grid) const = 0;
+    // Whether this engine applies sources in closed form on this grid where
+    // they cannot make a face steep (a bounded step with a source).
+    virtual bool takes_lazy_sources(const Grid &grid) const = 0;
     // At the start of a step of dt in sub-steps of sub_dt with sources on:
     // marks what the sources may make steep and returns whether a source
     // keeps some face steep at the end of the step (it may then flow for

@@ -44,6 +44,11 @@ inline void add_with_residual(double &h, float &residual, double increment) noex
     h = s;
 }
 
+// What a source q adds to a cell in `substeps` sub-steps of dt, the same
+// bits wherever it is applied: the engines add a lazy source in closed form
+// with it (structured/lazy_sources.hpp, mesh/mesh_engine.cpp).
+inline double source_lag(double q, double dt, double substeps) noexcept { return (q * dt) * substeps; }
+
 struct MassLedger {
     CompensatedSum sourced;   // mass added by sources
     CompensatedSum external;  // mass added by the host's own calls

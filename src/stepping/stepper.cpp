@@ -168,10 +168,10 @@ void step_in_time(Grid &grid, double dt, std::int64_t most) {
     plan.sub_dt = bounded ? dt / static_cast<double>(plan.substeps) : dt_max;
 
     // A source is applied lazily where it cannot make a face steep within
-    // the step (structured/lazy_sources.hpp), with the physics of real scenes at every
-    // sub-step; `driven`: a source may keep sand moving in this step.
+    // the step (structured/lazy_sources.hpp, mesh/mesh_engine.cpp), where
+    // the engine can; `driven`: a source may keep sand moving in this step.
     const bool source_active = state.source_active;
-    const bool lazy = source_active && bounded && !grid.uses_physics();
+    const bool lazy = source_active && bounded && engine.takes_lazy_sources(grid);
     plan.lazy_sources = lazy;
     bool driven = source_active;
     if (source_active) {

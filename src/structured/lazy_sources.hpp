@@ -20,16 +20,13 @@
 
 #include <cstdint>
 
+#include "model/ledger.hpp"
 #include "structured/tile_kernel.hpp"
 
 namespace dpsm {
 
 class Grid;
 struct HaloStore;
-
-// What a source q adds to a cell in `substeps` sub-steps of dt, the same
-// bits wherever it is applied.
-inline double source_lag(double q, double dt, double substeps) { return (q * dt) * substeps; }
 
 // Lazy sources, at the start of a step of duration T: sets the active set's
 // driven boxes to the cells whose faces are steeper than the rest threshold

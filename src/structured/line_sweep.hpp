@@ -31,7 +31,7 @@ void apply_rates(Grid &grid, double dt);
 // linearly, so where it is not steep now, nor then, it is not in between:
 // once a sub-step has moved nothing and this says no, the rest of the step
 // is the source in closed form, apply_source_1d over `substeps` sub-steps of
-// dt (source_lag, structured/lazy_sources.hpp).
+// dt (source_lag, model/ledger.hpp).
 bool source_may_steepen_1d(const Grid &grid, double T);
 void apply_source_1d(Grid &grid, double substeps, double dt);
 

@@ -41,6 +41,8 @@ public:
         return std::make_unique<StructuredState>(grid);
     }
     double stable_dt(const Grid &grid) const override { return structured_stable_dt(grid); }
+    // The tile kernels that keep the clocks are those without the physics of real scenes.
+    bool takes_lazy_sources(const Grid &grid) const override { return !grid.uses_physics(); }
     bool relax_to_rest(Grid &grid, std::int64_t budget, double &cells_visited) const override {
         structured_state(grid).switches = read_switches();
         return dpsm::relax_to_rest(grid, budget, cells_visited);
