@@ -271,6 +271,10 @@ static const command kCommands[] = {
     {"mesh", cmd_mesh,
      "[n [runs]]  2 n^2 (n = 708: 1,002,528) jittered triangles: a fully active sub-step on 1 and 2 threads against the"
      " plain face loop; ridges on ~1 % of cells and a mesh at rest against a fully active sub-step"},
+    {"mesh-wind", cmd_mesh_wind,
+     "[n [threads [runs]]]  the wind scene on 2 n^2 (n = 708: 1,002,528) jittered triangles: ~1 % of cells on slip faces"
+     " and a source on every cell; a call of 64 stable sub-steps against 64 fully active sub-steps and the plain face"
+     " loop's, on threads (1), best of runs (3)"},
     {"mesh-accuracy", cmd_mesh_accuracy,
      "[threads [levels [mesh]]]  column collapse (a = 0.5, 30 deg) to rest on quadrilaterals, jittered triangles, hexagons,"
      " the median dual (and a gmsh disk) at about 4,000, 16,000, 65,000, 262,000 cells (levels, 4): L1 error, order, runout,"

@@ -15,7 +15,9 @@
  * the threshold) against the plain face loop below (one pass over faces
  * computing the gradient and flux, one over cells updating, in the host's
  * order); the sparse scene (slip faces on ~1 % of cells) and a mesh at rest,
- * each against a fully active sub-step. */
+ * each against a fully active sub-step.
+ *
+ * mesh-wind: the dune field of `wind` with a source on every cell. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -466,6 +468,120 @@ int cmd_mesh(int argc, char **argv) {
     plain_free(&p);
     dpsm_destroy(g);
     free(h), free(plain_h);
+    scene_free(&s);
+    return 0;
+}
+
+/* mesh-wind: the grid's wind scene (dpsm-bench wind) on a mesh. A dune field
+ * on 2 n^2 jittered triangles, in the grid's units of cells (d, the side of
+ * the squares the triangles split): compact slip faces on ~1 % of the cells,
+ * 40 x 24 squares each, 1.15 tan(theta) steep; a source on every cell,
+ * erosion on the stoss slopes (0.05 of the x slope) and deposition on the
+ * three columns at each brink (0.2), per sub-step what the grid's scene
+ * puts on per grid sub-step. A call of 64 stable sub-steps against 64
+ * fully active sub-steps (the steep plane of `mesh`) and the plain face
+ * loop's; cells visited beside the seconds. */
+int cmd_mesh_wind(int argc, char **argv) {
+    const int n = argc > 0 ? atoi(argv[0]) : 708;
+    const int threads = argc > 1 ? atoi(argv[1]) : 1;
+    const int runs = argc > 2 ? atoi(argv[2]) : 3;
+    const int substeps = 64;
+    const double theta = 30.0 * kPi / 180.0, tan_theta = tan(theta);
+    mesh_scene s = scene_make(SCENE_TRIANGLES, n, 1.0, 4242u);
+    const double d = 2.0 / n;
+    double *h = xcalloc((size_t)s.cells, sizeof(double)), *q = xcalloc((size_t)s.cells, sizeof(double));
+    double *plane = xcalloc((size_t)s.cells, sizeof(double)), *plain_h = xcalloc((size_t)s.cells, sizeof(double));
+    unsigned char *brink = xcalloc((size_t)s.cells, 1), *slip = xcalloc((size_t)s.cells, 1);
+    /* The dune bed, and its slope along x (in heights per cell). */
+    const double kx = 2.0 * kPi / 400.0, ky = 2.0 * kPi / 700.0;
+    for (int64_t c = 0; c < s.cells; ++c) {
+        const double i = (s.cx[c] + 1.0) / d, j = (s.cy[c] + 1.0) / d;
+        h[c] = d * (3.0 + 2.0 * sin(kx * i) * cos(ky * j));
+    }
+    /* Slip faces on a lattice, as add_slip_faces in speed.c. */
+    const int face_w = 40, face_h = 24;
+    const int64_t faces = (int64_t)(0.01 * (double)n * (double)n / (double)(face_w * face_h));
+    const int64_t per_row = (int64_t)ceil(sqrt((double)faces));
+    const int64_t pitch = n / (per_row + 1);
+    unsigned seed = 12345u;
+    int64_t placed = 0;
+    for (int64_t a = 0; a < per_row && placed < faces; ++a)
+        for (int64_t b = 0; b < per_row && placed < faces; ++b, ++placed) {
+            seed = seed * 1664525u + 1013904223u;
+            const double i0 = (double)((a + 1) * pitch - face_w / 2 + (int64_t)(seed >> 28) - 8);
+            const double j0 = (double)((b + 1) * pitch - face_h / 2);
+            for (int64_t c = 0; c < s.cells; ++c) {
+                const double i = (s.cx[c] + 1.0) / d, j = (s.cy[c] + 1.0) / d;
+                if (i < i0 || i >= i0 + face_w || j < j0 || j >= j0 + face_h) continue;
+                h[c] += 1.15 * tan_theta * d * (i0 + face_w - i);
+                slip[c] = 1;
+                if (i < i0 + 3) brink[c] = 1;
+            }
+        }
+    int64_t on_slip = 0;
+    for (int64_t c = 0; c < s.cells; ++c) on_slip += slip[c];
+    /* The grid's stable sub-step on cells of 1, to put on per sub-step what the grid's scene does. */
+    double grid_dt = 0.0, mesh_dt = 0.0;
+    {
+        dpsm_grid *g = NULL;
+        CHECK(NULL, dpsm_create_2d(4, 4, 1.0, 1.0, &g));
+        CHECK(g, dpsm_set_repose_angle(g, theta));
+        CHECK(g, dpsm_stable_dt(g, &grid_dt));
+        dpsm_destroy(g);
+    }
+    dpsm_grid *g = NULL;
+    CHECK(NULL, scene_create(&s, &g));
+    CHECK(g, dpsm_set_repose_angle(g, theta));
+    CHECK(g, dpsm_set_threads(g, threads));
+    CHECK(g, dpsm_stable_dt(g, &mesh_dt));
+    const double per_substep = grid_dt * d / mesh_dt;
+    for (int64_t c = 0; c < s.cells; ++c) {
+        const double i = (s.cx[c] + 1.0) / d, j = (s.cy[c] + 1.0) / d;
+        const double slope_x = 2.0 * kx * cos(kx * i) * cos(ky * j); /* of the bed, in cells */
+        q[c] = per_substep * (brink[c] ? 0.2 : -0.05 * slope_x);
+    }
+    fprintf(stderr,
+            "mesh-wind: %lld jittered triangles, %.2f %% on slip faces, a source on every cell; a call of %d stable"
+            " sub-steps on %d thread(s), best of %d\n",
+            (long long)s.cells, 100.0 * (double)on_slip / (double)s.cells, substeps, threads, runs);
+    /* The fully active sub-step: the steep plane of `mesh` draining over open edges. */
+    for (int64_t c = 0; c < s.cells; ++c) plane[c] = 30.0 + 10.0 * (s.cx[c] + 0.3 * s.cy[c]);
+    double full = 1e300, full_updates = 0.0;
+    CHECK(g, dpsm_set_boundary(g, DPSM_MESH_EDGE, DPSM_OPEN));
+    for (int run = 0; run < runs; ++run) {
+        CHECK(g, dpsm_set_heights(g, plane));
+        full = fmin(full, seconds_per_substep(g, 20, &full_updates));
+    }
+    CHECK(g, dpsm_set_boundary(g, DPSM_MESH_EDGE, DPSM_WALL));
+    /* The plain face loop, in the same run. */
+    plain_mesh p = plain_from(&s);
+    double plain = 1e300;
+    for (int run = 0; run < runs; ++run) {
+        memcpy(plain_h, plane, sizeof(double) * (size_t)s.cells);
+        const double t0 = now_seconds();
+        for (int k = 0; k < 20; ++k) plain_substep(&p, plain_h, mesh_dt, tan_theta);
+        plain = fmin(plain, (now_seconds() - t0) / 20.0);
+    }
+    /* The call: after a first call (the host's edit looked at once), a second of 64 sub-steps. */
+    double call = 1e300, updates = 0.0, taken = 0.0;
+    for (int run = 0; run < runs; ++run) {
+        CHECK(g, dpsm_set_heights(g, h));
+        CHECK(g, dpsm_set_source(g, q));
+        CHECK(g, dpsm_step(g, substeps * mesh_dt));
+        const double t0 = now_seconds();
+        CHECK(g, dpsm_step(g, substeps * mesh_dt));
+        call = fmin(call, now_seconds() - t0);
+        CHECK(g, dpsm_get_step_info(g, DPSM_INFO_CELL_UPDATES, &updates));
+        CHECK(g, dpsm_get_step_info(g, DPSM_INFO_SUBSTEPS, &taken));
+    }
+    printf("cells,threads,slip_face_fraction,substeps,cells_visited_fraction,call_s,full_s,ratio,plain_s,"
+           "full_over_plain\n");
+    printf("%lld,%d,%.4f,%.0f,%.4f,%.3e,%.3e,%.4f,%.3e,%.2f\n", (long long)s.cells, threads,
+           (double)on_slip / (double)s.cells, taken, updates / (substeps * (double)s.cells), call, substeps * full,
+           call / (substeps * full), substeps * plain, full / plain);
+    plain_free(&p);
+    dpsm_destroy(g);
+    free(h), free(q), free(plane), free(plain_h), free(brink), free(slip);
     scene_free(&s);
     return 0;
 }

@@ -11,6 +11,8 @@
  *    next to a collapsing column, alone and with sand moving elsewhere): one
  *    call and many agree to round-off, and visiting every cell changes no
  *    bit;
+ *  - a face a source made steep at the very end of a call slides in the
+ *    next, whatever that call's source;
  *  - a source of 1e-300 takes the sub-steps of none, and dt = 1e12 with it
  *    is accepted;
  *  - only a source that makes a face steep is held to dpsm_set_max_substeps.
@@ -230,6 +232,48 @@ static void test_source_that_steepens_after_sand_moved(void **state) {
                           erosion_beside_a_collapse_moving_elsewhere);
 }
 
+/* A source that makes a disk's rim steep at the very end of a call (in the
+ * closed form added after its one sub-step), and the host's next source,
+ * which lowers the disk back to flat over the next call: the rim is steep
+ * at the start of that call and not at its end, yet it must slide in its
+ * first sub-step, as it does with every cell visited. */
+static void test_steep_at_a_call_end_slides_in_the_next(void **state) {
+    (void)state;
+    for (int k = 0; k < 4; ++k) {
+        mesh_scene s = scene_make(kKinds[k], 24, 2.5, 7u);
+        const int64_t n = s.cells;
+        REQUIRE(n > 0, "no mesh");
+        double *h = malloc(sizeof(double) * (size_t)n), *q = calloc((size_t)n, sizeof(double));
+        double *heights[2];
+        double moved[2] = {0.0, 0.0};
+        for (int every = 0; every < 2; ++every) {
+            if (every) setenv("DPSM_VISIT_ALL_CELLS", "1", 1);
+            dpsm_grid *g = dyadic_mesh(&s);
+            for (int64_t c = 0; c < n; ++c) {
+                h[c] = 1.0;
+                q[c] = hypot(s.cx[c] - 0.3, s.cy[c] + 0.2) < 0.7 ? 512.0 : 0.0;
+            }
+            CHECK_OK(g, dpsm_set_heights(g, h));
+            CHECK_OK(g, dpsm_set_source(g, q));
+            CHECK_OK(g, dpsm_step(g, 1.0 / 1024.0));
+            for (int64_t c = 0; c < n; ++c) q[c] = -q[c];
+            CHECK_OK(g, dpsm_set_source(g, q));
+            CHECK_OK(g, dpsm_step(g, 1.0 / 1024.0));
+            moved[every] = step_info_of(g, DPSM_INFO_MAX_EXCESS_SLOPE);
+            heights[every] = malloc(sizeof(double) * (size_t)n);
+            CHECK_OK(g, dpsm_get_heights(g, heights[every]));
+            dpsm_destroy(g);
+            unsetenv("DPSM_VISIT_ALL_CELLS");
+        }
+        REQUIRE(moved[1] > 0.0, "%s: the rim did not slide with every cell visited", scene_name(kKinds[k]));
+        REQUIRE(memcmp(heights[0], heights[1], sizeof(double) * (size_t)n) == 0,
+                "%s: the heights differ with every cell visited (excess slope %g against %g)", scene_name(kKinds[k]),
+                moved[0], moved[1]);
+        free(heights[0]), free(heights[1]), free(h), free(q);
+        scene_free(&s);
+    }
+}
+
 /* A cone on hexagons with an open edge, with and without a source of 1e-300
  * on a cell far from it: the same sub-steps, the same heights but in that
  * cell, where the source lands in closed form; the step integrates all of
@@ -337,6 +381,7 @@ int main(void) {
         cmocka_unit_test(test_closed_form_bit_for_bit_where_no_face_moves),
         cmocka_unit_test(test_source_that_steepens_within_the_step),
         cmocka_unit_test(test_source_that_steepens_after_sand_moved),
+        cmocka_unit_test(test_steep_at_a_call_end_slides_in_the_next),
         cmocka_unit_test(test_negligible_source_costs_nothing),
         cmocka_unit_test(test_work_limit_only_for_a_driving_source),
     };

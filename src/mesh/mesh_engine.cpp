@@ -391,8 +391,7 @@ public:
         s.lazy_substeps = std::round(dt / sub_dt);
         s.moved_since_look = s.source_may_steepen = false;
         const Mesh &m = *grid.geometry().mesh;
-        look_under_sources(grid, m, s, sub_dt, 0.0, true);
-        return look_under_sources(grid, m, s, sub_dt, s.lazy_substeps, true);
+        return look_under_sources(grid, m, s, sub_dt, -1.0, s.lazy_substeps, true).second;
     }
     void forget_driven(Grid &grid) const override {
         MeshState &s = mesh_state(grid);
@@ -827,9 +826,11 @@ private:
     // slope vector (its two-point slope and its cells' gradients along t) is
     // affine in time, so its length is convex: where a face is not steep at
     // the start of the step nor at its end, it is not in between. So the
-    // step starts by looking at every face whose slope a source moves, now
-    // and at the end (look_under_sources), and keeps the cells of those steep
-    // at either end hot. Where sand moves, the faces that read the cells it
+    // step starts by looking at every face whose slope a source moves at the
+    // end (look_under_sources), and keeps the cells of those steep then hot.
+    // Those steep now are hot already: the step before looked at them at its
+    // own end, and its last sub-step woke what it kept hot; a step without
+    // lazy sources woke every source cell. Where sand moves, the faces that read the cells it
     // changed no longer follow the sources alone: for the rest of the step
     // the cells near those faces whose slopes a source moves are kept hot too
     // (watch_near_moves). And a sub-step that moved nothing ends the step at
@@ -886,39 +887,69 @@ private:
             for (const std::int64_t c : *list) s.sand_source[c] = q[c];
     }
 
-    // Whether a face whose slope the sources move is steep (or within a
-    // band of rounding below its threshold) at sub-step `at` of the step,
-    // the sources alone acting from the heights now; with `watch`, the cells
-    // of those faces are kept hot for the rest of the step. Collective on a
-    // part with one layer of ghosts (their gradients at `at` come from their
-    // owners; a part that steps its ghosts holds their stencils); the answer
-    // is this part's.
-    bool look_under_sources(Grid &grid, const Mesh &m, MeshState &s, double dt, double at, bool watch) const {
+    // Which faces whose slopes the sources move are steep (or within a band
+    // of rounding below their thresholds) at sub-steps `first` (none where it
+    // is negative) and `second` of the step, the sources alone acting from the
+    // heights now: whether any is at `first`, whether any is at `second`; with
+    // `watch`, the cells of those steep at either are kept hot for the rest
+    // of the step. Collective
+    // on a part with one layer of ghosts (their gradients come from their
+    // owners; a part that steps its ghosts holds their stencils); the answers
+    // are this part's.
+    struct Steep {
+        bool first = false, second = false;
+    };
+    Steep look_under_sources(Grid &grid, const Mesh &m, MeshState &s, double dt, double first, double second,
+                             bool watch) const {
         read_sand_sources(grid, s);
         const std::size_t n = static_cast<std::size_t>(m.cells);
-        s.look_gx.resize(n, 0.0), s.look_gy.resize(n, 0.0);
-        const std::vector<std::uint8_t> &kind = grid.kinds();
-        FaceLaw law = law_of(grid, heights_read(grid, s, dt, at), s.look_gx.data(), s.look_gy.data(), dt);
-        if (law.isotropic) {
+        for (std::vector<double> *v : {&s.look_gx, &s.look_gy, &s.look_gx_later, &s.look_gy_later}) v->resize(n, 0.0);
+        s.look_steep.resize(static_cast<std::size_t>(m.faces), 0);
+        const std::uint8_t *kind = grid.kinds().data();
+        const FaceLaw at_first = law_of(grid, heights_read(grid, s, dt, first), s.look_gx.data(), s.look_gy.data(), dt);
+        const FaceLaw at_second =
+            law_of(grid, heights_read(grid, s, dt, second), s.look_gx_later.data(), s.look_gy_later.data(), dt);
+        const int threads = grid.step_threads();
+        const bool both = first >= 0.0;
+        const auto gradients = [&](std::int64_t c) {
+            if (both) gradient_of(m, at_first.h, kind, c, s.look_gx.data(), s.look_gy.data());
+            gradient_of(m, at_second.h, kind, c, s.look_gx_later.data(), s.look_gy_later.data());
+        };
+        if (at_first.isotropic) {
             if (s.exchange && !steps_ghosts(grid)) {
                 // Every owned cell: a ghost's owner reads the gradient of the cell across their face.
-                for (std::int64_t c = 0; c < m.owned; ++c) gradient_of(m, law.h, kind.data(), c, s.look_gx.data(), s.look_gy.data());
-                s.exchange->send_all(GhostExchange::kFaceGhosts, {GhostField{s.look_gx.data()}, GhostField{s.look_gy.data()}},
+                const std::int64_t owned = m.owned;
+#pragma omp parallel for num_threads(threads) if (threads_in_use(threads, owned) > 1) schedule(static)
+                for (std::int64_t c = 0; c < owned; ++c) gradients(c);
+                s.exchange->send_all(GhostExchange::kFaceGhosts,
+                                     {GhostField{s.look_gx.data()}, GhostField{s.look_gy.data()},
+                                      GhostField{s.look_gx_later.data()}, GhostField{s.look_gy_later.data()}},
                                      false);
             } else {
-                for (const std::int64_t c : s.source_face_cells)
-                    gradient_of(m, law.h, kind.data(), c, s.look_gx.data(), s.look_gy.data());
+                const std::int64_t count = static_cast<std::int64_t>(s.source_face_cells.size());
+                const std::int64_t *cells = s.source_face_cells.data();
+#pragma omp parallel for num_threads(threads) if (threads_in_use(threads, count) > 1) schedule(static)
+                for (std::int64_t k = 0; k < count; ++k) gradients(cells[k]);
             }
         }
-        bool steep = false;
-        for (const std::int64_t f : s.source_faces) {
-            if (!law.may_be_steep(f)) continue;
-            steep = true;
-            if (!watch) break;
-            for (const std::int64_t e : {m.face_a[f], m.face_b[f]})
-                if (e >= 0) watch_cell(s, e);
+        const std::int64_t count = static_cast<std::int64_t>(s.source_faces.size());
+        const std::int64_t *faces = s.source_faces.data();
+        std::uint8_t *steep = s.look_steep.data();
+        bool any_first = false, any_second = false;
+#pragma omp parallel for num_threads(threads) if (threads_in_use(threads, count) > 1) schedule(static) \
+    reduction(|| : any_first, any_second)
+        for (std::int64_t k = 0; k < count; ++k) {
+            const bool then = both && at_first.may_be_steep(faces[k]), later = at_second.may_be_steep(faces[k]);
+            steep[faces[k]] = then || later;
+            any_first = any_first || then;
+            any_second = any_second || later;
         }
-        return steep;
+        if (watch && (any_first || any_second))
+            for (const std::int64_t f : s.source_faces)
+                if (steep[f])
+                    for (const std::int64_t e : {m.face_a[f], m.face_b[f]})
+                        if (e >= 0) watch_cell(s, e);
+        return Steep{any_first, any_second};
     }
 
     static void watch_cell(MeshState &s, std::int64_t c) {
@@ -977,7 +1008,8 @@ private:
         if (moved || !s.moved_since_look) return s.source_may_steepen;
         s.moved_since_look = false;
         const double now = static_cast<double>(done);
-        bool steep = look_under_sources(grid, m, s, dt, now, false) || look_under_sources(grid, m, s, dt, s.lazy_substeps, false);
+        const Steep found = look_under_sources(grid, m, s, dt, now, s.lazy_substeps, false);
+        bool steep = found.first || found.second;
         if (grid.distribution()) steep = grid.global_sum(steep ? 1.0 : 0.0) > 0.0;
         s.source_may_steepen = steep;
         return steep;

@@ -107,8 +107,9 @@ struct MeshState final : EngineState {
     bool moved_since_look = false, source_may_steepen = false;
     // The last step added sources in closed form; the next one has not looked at what they steepened.
     bool caught_up = false;
-    // Per face and cell, scratch of that look: gradients at one time.
-    std::vector<double> look_gx, look_gy;
+    // Scratch of that look: per cell, gradients at two times; per face, steep at either.
+    std::vector<double> look_gx, look_gy, look_gx_later, look_gy_later;
+    std::vector<std::uint8_t> look_steep;
 
     // What the host's masks, sources and edges make of the mesh, found again
     // after the host changed them (lists_current false).
