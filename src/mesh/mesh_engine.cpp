@@ -406,7 +406,7 @@ public:
         if (record) std::fill(grid.face_fluxes().x.begin(), grid.face_fluxes().x.end(), 0.0);
         if (!plan.something_may_move) {
             info.at_rest = true;
-            if (s.lazy) catch_up_sources(grid, s, plan.sub_dt);
+            if (s.lazy) info.cell_updates += catch_up_sources(grid, s, plan.sub_dt);
             return;
         }
         s.switches = read_switches();
@@ -435,7 +435,7 @@ public:
             if (in_batch > 0 && (!go_on || in_batch == per_exchange || k + 1 == plan.substeps)) end_batch(grid, m, s);
             if (!go_on) break;
         }
-        if (s.lazy) catch_up_sources(grid, s, plan.sub_dt);
+        if (s.lazy) info.cell_updates += catch_up_sources(grid, s, plan.sub_dt);
     }
 
     // Meshes relax by time-accurate sub-steps to rest: the stepper takes over.
@@ -1020,17 +1020,22 @@ private:
     // residual as the sub-steps' updates; the clocks start again from 0. A
     // part that steps its ghosts holds their owners' heights, residuals and
     // clocks after the step's last exchange, and does the same to them;
-    // another takes them from their owners (collective).
-    void catch_up_sources(Grid &grid, MeshState &s, double dt) const {
+    // another takes them from their owners (collective). Returns the owned
+    // cells it changed.
+    double catch_up_sources(Grid &grid, MeshState &s, double dt) const {
         std::vector<double> &h = grid.heights_for_stepping();
         std::vector<float> &residual = grid.residuals_for_stepping();
         read_sand_sources(grid, s);
         const bool ghosts_here = s.exchange && steps_ghosts(grid);
+        double changed = 0.0;
         for (const std::vector<std::int64_t> *list : {&s.source_cells, &s.ghost_source_cells}) {
             if (list == &s.ghost_source_cells && !ghosts_here) break;
             for (const std::int64_t c : *list) {
                 const double lag = source_lag(s.sand_source[c], dt, s.lazy_substeps - s.since[c]);
-                if (lag != 0.0) add_with_residual(h[c], residual[c], lag);
+                if (lag != 0.0) {
+                    add_with_residual(h[c], residual[c], lag);
+                    if (list == &s.source_cells) changed += 1.0;
+                }
                 s.since[c] = 0.0;
             }
         }
@@ -1043,6 +1048,7 @@ private:
         forget_watches(s);
         s.lazy = false;
         s.caught_up = true;
+        return changed;
     }
 
     // One sub-step's law over the grid, reading heights `hv` and gradients gx, gy.
