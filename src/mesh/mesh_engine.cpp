@@ -366,18 +366,14 @@ public:
         list_source_faces(m, s);
     }
 
-    // After a step that added sources in closed form, the next one must look
-    // at the faces those cells' new heights steepened: with lazy sources its
-    // look under the sources does, else every cell is hot (advance).
     // Not with a bed (erosion stops at it, so a source's part depends on the
     // sand there) nor with a static angle (a cell's threshold depends on
     // whether it moved).
     bool takes_lazy_sources(const Grid &grid) const override { return grid.bed().empty() && !grid.hysteresis(); }
 
-    bool may_move(const Grid &grid) const override {
-        const MeshState &s = mesh_state(grid);
-        return s.activity.may_move() || s.caught_up;
-    }
+    // After a step with lazy sources, the cells a source kept hot are hot:
+    // what its closed form made steep at its end is among them.
+    bool may_move(const Grid &grid) const override { return mesh_state(grid).activity.may_move(); }
 
     // Without lazy sources every source cell takes its source at every
     // sub-step and counts as driven. With them, the faces a source may make
@@ -387,7 +383,6 @@ public:
         if (!lazy) return true;
         MeshState &s = mesh_state(grid);
         s.lazy = true;
-        s.caught_up = false;
         s.lazy_substeps = std::round(dt / sub_dt);
         s.moved_since_look = s.source_may_steepen = false;
         const Mesh &m = *grid.geometry().mesh;
@@ -410,8 +405,6 @@ public:
             return;
         }
         s.switches = read_switches();
-        if (s.caught_up) s.activity.wake_all();
-        s.caught_up = false;
         if (s.lazy)
             for (const std::int64_t c : s.watched_cells) s.activity.wake(c);
         const Distribution *parts = grid.distribution();
@@ -782,7 +775,7 @@ private:
             act.cool_all();
             for (const std::int64_t c : s.update_cells) act.wake_around(m, c);
             for (const std::int64_t c : changed_ghosts) act.wake_around(m, c);
-            wake_what_sources_keep_hot(m, s, false);
+            if (s.lazy) wake_what_sources_keep_hot(m, s, false);  // else the sources' cells are among those updated
             for (const std::int64_t c : s.pull_cells) pull_x[c] = pull_y[c] = 0.0;
             for (const std::int64_t c : s.limit_cells) limit_in[c] = limit_out[c] = 1.0;
         }
@@ -829,12 +822,13 @@ private:
     // step starts by looking at every face whose slope a source moves at the
     // end (look_under_sources), and keeps the cells of those steep then hot.
     // Those steep now are hot already: the step before looked at them at its
-    // own end, and its last sub-step woke what it kept hot; a step without
-    // lazy sources woke every source cell. Where sand moves, the faces that read the cells it
-    // changed no longer follow the sources alone: for the rest of the step
-    // the cells near those faces whose slopes a source moves are kept hot too
-    // (watch_near_moves). And a sub-step that moved nothing ends the step at
-    // rest only when no such face is steep then nor at the end.
+    // own end, and its last sub-step woke what the sources kept hot; a step
+    // without lazy sources woke every source cell. Where sand moves, the
+    // faces that read the cells it changed no longer follow the sources
+    // alone: for the rest of the step the cells near those faces whose slopes
+    // a source moves are kept hot too (watch_near_moves). And a sub-step that
+    // moved nothing ends the step at rest only when no such face is steep
+    // then nor at the end (source_may_steepen).
 
     // The heights sub-step `now` reads.
     static Heights heights_read(Grid &grid, MeshState &s, double dt, double now) {
@@ -1047,7 +1041,6 @@ private:
         }
         forget_watches(s);
         s.lazy = false;
-        s.caught_up = true;
         return changed;
     }
 

@@ -105,8 +105,6 @@ struct MeshState final : EngineState {
     // A sub-step moved sand since the last look at whether a source may
     // still make a face steep before the step ends; that look's answer.
     bool moved_since_look = false, source_may_steepen = false;
-    // The last step added sources in closed form; the next one has not looked at what they steepened.
-    bool caught_up = false;
     // Scratch of that look: per cell, gradients at two times; per face, steep at either.
     std::vector<double> look_gx, look_gy, look_gx_later, look_gy_later;
     std::vector<std::uint8_t> look_steep;
