@@ -3,7 +3,7 @@
 # mesh kind at three refinements and the cone on triangles (dpsm-bench
 # mesh-accuracy, with the gmsh disk when gmsh is installed), the 2D grid's
 # isotropic scheme beside them (docs/data/work_precision.csv), the speed of
-# the mesh engine (dpsm-bench mesh), the error-against-cells figure and the
+# the mesh engine (dpsm-bench mesh, mesh-wind), the error-against-cells figure and the
 # picture of a pile on a gmsh mesh (examples/python/mesh_pile.py).
 #
 #   bash bench/run_mesh_validation.sh     # about 45 minutes on 2 cores, on a quiet machine
@@ -41,6 +41,13 @@ cat "$data/mesh_accuracy.csv"
 echo ">> dpsm-bench mesh"
 "$bench" mesh > "$data/mesh_speed.csv" 2> "$data/mesh_speed.log"
 cat "$data/mesh_speed.csv"
+echo ">> dpsm-bench mesh-wind, 1 and 2 threads, three runs each"
+{
+  for threads in 1 2; do
+    for run in 1 2 3; do "$bench" mesh-wind 708 "$threads" 3 2> "$data/mesh_wind.log"; done
+  done
+} | awk 'NR == 1 { print "build," $0; next } /^cells/ { next } { print "this," $0 }' > "$data/mesh_wind.csv"
+cat "$data/mesh_wind.csv"
 "$python" "$root/bench/plot_mesh_accuracy.py" "$data/mesh_accuracy.csv" "$data/work_precision.csv" \
     "$figures/mesh_accuracy.png"
 PYTHONPATH=$root/bindings/python DPSM_LIBRARY=$build/src/libdpsm.so \

@@ -2070,6 +2070,33 @@ static int mesh_source_active(const mesh_state_t *ms) {
     return 0;
 }
 
+/* A source surely makes a face steep at the end of a step of dt under the
+ * sources alone: a face between a sand cell with a source and a sand or open
+ * cell whose two-point slope alone (a lower bound of the face's slope) is
+ * then beyond the default angle's threshold. Only such a source must be held
+ * to the sub-step limit; one that is not surely steep may or may not be (its
+ * gradients' part decides). */
+static int mesh_source_surely_steep(const mesh_state_t *ms, const double *h, double dt) {
+    if (!ms->source) return 0;
+    const mesh_t *m = ms->m;
+    double *xy = xcalloc((size_t)(2 * m->ncells), sizeof(double)), *area = xcalloc((size_t)m->ncells, sizeof(double));
+    if (dpsm_get_cell_centres(ms->g, xy, area) != DPSM_OK) die("dpsm_get_cell_centres failed on a mesh");
+    const double threshold = tan(DPSM_DEFAULT_REPOSE_ANGLE) * (1.0 + DPSM_DEFAULT_REST_TOLERANCE) * (1.0 + 1e-6);
+    int steep = 0;
+    for (int64_t f = 0; f < m->nfaces && !steep; ++f) {
+        const int64_t a = m->face_cells[2 * f], b = m->face_cells[2 * f + 1];
+        if (b < 0) continue;
+        const uint8_t ka = ms->kinds[a], kb = ms->kinds[b];
+        if (ka == DPSM_CELL_WALL || kb == DPSM_CELL_WALL || (ka != DPSM_CELL_SAND && kb != DPSM_CELL_SAND)) continue;
+        const double qa = ka == DPSM_CELL_SAND ? ms->source[a] : 0.0, qb = kb == DPSM_CELL_SAND ? ms->source[b] : 0.0;
+        if (qa == 0.0 && qb == 0.0) continue;
+        const double d = hypot(xy[2 * a] - xy[2 * b], xy[2 * a + 1] - xy[2 * b + 1]);
+        steep = fabs((h[a] + qa * dt) - (h[b] + qb * dt)) > threshold * d;
+    }
+    free(xy), free(area);
+    return steep;
+}
+
 /* The held levels (open edge faces, open cells): their range; 0 if none. */
 static int mesh_held_range(const mesh_state_t *ms, const double *h, double *lo, double *hi) {
     int any = 0;
@@ -2120,10 +2147,12 @@ static void mesh_step(mesh_state_t *ms, reader_t *r) {
     const int sourced = mesh_source_active(ms);
     double held_lo = 0.0, held_hi = 0.0;
     const int held = mesh_held_range(ms, before.h, &held_lo, &held_hi);
-    const int limited = sourced || (held && held_lo != held_hi);
+    /* A source drives only where it keeps a face steep to the end of the step (sources in closed form). */
+    const int held_apart = held && held_lo != held_hi;
+    const int limited = held_apart || (sourced && mesh_source_surely_steep(ms, before.h, dt));
     const double needed = ceil(dt / before.stable_dt), limit = (double)ms->max_substeps;
     int want = limited && needed > limit ? DPSM_ERR_WORK_LIMIT : DPSM_OK;
-    const int either = limited && fabs(needed - limit) <= 1.0;
+    const int either = (limited && fabs(needed - limit) <= 1.0) || (sourced && !limited && needed > limit - 1.0);
     /* Bounded work: a scene at rest by itself stops early, but how early depends on it. */
     const double cost = (want == DPSM_OK || either ? fmax(needed, 1.0) : 1.0) * (double)m->ncells *
                         ((through_restart ? 2 : 1) + (ms->twin ? 1 : 0));
