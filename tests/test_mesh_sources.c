@@ -11,6 +11,8 @@
  *    next to a collapsing column, alone and with sand moving elsewhere): one
  *    call and many agree to round-off, and visiting every cell changes no
  *    bit;
+ *  - the same with an angle field and a flux exponent, which keep sources
+ *    in closed form on meshes;
  *  - a face a source made steep at the very end of a call slides in the
  *    next, whatever that call's source;
  *  - a source of 1e-300 takes the sub-steps of none, and dt = 1e12 with it
@@ -37,11 +39,23 @@ static const scene_kind kKinds[4] = {SCENE_TRIANGLES, SCENE_HEXAGONS, SCENE_DUAL
 /* The scene's mesh at 30 degrees, on one thread, with the mobility that
  * makes its stable sub-step 1025/1024 of 2^-10: a call of 2^-j (j from 0 to
  * 10) takes sub-steps of exactly 2^-10. */
+/* With it, the meshes dyadic_mesh makes have an angle of repose per cell
+ * (28 to 34 degrees across x) and a flux exponent of 1.5, which keep
+ * sources in closed form. */
+static int g_angle_field_and_exponent = 0;
+
 static dpsm_grid *dyadic_mesh(const mesh_scene *s) {
     dpsm_grid *g = NULL;
     CHECK_OK(NULL, scene_create(s, &g));
     CHECK_OK(g, dpsm_set_repose_angle(g, 30.0 * kDeg));
     CHECK_OK(g, dpsm_set_threads(g, 1));
+    if (g_angle_field_and_exponent) {
+        double *theta = malloc(sizeof(double) * (size_t)s->cells);
+        for (int64_t c = 0; c < s->cells; ++c) theta[c] = (31.0 + 3.0 * s->cx[c] / 2.5) * kDeg;
+        CHECK_OK(g, dpsm_set_repose_angle_field(g, theta));
+        CHECK_OK(g, dpsm_set_flux_exponent(g, 1.5));
+        free(theta);
+    }
     double stable = 0.0;
     CHECK_OK(g, dpsm_stable_dt(g, &stable)); /* at the default mobility, to which it is inversely proportional */
     CHECK_OK(g, dpsm_set_mobility(g, DPSM_DEFAULT_MOBILITY * stable / (1025.0 / 1024.0 / 1024.0)));
@@ -225,6 +239,15 @@ static void test_source_that_steepens_within_the_step(void **state) {
     one_call_against_many("a source that steepens its rim", 1.0 / 16.0, steepening_scene);
 }
 
+/* The same with an angle field and a flux exponent. */
+static void test_with_an_angle_field_and_an_exponent(void **state) {
+    (void)state;
+    g_angle_field_and_exponent = 1;
+    one_call_against_many("a source that steepens its rim, angle field, exponent 1.5", 1.0 / 16.0, steepening_scene);
+    one_call_against_many("erosion beside a collapse, angle field, exponent 1.5", 1.0, erosion_beside_a_collapse);
+    g_angle_field_and_exponent = 0;
+}
+
 static void test_source_that_steepens_after_sand_moved(void **state) {
     (void)state;
     one_call_against_many("erosion beside a collapse", 1.0, erosion_beside_a_collapse);
@@ -392,6 +415,7 @@ int main(void) {
         cmocka_unit_test(test_closed_form_bit_for_bit_where_no_face_moves),
         cmocka_unit_test(test_source_that_steepens_within_the_step),
         cmocka_unit_test(test_source_that_steepens_after_sand_moved),
+        cmocka_unit_test(test_with_an_angle_field_and_an_exponent),
         cmocka_unit_test(test_steep_at_a_call_end_slides_in_the_next),
         cmocka_unit_test(test_negligible_source_costs_nothing),
         cmocka_unit_test(test_work_limit_only_for_a_driving_source),
