@@ -363,7 +363,7 @@ public:
         const std::vector<double> &q = grid.source();
         for (std::int64_t c = 0; c < static_cast<std::int64_t>(q.size()); ++c)
             if (kind[c] == kSand && q[c] != 0.0) (c < m.owned ? s.source_cells : s.ghost_source_cells).push_back(c);
-        list_source_faces(m, s);
+        list_source_faces(m, q, s);
     }
 
     // Not with a bed (erosion stops at it, so a source's part depends on the
@@ -837,19 +837,19 @@ private:
         return hv;
     }
 
-    // What the sources make of the mesh (after the host changed them): the
-    // sand cells' sources, which cells' slopes they move, the faces whose
-    // slopes they move and those faces' cells.
-    static void list_source_faces(const Mesh &m, MeshState &s) {
+    // What the sources make of the mesh (after the host changed them, which
+    // every change of a source's value is): the sand cells' sources, which
+    // cells' slopes they move, the faces whose slopes they move and those
+    // faces' cells.
+    static void list_source_faces(const Mesh &m, const std::vector<double> &q, MeshState &s) {
         const std::size_t n = static_cast<std::size_t>(m.cells);
         s.sand_source.assign(n, 0.0);
         s.source_reach.assign(n, 0);
         s.source_faces.clear();
         s.source_face_cells.clear();
         if (s.source_cells.empty() && s.ghost_source_cells.empty()) return;
-        // Set by hand below: the cells whose stored heights the source lists name.
         for (const std::vector<std::int64_t> *list : {&s.source_cells, &s.ghost_source_cells})
-            for (const std::int64_t c : *list) s.sand_source[c] = 1.0;
+            for (const std::int64_t c : *list) s.sand_source[c] = q[c];
         // A cell's height moves under a source, or its gradient reads one.
         for (std::int64_t c = 0; c < m.cells; ++c) {
             bool reach = s.sand_source[c] != 0.0;
@@ -870,15 +870,6 @@ private:
             }
         }
         std::sort(s.source_face_cells.begin(), s.source_face_cells.end());
-        s.sand_source.assign(n, 0.0);
-    }
-
-    // The grid's sources on the sand cells, as lazy sources read them (the
-    // lists hold which cells; the values may change without the lists).
-    static void read_sand_sources(const Grid &grid, MeshState &s) {
-        const std::vector<double> &q = grid.source();
-        for (const std::vector<std::int64_t> *list : {&s.source_cells, &s.ghost_source_cells})
-            for (const std::int64_t c : *list) s.sand_source[c] = q[c];
     }
 
     // Which faces whose slopes the sources move are steep (or within a band
@@ -895,7 +886,6 @@ private:
     };
     Steep look_under_sources(Grid &grid, const Mesh &m, MeshState &s, double dt, double first, double second,
                              bool watch) const {
-        read_sand_sources(grid, s);
         const std::size_t n = static_cast<std::size_t>(m.cells);
         for (std::vector<double> *v : {&s.look_gx, &s.look_gy, &s.look_gx_later, &s.look_gy_later}) v->resize(n, 0.0);
         s.look_steep.resize(static_cast<std::size_t>(m.faces), 0);
@@ -1019,7 +1009,6 @@ private:
     double catch_up_sources(Grid &grid, MeshState &s, double dt) const {
         std::vector<double> &h = grid.heights_for_stepping();
         std::vector<float> &residual = grid.residuals_for_stepping();
-        read_sand_sources(grid, s);
         const bool ghosts_here = s.exchange && steps_ghosts(grid);
         double changed = 0.0;
         for (const std::vector<std::int64_t> *list : {&s.source_cells, &s.ghost_source_cells}) {
