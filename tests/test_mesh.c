@@ -1002,6 +1002,79 @@ static void test_active_set_same_bits(void **state) {
     run_with_and_without("DPSM_VISIT_ALL_CELLS", 60, 5u, "every cell visited", same_bits_and_ledger);
 }
 
+/* The sparse step's passes over its lists run on the threads where the
+ * lists are long (mesh/mesh_engine.cpp, for_each_item). Ridges on a mesh of
+ * about 80,000 cells collapse in sub-steps that each change a few thousand
+ * cells: on one thread and on two, the same heights bit for bit, and on each
+ * the same as with every cell visited. And the sparse step visits what moves
+ * (issue 34): over the sub-steps, the cells visited at most 2.5 times those
+ * whose heights changed. */
+static void ridges_on(const mesh_scene *s, int threads, int calls, double *h_out, double *visited, double *changed) {
+    dpsm_grid *g = NULL;
+    CHECK_OK(NULL, scene_create(s, &g));
+    CHECK_OK(g, dpsm_set_repose_angle(g, 30.0 * kDeg));
+    CHECK_OK(g, dpsm_set_threads(g, threads));
+    double *h = calloc((size_t)s->cells, sizeof(double)), *after = calloc((size_t)s->cells, sizeof(double));
+    for (int64_t c = 0; c < s->cells; ++c)
+        if (fabs(fabs(s->cy[c]) - 0.5) < 0.02) h[c] = 0.05; /* two ridges */
+    CHECK_OK(g, dpsm_set_heights(g, h));
+    double dt = 0.0;
+    CHECK_OK(g, dpsm_stable_dt(g, &dt));
+    CHECK_OK(g, dpsm_step(g, dt)); /* the host's heights: every cell looked at once */
+    CHECK_OK(g, dpsm_get_heights(g, h));
+    *visited = *changed = 0.0;
+    for (int call = 0; call < calls; ++call) {
+        double updates = 0.0, substeps = 0.0;
+        CHECK_OK(g, dpsm_step(g, dt));
+        CHECK_OK(g, dpsm_get_step_info(g, DPSM_INFO_CELL_UPDATES, &updates));
+        CHECK_OK(g, dpsm_get_step_info(g, DPSM_INFO_SUBSTEPS, &substeps));
+        REQUIRE(substeps == 1.0, "ridges, call %d: %g sub-steps, expected 1", call + 1, substeps);
+        CHECK_OK(g, dpsm_get_heights(g, after));
+        for (int64_t c = 0; c < s->cells; ++c) *changed += after[c] != h[c];
+        *visited += updates;
+        memcpy(h, after, sizeof(double) * (size_t)s->cells);
+    }
+    memcpy(h_out, h, sizeof(double) * (size_t)s->cells);
+    free(h), free(after);
+    dpsm_destroy(g);
+}
+
+static void test_sparse_step_on_threads(void **state) {
+    (void)state;
+    const scene_kind kinds[2] = {SCENE_TRIANGLES, SCENE_DUAL};
+    const int calls = 12;
+    for (int k = 0; k < 2; ++k) {
+        mesh_scene s = scene_make(kinds[k], kinds[k] == SCENE_DUAL ? 283 : 200, 1.0, 11u);
+        const size_t n = (size_t)s.cells;
+        double *one = calloc(n, sizeof(double)), *two = calloc(n, sizeof(double)), *all = calloc(n, sizeof(double));
+        double visited = 0.0, changed = 0.0, v2 = 0.0, c2 = 0.0, va = 0.0, ca = 0.0;
+        ridges_on(&s, 1, calls, one, &visited, &changed);
+        ridges_on(&s, 2, calls, two, &v2, &c2);
+        setenv("DPSM_VISIT_ALL_CELLS", "1", 1);
+        ridges_on(&s, 2, calls, all, &va, &ca);
+        unsetenv("DPSM_VISIT_ALL_CELLS");
+        const char *name = scene_name(kinds[k]);
+        /* The lists long enough for the threads, and the step sparse on two
+         * threads too (it then takes the plain passes over an eighth of the cells). */
+        REQUIRE(v2 / calls > 4096.0 && v2 / calls < 0.125 * (double)n,
+                "%s, %lld cells: %.0f cells visited a sub-step on two threads; the test wants the sparse step "
+                "over more than 4096", name, (long long)s.cells, v2 / calls);
+        REQUIRE(visited == v2, "%s: %.0f cells visited on one thread, %.0f on two", name, visited, v2);
+        for (size_t c = 0; c < n; ++c) {
+            REQUIRE(memcmp(&one[c], &two[c], sizeof(double)) == 0, "%s: cell %zu: %.17g on two threads, %.17g on one",
+                    name, c, two[c], one[c]);
+            REQUIRE(memcmp(&one[c], &all[c], sizeof(double)) == 0,
+                    "%s: cell %zu: %.17g with every cell visited, %.17g with the active set", name, c, all[c], one[c]);
+        }
+        REQUIRE(visited <= 2.5 * changed, "%s: %.0f cells visited a sub-step, %.0f changed: %.2f times", name,
+                visited / calls, changed / calls, visited / changed);
+        print_message("%s, %lld cells: %.0f cells visited a sub-step, %.0f changed (%.2f times)\n", name,
+                      (long long)s.cells, visited / calls, changed / calls, visited / changed);
+        free(one), free(two), free(all);
+        scene_free(&s);
+    }
+}
+
 /* What a cell's sums read is ordered by the host's cell numbers (and on the
  * domain edge by the faces' midpoints), never by the library's internal
  * order or the order the host lists faces in: a distributed mesh, whose ranks
@@ -1196,6 +1269,7 @@ int main(void) {
         cmocka_unit_test(test_host_order),
         cmocka_unit_test(test_graph_steps_as_polygons),
         cmocka_unit_test(test_active_set_same_bits),
+        cmocka_unit_test(test_sparse_step_on_threads),
         cmocka_unit_test(test_sums_ordered_by_host_numbers),
         cmocka_unit_test(test_fluxes_match_height_changes),
         cmocka_unit_test(test_restart_on_meshes),

@@ -34,6 +34,27 @@ inline int threads_in_use(int threads, std::int64_t cells) { return cells >= kCe
 inline double dense_share(int threads, std::int64_t cells) {
     return kDenseShareOnOneThread / threads_in_use(threads, cells);
 }
+
+// Below this many items a pass over a list runs on one thread: an item of
+// a list costs several cells of a plain pass (its data lies scattered).
+constexpr std::int64_t kListItemsForThreads = 4096;
+
+// Calls work(item) for every item of a list, on the threads where the list
+// is long enough. Each item's work must write only its own item's values
+// (every pass is a gather), so the results do not depend on the threads.
+// for_each_place: work(k, item) with the item's place k in the list.
+template <class Work>
+void for_each_place(const std::vector<std::int64_t> &list, int threads, const Work &work) {
+    const std::int64_t count = static_cast<std::int64_t>(list.size());
+    const std::int64_t *items = list.data();
+    const bool parallel = threads > 1 && count >= kListItemsForThreads;
+#pragma omp parallel for num_threads(threads) if (parallel) schedule(static)
+    for (std::int64_t k = 0; k < count; ++k) work(k, items[k]);
+}
+template <class Work>
+void for_each_item(const std::vector<std::int64_t> &list, int threads, const Work &work) {
+    for_each_place(list, threads, [&](std::int64_t, std::int64_t item) { work(item); });
+}
 // The share of the room to its bounds a cell's limiter lets the gradient
 // flow's excess fill.
 constexpr double kLimiterRoom = 1.0 - 1e-9;
@@ -669,7 +690,8 @@ private:
                 s.flux_clean = true;
             }
             if (law.isotropic) {
-                for (const std::int64_t c : s.gradient_cells) gradient_of(m, law.h, kind.data(), c, s.gx.data(), s.gy.data());
+                for_each_item(s.gradient_cells, threads,
+                              [&](std::int64_t c) { gradient_of(m, law.h, kind.data(), c, s.gx.data(), s.gy.data()); });
                 if (exchanges) {
                     // A ghost whose gradient changed makes its faces steep or flat
                     // whether or not anything near them here changed.
@@ -681,17 +703,26 @@ private:
             }
             // The steep faces: those looked at again as they are now, the others as they were.
             std::vector<std::int64_t> &steep_faces = s.steep_faces;
-            for (const std::int64_t f : s.faces) {
+            std::vector<std::uint8_t> &became_steep = s.became_steep;
+            became_steep.resize(s.faces.size());
+            for_each_place(s.faces, threads, [&](std::int64_t k, std::int64_t f) {
                 const bool was = steep[f] != 0;
-                if (face_terms(f).steep && !was) steep_faces.push_back(f);
-            }
+                became_steep[static_cast<std::size_t>(k)] = face_terms(f).steep && !was;
+            });
+            for (std::size_t k = 0; k < s.faces.size(); ++k)
+                if (became_steep[k]) steep_faces.push_back(s.faces[k]);
+            // Each steep face once (a face that turned flat in a sub-step
+            // that did not look at it may be listed twice): kept faces are
+            // marked 2 while the list is read.
             std::size_t kept = 0;
             for (const std::int64_t f : steep_faces)
-                if (steep[f]) steep_faces[kept++] = f;
+                if (steep[f] == 1) steep[f] = 2, steep_faces[kept++] = f;
             steep_faces.resize(kept);
+            for (const std::int64_t f : steep_faces) steep[f] = 1;
             // The steep faces not looked at again: as they were, with this sub-step's terms.
-            for (const std::int64_t f : steep_faces)
+            for_each_item(steep_faces, threads, [&](std::int64_t f) {
                 if (s.face_seen[f] != stamp) face_terms(f);
+            });
             // The owned cells of `faces`, each once, into `cells`.
             const auto owned_cells_of = [&](const std::vector<std::int64_t> &faces, std::vector<std::int64_t> &cells) {
                 const std::uint32_t listed = next_stamp(s);
@@ -705,7 +736,7 @@ private:
             };
             // Pulls: the owned cells of steep faces.
             owned_cells_of(steep_faces, s.pull_cells);
-            for (const std::int64_t c : s.pull_cells) pull_of(m, pull, c, pull_x, pull_y);
+            for_each_item(s.pull_cells, threads, [&](std::int64_t c) { pull_of(m, pull, c, pull_x, pull_y); });
             if (exchanges) {
                 // The ghosts that pull: those whose pull changed, and those that pulled before and still do.
                 exchange_ghost_pulls(s, changed_ghosts);
@@ -728,7 +759,6 @@ private:
                 if (f >= m.live_faces || s.face_seen[f] == carrying) return;
                 s.face_seen[f] = carrying;
                 s.faces.push_back(f);
-                high[f] = gradient_flow_flux(m, law, f, high[f], pull_x, pull_y);
             };
             const auto carry_faces_of = [&](std::int64_t c) {
                 for (std::int64_t k = m.cell_face_start[c]; k < m.cell_face_start[c + 1]; ++k) carry(m.cell_faces[k]);
@@ -736,9 +766,12 @@ private:
             for (const std::int64_t f : steep_faces) carry(f);
             for (const std::int64_t c : s.pull_cells) carry_faces_of(c);
             for (const std::int64_t c : s.pulling_ghosts) carry_faces_of(c);
+            for_each_item(s.faces, threads,
+                          [&](std::int64_t f) { high[f] = gradient_flow_flux(m, law, f, high[f], pull_x, pull_y); });
             // Limiters: the owned cells of those faces.
             owned_cells_of(s.faces, s.limit_cells);
-            for (const std::int64_t c : s.limit_cells) limits_of(m, law, low, high, bed, c, limit_in, limit_out);
+            for_each_item(s.limit_cells, threads,
+                          [&](std::int64_t c) { limits_of(m, law, low, high, bed, c, limit_in, limit_out); });
             if (exchanges) exchange_ghost_limits(s);
             // The cells to update: those of faces that carried sand, and the sources.
             const std::uint32_t update_stamp = next_stamp(s);
@@ -749,10 +782,10 @@ private:
                     s.update_cells.push_back(c);
                 }
             };
+            for_each_item(s.faces, threads,
+                          [&](std::int64_t f) { flux[f] = limited_flux(m, law, f, low[f], high[f], limit_in, limit_out); });
             for (const std::int64_t f : s.faces) {
-                const double v = limited_flux(m, law, f, low[f], high[f], limit_in, limit_out);
-                flux[f] = v;
-                if (v == 0.0) continue;
+                if (flux[f] == 0.0) continue;
                 moved = true;
                 max_excess = std::max(max_excess, excess[f]);
                 for (const std::int64_t e : {m.face_a[f], m.face_b[f]})
@@ -761,7 +794,7 @@ private:
             // Sources at every sub-step (not lazy): every source cell changes.
             if (!s.lazy)
                 for (const std::int64_t c : s.source_cells) to_update(c);
-            for (const std::int64_t c : s.update_cells) update_cell(c);
+            for_each_item(s.update_cells, threads, [&](std::int64_t c) { update_cell(c); });
             // Every cell a pass read or wrote, once.
             const std::uint32_t counted = next_stamp(s);
             double cells_visited = 0.0;

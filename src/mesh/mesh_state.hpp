@@ -76,6 +76,7 @@ struct MeshState final : EngineState {
     // list that may hold faces no longer steep, dropped as it is read).
     std::vector<std::uint8_t> steep;
     std::vector<std::int64_t> steep_faces;
+    std::vector<std::uint8_t> became_steep;  // per face looked at, in the sub-step's list: it turned steep
     std::vector<std::int64_t> pull_cells, limit_cells;
     std::vector<std::int64_t> pulling_ghosts;  // a part's ghosts whose pulls are not 0
     std::vector<std::uint32_t> face_seen, cell_seen;
