@@ -38,11 +38,15 @@ static const double kHalf = 2.5;
 
 /* ---- the quadtree ---------------------------------------------------------- */
 
+enum { kMostLevels = 12 };
+
 typedef struct {
     int m;          /* lattice points per side less one: the domain is m fine cells wide */
+    int levels;     /* the largest cells are 2^levels fine cells wide; m is a multiple of it */
     double h;       /* fine cell size */
     double px, py;  /* the refinement's centre */
-    double r1, r2, r3; /* within r1: h; r2: 2h; r3: 4h; beyond: 8h */
+    /* within radius[k] of the centre, cells of 2^k fine cells (k < levels); beyond the last, 2^levels */
+    double radius[kMostLevels];
     int64_t count, capacity;
     int *i0, *j0, *size; /* leaves: lower-left lattice corner and size in fine cells */
 } quadtree;
@@ -52,7 +56,36 @@ static int wanted_size(const quadtree *q, int i0, int j0, int size) {
     const double x0 = -kHalf + i0 * q->h, y0 = -kHalf + j0 * q->h, w = size * q->h;
     const double dx = fmax(0.0, fmax(x0 - q->px, q->px - (x0 + w))), dy = fmax(0.0, fmax(y0 - q->py, q->py - (y0 + w)));
     const double r = hypot(dx, dy);
-    return r < q->r1 ? 1 : r < q->r2 ? 2 : r < q->r3 ? 4 : 8;
+    for (int k = 0; k < q->levels; ++k)
+        if (r < q->radius[k]) return 1 << k;
+    return 1 << q->levels;
+}
+
+/* The quadtree's nodes: lattice points (i, j) numbered from 1 in the order
+ * they are first met, in an open-addressed table (a lattice of the fine
+ * cells would not fit at 512 fine cells a coarse cell). */
+typedef struct {
+    int64_t capacity, count;
+    int64_t *key, *id;     /* key: i + (m + 1) j + 1, 0 for an empty slot */
+    int64_t *node_i, *node_j;
+} node_table;
+
+static int64_t *node_slot(node_table *t, int64_t key) {
+    uint64_t k = (uint64_t)key * 0x9E3779B97F4A7C15ull;
+    for (int64_t at = (int64_t)(k >> 20) & (t->capacity - 1);; at = (at + 1) & (t->capacity - 1))
+        if (t->key[at] == key || t->key[at] == 0) return &t->key[at];
+}
+
+/* The node at (i, j): its number from 1, or 0 where none is (add: make it). */
+static int64_t node_at(node_table *t, int64_t side, int64_t i, int64_t j, int add) {
+    int64_t *slot = node_slot(t, i + side * j + 1);
+    const int64_t at = slot - t->key;
+    if (*slot) return t->id[at];
+    if (!add) return 0;
+    *slot = i + side * j + 1;
+    t->id[at] = ++t->count;
+    t->node_i[t->count - 1] = i, t->node_j[t->count - 1] = j;
+    return t->count;
 }
 
 static void add_leaf(quadtree *q, int i0, int j0, int size) {
@@ -81,10 +114,17 @@ static void add_leaf(quadtree *q, int i0, int j0, int size) {
 /* The quadtree's leaves as polygons: each square's corners and every leaf
  * corner lying on its edges, counter-clockwise. */
 static mesh_scene quadtree_scene(quadtree *q) {
-    for (int j = 0; j < q->m; j += 8)
-        for (int i = 0; i < q->m; i += 8) add_leaf(q, i, j, 8);
+    const int base = 1 << q->levels;
+    for (int j = 0; j < q->m; j += base)
+        for (int i = 0; i < q->m; i += base) add_leaf(q, i, j, base);
     const int64_t side = q->m + 1;
-    int64_t *node_of = xcalloc((size_t)(side * side), sizeof(int64_t));
+    node_table nodes = {0};
+    nodes.capacity = 1024;
+    while (nodes.capacity < 8 * q->count) nodes.capacity *= 2; /* at most 4 corners a leaf: half full at most */
+    nodes.key = xcalloc((size_t)nodes.capacity, sizeof(int64_t));
+    nodes.id = xcalloc((size_t)nodes.capacity, sizeof(int64_t));
+    nodes.node_i = xcalloc((size_t)(4 * q->count), sizeof(int64_t));
+    nodes.node_j = xcalloc((size_t)(4 * q->count), sizeof(int64_t));
     mesh_scene s;
     memset(&s, 0, sizeof s);
     s.kind = SCENE_QUADS;
@@ -92,16 +132,14 @@ static mesh_scene quadtree_scene(quadtree *q) {
         for (int corner = 0; corner < 4; ++corner) {
             const int64_t i = q->i0[c] + (corner == 1 || corner == 2) * q->size[c];
             const int64_t j = q->j0[c] + (corner >= 2) * q->size[c];
-            if (!node_of[i + side * j]) node_of[i + side * j] = ++s.nnodes;
+            node_at(&nodes, side, i, j, 1);
         }
+    s.nnodes = nodes.count;
     s.node_xy = xcalloc((size_t)(2 * s.nnodes), sizeof(double));
-    for (int64_t j = 0; j < side; ++j)
-        for (int64_t i = 0; i < side; ++i) {
-            const int64_t k = node_of[i + side * j];
-            if (!k) continue;
-            s.node_xy[2 * (k - 1)] = -kHalf + (double)i * q->h;
-            s.node_xy[2 * (k - 1) + 1] = -kHalf + (double)j * q->h;
-        }
+    for (int64_t k = 0; k < s.nnodes; ++k) {
+        s.node_xy[2 * k] = -kHalf + (double)nodes.node_i[k] * q->h;
+        s.node_xy[2 * k + 1] = -kHalf + (double)nodes.node_j[k] * q->h;
+    }
     s.npolygons = s.cells = q->count;
     s.cell_start = xcalloc((size_t)s.cells + 1, sizeof(int64_t));
     s.cell_nodes = xcalloc((size_t)(32 * s.cells), sizeof(int64_t));
@@ -115,7 +153,8 @@ static mesh_scene quadtree_scene(quadtree *q) {
         int64_t i = q->i0[c], j = q->j0[c];
         for (int edge = 0; edge < 4; ++edge)
             for (int step = 0; step < q->size[c]; ++step) {
-                if (node_of[i + side * j]) s.cell_nodes[k++] = node_of[i + side * j] - 1;
+                const int64_t node = node_at(&nodes, side, i, j, 0);
+                if (node) s.cell_nodes[k++] = node - 1;
                 i += walk[edge][0], j += walk[edge][1];
             }
         const double w = q->size[c] * q->h;
@@ -124,7 +163,7 @@ static mesh_scene quadtree_scene(quadtree *q) {
         s.area[c] = w * w;
     }
     s.cell_start[s.cells] = k;
-    free(node_of);
+    free(nodes.key), free(nodes.id), free(nodes.node_i), free(nodes.node_j);
     return s;
 }
 
@@ -282,8 +321,8 @@ int cmd_lts(int argc, char **argv) {
     for (size_t p = 0; p < sizeof placements / sizeof placements[0]; ++p) {
         quadtree q;
         memset(&q, 0, sizeof q);
-        q.m = m, q.h = h, q.px = placements[p].px, q.py = placements[p].py;
-        q.r1 = placements[p].r1, q.r2 = q.r1 + 0.4, q.r3 = q.r1 + 0.8;
+        q.m = m, q.levels = 3, q.h = h, q.px = placements[p].px, q.py = placements[p].py;
+        q.radius[0] = placements[p].r1, q.radius[1] = q.radius[0] + 0.4, q.radius[2] = q.radius[0] + 0.8;
         mesh_scene graded = quadtree_scene(&q);
         const int n = (int)lround(sqrt((double)graded.cells));
         mesh_scene uniform = scene_make(SCENE_QUADS, n, kHalf, 1u);
@@ -295,5 +334,136 @@ int cmd_lts(int argc, char **argv) {
         scene_free(&uniform);
         free(q.i0), free(q.j0), free(q.size);
     }
+    return 0;
+}
+
+/* ---- the graded mesh of issue 34's targets ----------------------------------
+ *
+ * dpsm-bench mesh-graded [levels [coarse_across [seconds]]]: a quadtree of
+ * squares from h to 2^levels h (default 9: h..512h) on [-2.5, 2.5]^2, the
+ * coarse cells `coarse_across` (default 48) across; cells of h within 0.06
+ * of (-1.25, 0), each coarser size in a band four of its cells wide beyond.
+ * Three piles (cylinders of height half their radius, 30 degrees, closed
+ * edge), each stepped alone to rest or for `seconds` (default 60) of
+ * stepping, one thread:
+ *   fine      radius 30 h at the fine region's centre;
+ *   coarse    radius 8 coarse cells at (1.25, 0), far from the grading; also
+ *             on a uniform mesh of the coarse squares (its reference);
+ *   straddle  radius 40 h on the fine region's edge (fine cells and cells of
+ *             2h to 8h).
+ * Calls of 4096 of the mesh's sub-steps (the uniform mesh: calls of 0.05). A
+ * run stopped by the budget reports the cell updates per unit of flow time,
+ * and the coarse pile the updates projected to the uniform mesh's rest time
+ * at that rate (an extrapolation, printed as one). Counts (sub-steps, cell
+ * updates) do not depend on the machine; the seconds do. */
+
+typedef struct {
+    const char *name;
+    double x, y, radius;
+} pile;
+
+typedef struct {
+    double substeps, updates, flow_time, seconds;
+    int calls, at_rest;
+} pile_run;
+
+static pile_run run_pile(const mesh_scene *s, const pile *p, double call, double budget) {
+    pile_run r;
+    memset(&r, 0, sizeof r);
+    double *h = xcalloc((size_t)s->cells, sizeof(double));
+    for (int64_t c = 0; c < s->cells; ++c) h[c] = hypot(s->cx[c] - p->x, s->cy[c] - p->y) < p->radius ? 0.5 * p->radius : 0.0;
+    dpsm_grid *g = NULL;
+    CHECK(NULL, scene_create(s, &g));
+    CHECK(g, dpsm_set_threads(g, 1));
+    CHECK(g, dpsm_set_repose_angle(g, 30.0 * kPi / 180.0));
+    CHECK(g, dpsm_set_heights(g, h));
+    while (r.seconds < budget) {
+        const double t0 = now_seconds();
+        CHECK(g, dpsm_step(g, call));
+        r.seconds += now_seconds() - t0;
+        double substeps = 0.0, integrated = 0.0, updates = 0.0, at_rest = 0.0;
+        CHECK(g, dpsm_get_step_info(g, DPSM_INFO_SUBSTEPS, &substeps));
+        CHECK(g, dpsm_get_step_info(g, DPSM_INFO_TIME_INTEGRATED, &integrated));
+        CHECK(g, dpsm_get_step_info(g, DPSM_INFO_CELL_UPDATES, &updates));
+        CHECK(g, dpsm_get_step_info(g, DPSM_INFO_AT_REST, &at_rest));
+        r.substeps += substeps, r.updates += updates, r.flow_time += integrated;
+        ++r.calls;
+        if (at_rest > 0.0) {
+            r.at_rest = 1;
+            break;
+        }
+    }
+    dpsm_destroy(g);
+    free(h);
+    return r;
+}
+
+static void print_pile(const char *mesh, const mesh_scene *s, const pile *p, double sub_dt, const pile_run *r) {
+    printf("%-9s %-8s %7lld %9.3e %6d %10.4e %-4s %10.4e %10.4e %10.4e %8.2f\n", mesh, p->name, (long long)s->cells,
+           sub_dt, r->calls, r->flow_time, r->at_rest ? "yes" : "no", r->substeps, r->updates,
+           r->updates / r->flow_time, r->seconds);
+    fflush(stdout);
+}
+
+int cmd_mesh_graded(int argc, char **argv) {
+    const int levels = argc > 0 ? atoi(argv[0]) : 9;
+    const int across = argc > 1 ? atoi(argv[1]) : 48;
+    const double budget = argc > 2 ? atof(argv[2]) : 60.0;
+    if (levels < 1 || levels >= kMostLevels || across < 8 || !(budget > 0.0)) {
+        fprintf(stderr, "mesh-graded: levels from 1 to %d, at least 8 coarse cells across, a positive budget\n",
+                kMostLevels - 1);
+        return 2;
+    }
+    quadtree q;
+    memset(&q, 0, sizeof q);
+    q.levels = levels;
+    q.m = across << levels;
+    q.h = 2.0 * kHalf / q.m;
+    q.px = -1.25, q.py = 0.0;
+    q.radius[0] = 0.06;
+    for (int k = 1; k < levels; ++k) q.radius[k] = q.radius[k - 1] + 4.0 * (double)(1 << k) * q.h;
+    mesh_scene graded = quadtree_scene(&q);
+    mesh_scene uniform = scene_make(SCENE_QUADS, across, kHalf, 1u);
+    const double coarse = (double)(1 << levels) * q.h;
+    const pile fine = {"fine", q.px, q.py, 30.0 * q.h};
+    const pile far = {"coarse", 1.25, 0.0, 8.0 * coarse};
+    const pile straddle = {"straddle", q.px + q.radius[0], q.py, 40.0 * q.h};
+    dpsm_grid *g = NULL;
+    double graded_dt = 0.0, uniform_dt = 0.0;
+    CHECK(NULL, scene_create(&graded, &g));
+    CHECK(g, dpsm_set_repose_angle(g, 30.0 * kPi / 180.0));
+    CHECK(g, dpsm_stable_dt(g, &graded_dt));
+    dpsm_destroy(g);
+    CHECK(NULL, scene_create(&uniform, &g));
+    CHECK(g, dpsm_set_repose_angle(g, 30.0 * kPi / 180.0));
+    CHECK(g, dpsm_stable_dt(g, &uniform_dt));
+    dpsm_destroy(g);
+    printf("# graded quadtree: %lld squares from h = %.4e to %d h = %.4e (fine within %.2f of (%.2f, %.2f)); uniform: "
+           "%lld squares of %.4e; piles of height half their radius, 30 deg, closed edge, 1 thread; graded calls of "
+           "4096 sub-steps, uniform calls of 0.05; a run stops at rest or after %.0f s of stepping\n",
+           (long long)graded.cells, q.h, 1 << levels, coarse, q.radius[0], q.px, q.py, (long long)uniform.cells,
+           coarse, budget);
+    printf("%-9s %-8s %7s %9s %6s %10s %-4s %10s %10s %10s %8s\n", "mesh", "pile", "cells", "sub_dt", "calls",
+           "flow_time", "rest", "substeps", "updates", "upd/time", "seconds");
+    const pile_run uniform_coarse = run_pile(&uniform, &far, 0.05, budget);
+    print_pile("uniform", &uniform, &far, uniform_dt, &uniform_coarse);
+    const pile_run graded_coarse = run_pile(&graded, &far, 4096.0 * graded_dt, budget);
+    print_pile("graded", &graded, &far, graded_dt, &graded_coarse);
+    const pile_run graded_fine = run_pile(&graded, &fine, 4096.0 * graded_dt, budget);
+    print_pile("graded", &graded, &fine, graded_dt, &graded_fine);
+    const pile_run graded_straddle = run_pile(&graded, &straddle, 4096.0 * graded_dt, budget);
+    print_pile("graded", &graded, &straddle, graded_dt, &graded_straddle);
+    if (uniform_coarse.at_rest) {
+        const double projected = graded_coarse.at_rest
+                                     ? graded_coarse.updates
+                                     : graded_coarse.updates / graded_coarse.flow_time * uniform_coarse.flow_time;
+        printf("# coarse pile: the graded mesh %s %.4e cell updates to the uniform mesh's rest time (t = %.4g), %.1f "
+               "times the uniform mesh's %.4e (target: at most 2)\n",
+               graded_coarse.at_rest ? "took" : "would take, at its measured rate (extrapolated),", projected,
+               uniform_coarse.flow_time, projected / uniform_coarse.updates, uniform_coarse.updates);
+    }
+    scene_free(&graded);
+    scene_free(&uniform);
+    free(q.i0), free(q.j0), free(q.size);
     return 0;
 }
