@@ -36,14 +36,14 @@
 static const double kDeg = 3.14159265358979323846 / 180.0;
 static const scene_kind kKinds[4] = {SCENE_TRIANGLES, SCENE_HEXAGONS, SCENE_DUAL, SCENE_QUADS};
 
-/* The scene's mesh at 30 degrees, on one thread, with the mobility that
- * makes its stable sub-step 1025/1024 of 2^-10: a call of 2^-j (j from 0 to
- * 10) takes sub-steps of exactly 2^-10. */
 /* With it, the meshes dyadic_mesh makes have an angle of repose per cell
  * (28 to 34 degrees across x) and a flux exponent of 1.5, which keep
  * sources in closed form. */
 static int g_angle_field_and_exponent = 0;
 
+/* The scene's mesh at 30 degrees, on one thread, with the mobility that
+ * makes its stable sub-step 1025/1024 of 2^-10: a call of 2^-j (j from 0 to
+ * 10) takes sub-steps of exactly 2^-10. */
 static dpsm_grid *dyadic_mesh(const mesh_scene *s) {
     dpsm_grid *g = NULL;
     CHECK_OK(NULL, scene_create(s, &g));

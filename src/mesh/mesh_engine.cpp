@@ -39,10 +39,10 @@ inline double dense_share(int threads, std::int64_t cells) {
 // a list costs several cells of a plain pass (its data lies scattered).
 constexpr std::int64_t kListItemsForThreads = 4096;
 
-// Calls work(item) for every item of a list, on the threads where the list
-// is long enough. Each item's work must write only its own item's values
-// (every pass is a gather), so the results do not depend on the threads.
-// for_each_place: work(k, item) with the item's place k in the list.
+// Calls work(k, item) for every item of a list and its place k in it, on the
+// threads where the list is long enough. Each item's work must write only
+// its own item's values (every pass is a gather), so the results do not
+// depend on the threads.
 template <class Work>
 void for_each_place(const std::vector<std::int64_t> &list, int threads, const Work &work) {
     const std::int64_t count = static_cast<std::int64_t>(list.size());
@@ -51,6 +51,7 @@ void for_each_place(const std::vector<std::int64_t> &list, int threads, const Wo
 #pragma omp parallel for num_threads(threads) if (parallel) schedule(static)
     for (std::int64_t k = 0; k < count; ++k) work(k, items[k]);
 }
+// The same, work(item) alone.
 template <class Work>
 void for_each_item(const std::vector<std::int64_t> &list, int threads, const Work &work) {
     for_each_place(list, threads, [&](std::int64_t, std::int64_t item) { work(item); });

@@ -2079,8 +2079,8 @@ static int mesh_source_active(const mesh_state_t *ms) {
 static int mesh_source_surely_steep(const mesh_state_t *ms, const double *h, double dt) {
     if (!ms->source) return 0;
     const mesh_t *m = ms->m;
-    double *xy = xcalloc((size_t)(2 * m->ncells), sizeof(double)), *area = xcalloc((size_t)m->ncells, sizeof(double));
-    if (dpsm_get_cell_centres(ms->g, xy, area) != DPSM_OK) die("dpsm_get_cell_centres failed on a mesh");
+    double *xy = xcalloc((size_t)(2 * m->ncells), sizeof(double));
+    if (dpsm_get_cell_centres(ms->g, xy, NULL) != DPSM_OK) die("dpsm_get_cell_centres failed on a mesh");
     const double threshold = tan(DPSM_DEFAULT_REPOSE_ANGLE) * (1.0 + DPSM_DEFAULT_REST_TOLERANCE) * (1.0 + 1e-6);
     int steep = 0;
     for (int64_t f = 0; f < m->nfaces && !steep; ++f) {
@@ -2093,7 +2093,7 @@ static int mesh_source_surely_steep(const mesh_state_t *ms, const double *h, dou
         const double d = hypot(xy[2 * a] - xy[2 * b], xy[2 * a + 1] - xy[2 * b + 1]);
         steep = fabs((h[a] + qa * dt) - (h[b] + qb * dt)) > threshold * d;
     }
-    free(xy), free(area);
+    free(xy);
     return steep;
 }
 
