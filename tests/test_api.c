@@ -481,7 +481,7 @@ static void expect_fresh_grid(const dpsm_grid *g, int64_t nx, int64_t ny) {
     const ledger_t l = read_ledger(g);
     REQUIRE(l.total == 0.0 && l.sourced == 0.0 && l.external == 0.0 && l.outflow == 0.0,
             "fresh ledger %g %g %g %g", l.total, l.sourced, l.external, l.outflow);
-    for (int i = DPSM_INFO_SUBSTEPS; i <= DPSM_INFO_SUBSTEPS_PER_EXCHANGE; ++i) {
+    for (int i = DPSM_INFO_SUBSTEPS; i <= DPSM_INFO_SUBSTEPS_EVALUATED; ++i) {
         double v = 42.0;
         CHECK_OK(g, dpsm_get_step_info(g, i, &v));
         REQUIRE(v == 0.0, "step info %d before the first step = %g, expected 0", i, v);
@@ -1372,7 +1372,7 @@ static void test_step_info(void **state) {
     dpsm_grid *g = NULL;
     CHECK_OK(NULL, dpsm_create_1d(NX, dx, &g));
     double v = -1.0;
-    for (int i = DPSM_INFO_SUBSTEPS; i <= DPSM_INFO_SUBSTEPS_PER_EXCHANGE; ++i) {
+    for (int i = DPSM_INFO_SUBSTEPS; i <= DPSM_INFO_SUBSTEPS_EVALUATED; ++i) {
         CHECK_OK(g, dpsm_get_step_info(g, i, &v));
         REQUIRE(v == 0.0, "info %d before any step: %g", i, v);
     }
@@ -2424,7 +2424,7 @@ static void test_bad_scheme(void **state) {
 
 static void test_bad_relaxation(void **state) {
     fixture_t *fx = *state;
-    const int bad[] = {-1, 3, 4, 255, INT_MAX, INT_MIN};
+    const int bad[] = {-1, DPSM_RELAX_LOCAL_STEPS + 1, 5, 255, INT_MAX, INT_MIN};
     for (size_t k = 0; k < sizeof bad / sizeof *bad; ++k)
         EXPECT_FAIL(fx, dpsm_set_relaxation(fx->g, bad[k]), DPSM_ERR_UNKNOWN_ENUM, "dpsm_set_relaxation", "relaxation");
 }
@@ -2585,10 +2585,10 @@ static void test_bad_get_mass(void **state) {
 static void test_bad_get_step_info(void **state) {
     fixture_t *fx = *state;
     double v = 0.0;
-    const int bad[] = {-1, DPSM_INFO_SUBSTEPS_PER_EXCHANGE + 1, 10, 255, INT_MAX, INT_MIN};
+    const int bad[] = {-1, DPSM_INFO_SUBSTEPS_EVALUATED + 1, 11, 255, INT_MAX, INT_MIN};
     for (size_t k = 0; k < sizeof bad / sizeof *bad; ++k)
         EXPECT_FAIL(fx, dpsm_get_step_info(fx->g, bad[k], &v), DPSM_ERR_UNKNOWN_ENUM, "dpsm_get_step_info", "item");
-    for (int i = DPSM_INFO_SUBSTEPS; i <= DPSM_INFO_SUBSTEPS_PER_EXCHANGE; ++i)
+    for (int i = DPSM_INFO_SUBSTEPS; i <= DPSM_INFO_SUBSTEPS_EVALUATED; ++i)
         EXPECT_FAIL(fx, dpsm_get_step_info(fx->g, i, NULL), DPSM_ERR_NULL_POINTER, "dpsm_get_step_info", "value");
 }
 

@@ -552,17 +552,22 @@ static void test_values_are_checked_behind_the_checksum(void **state) {
     REQUIRE(get_u32(good + kOffsetVersion) == 1, "the small file is of version %u, not 1",
             get_u32(good + kOffsetVersion));
     memcpy(bytes, good, size);
-    put_u32(bytes + kOffsetVersion, 9);
+    put_u32(bytes + kOffsetVersion, 10);
     reseal(bytes, size);
     write_file(bad, bytes, size);
-    require_refused(bad, "written by a newer dpsm, version 9", "version 9");
+    require_refused(bad, "written by a newer dpsm, version 10", "version 10");
 
     /* The relaxations' flags: DPSM_RELAX_AUTO's needs version 3, and a file
      * cannot ask for both. */
     write_with_header(bad, bytes, good, size, 2, 64u);
     require_refused(bad, "need version 3", "the flag of DPSM_RELAX_AUTO in version 2");
     write_with_header(bad, bytes, good, size, 3, 64u | 32u);
-    require_refused(bad, "both relaxation flags", "both relaxations");
+    require_refused(bad, "2 relaxation flags are set", "both relaxations");
+    /* DPSM_RELAX_LOCAL_STEPS's flag needs version 9, and alone. */
+    write_with_header(bad, bytes, good, size, 8, 1u << 18);
+    require_refused(bad, "need version 9", "the flag of DPSM_RELAX_LOCAL_STEPS in version 8");
+    write_with_header(bad, bytes, good, size, 9, (1u << 18) | 64u);
+    require_refused(bad, "2 relaxation flags are set", "local steps and DPSM_RELAX_AUTO");
     /* Version 4's parts need version 4: the recording flag (no data of its own). */
     write_with_header(bad, bytes, good, size, 3, 1u << 12);
     require_refused(bad, "need version 4", "the recording flag in version 3");

@@ -108,6 +108,8 @@ module dpsm
   integer(c_int), parameter, public :: DPSM_RELAX_TO_REST = 1
   !> Relaxations (dpsm_set_relaxation): DPSM_RELAX_AUTO, as in dpsm.h.
   integer(c_int), parameter, public :: DPSM_RELAX_AUTO = 2
+  !> Relaxations (dpsm_set_relaxation): DPSM_RELAX_LOCAL_STEPS, as in dpsm.h.
+  integer(c_int), parameter, public :: DPSM_RELAX_LOCAL_STEPS = 3
   ! Cell kinds (the values of an integer(c_int8_t) kinds array).
   !> Cell kinds (the values of an integer(c_int8_t) kinds array): DPSM_CELL_SAND, as in dpsm.h.
   integer(c_int8_t), parameter, public :: DPSM_CELL_SAND = 0_c_int8_t
@@ -145,6 +147,8 @@ module dpsm
   integer(c_int), parameter, public :: DPSM_INFO_BYTES_SENT = 7
   !> Step information: DPSM_INFO_SUBSTEPS_PER_EXCHANGE, as in dpsm.h.
   integer(c_int), parameter, public :: DPSM_INFO_SUBSTEPS_PER_EXCHANGE = 8
+  !> Step information: DPSM_INFO_SUBSTEPS_EVALUATED, as in dpsm.h.
+  integer(c_int), parameter, public :: DPSM_INFO_SUBSTEPS_EVALUATED = 9
   ! Defaults.
   !> Defaults: DPSM_DEFAULT_REPOSE_ANGLE, as in dpsm.h.
   real(c_double), parameter, public :: DPSM_DEFAULT_REPOSE_ANGLE = 0.52359877559829887_c_double
@@ -1576,8 +1580,9 @@ contains
 
   !> dpsm_set_relaxation(g, relaxation[, ierr]): DPSM_RELAX_AUTO (the default:
   !> sub-steps over dt, as DPSM_RELAX_TIME_ACCURATE),
-  !> DPSM_RELAX_TO_REST (each dpsm_step relaxes to rest, fast) or
-  !> DPSM_RELAX_TIME_ACCURATE (sub-steps over dt).
+  !> DPSM_RELAX_TO_REST (each dpsm_step relaxes to rest, fast),
+  !> DPSM_RELAX_TIME_ACCURATE (sub-steps over dt) or DPSM_RELAX_LOCAL_STEPS
+  !> (sub-steps over dt, each mesh cell at its own pace).
   subroutine dpsm_set_relaxation(g, relaxation, ierr)
     type(dpsm_grid), intent(in) :: g
     integer(c_int), intent(in) :: relaxation

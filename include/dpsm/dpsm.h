@@ -146,6 +146,13 @@ typedef struct dpsm_grid dpsm_grid;
  *  finds fastest among those that land within 1e-3 of them; in this version
  *  they themselves. */
 #define DPSM_RELAX_AUTO 2
+/** Time-accurate sub-steps, each cell of a mesh at the pace of its own
+ *  stable bound (local time steps in power-of-two classes): the model's time
+ *  advances by `dt`, mass is exact and no new extremum appears, but the
+ *  large cells' sub-steps are not those of ::DPSM_RELAX_TIME_ACCURATE, so the
+ *  heights differ from its by their own time error. A host's explicit
+ *  choice; on a grid the same as ::DPSM_RELAX_TIME_ACCURATE. */
+#define DPSM_RELAX_LOCAL_STEPS 3
 /** @} */
 
 /** @name Cell kinds
@@ -228,6 +235,12 @@ typedef struct dpsm_grid dpsm_grid;
  *  exchange of gradients and one of heights in every sub-step). The same on
  *  every rank; 0 on a serial grid. */
 #define DPSM_INFO_SUBSTEPS_PER_EXCHANGE 8
+/** The sub-steps at which it evaluated any face's flux. With local time
+ *  steps (::DPSM_RELAX_LOCAL_STEPS) ::DPSM_INFO_SUBSTEPS counts the sub-steps
+ *  of the smallest class of cells, and this those at which a class near
+ *  moving sand was due: the ticks it passed over cost nothing. Otherwise the
+ *  same as ::DPSM_INFO_SUBSTEPS (and so after dpsm_load()). */
+#define DPSM_INFO_SUBSTEPS_EVALUATED 9
 /** @} */
 
 /** The default angle of repose: 30 degrees, in radians. */
@@ -686,9 +699,26 @@ DPSM_API int dpsm_set_scheme(dpsm_grid *g, int scheme);
  * flow takes 1.05, its summit 5 % lower at that time: a host that needs the
  * flow's timing keeps the default.
  *
+ * ::DPSM_RELAX_LOCAL_STEPS takes time-accurate sub-steps with each cell of a
+ * mesh at the pace of its own stable bound: cells fall into classes whose
+ * sub-steps are 1, 2, 4, ... times the smallest (::DPSM_INFO_SUBSTEPS counts
+ * the smallest class's), a face fires at the sub-steps of the smaller class
+ * of its cells over that class's span, and both its cells take its sand at
+ * once, so mass is exact and no height leaves its neighbours' range. Where
+ * sand moves only on large cells, a step evaluates only at their sub-steps
+ * (::DPSM_INFO_SUBSTEPS_EVALUATED): on a mesh graded from h to 512 h, a
+ * pile on the coarse cells costs about what it costs on a uniform mesh of
+ * them, where the default would take some 1e5 times more. The large cells
+ * step at their own stable size, so the heights differ from the default's
+ * by the time error of that size (on meshes graded from h to 8 h, up to a
+ * fifth of the volume moved during the flow and 2 % at rest;
+ * \ref guide_meshes). A host's explicit choice. dpsm_step() refuses it
+ * (::DPSM_ERR_NOT_APPLICABLE, the grid unchanged) on distributed meshes and
+ * with a bed or a static angle; on a grid it is ::DPSM_RELAX_TIME_ACCURATE.
+ *
  * @param g           the grid.
- * @param relaxation  ::DPSM_RELAX_AUTO, ::DPSM_RELAX_TO_REST or
- *                    ::DPSM_RELAX_TIME_ACCURATE.
+ * @param relaxation  ::DPSM_RELAX_AUTO, ::DPSM_RELAX_TO_REST,
+ *                    ::DPSM_RELAX_TIME_ACCURATE or ::DPSM_RELAX_LOCAL_STEPS.
  * @return ::DPSM_OK, ::DPSM_ERR_NULL_POINTER or ::DPSM_ERR_UNKNOWN_ENUM.
  */
 DPSM_API int dpsm_set_relaxation(dpsm_grid *g, int relaxation);
@@ -914,8 +944,9 @@ DPSM_API int dpsm_get_mass(const dpsm_grid *g, int quantity, double *value);
  * @param item   ::DPSM_INFO_SUBSTEPS, ::DPSM_INFO_TIME_INTEGRATED,
  *               ::DPSM_INFO_AT_REST, ::DPSM_INFO_MAX_EXCESS_SLOPE,
  *               ::DPSM_INFO_CELL_UPDATES, ::DPSM_INFO_RANK_CELL_UPDATES,
- *               ::DPSM_INFO_MESSAGES_SENT, ::DPSM_INFO_BYTES_SENT or
- *               ::DPSM_INFO_SUBSTEPS_PER_EXCHANGE.
+ *               ::DPSM_INFO_MESSAGES_SENT, ::DPSM_INFO_BYTES_SENT,
+ *               ::DPSM_INFO_SUBSTEPS_PER_EXCHANGE or
+ *               ::DPSM_INFO_SUBSTEPS_EVALUATED.
  * @param value  receives the figure (0 for every item before the first step).
  * @return ::DPSM_OK, ::DPSM_ERR_NULL_POINTER or ::DPSM_ERR_UNKNOWN_ENUM.
  */

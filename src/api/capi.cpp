@@ -503,9 +503,9 @@ int dpsm_set_relaxation(dpsm_grid *g, int relaxation) {
     return guarded(g, fn, [&] {
         require_grid(g, fn);
         if (relaxation != DPSM_RELAX_TIME_ACCURATE && relaxation != DPSM_RELAX_TO_REST &&
-            relaxation != DPSM_RELAX_AUTO)
+            relaxation != DPSM_RELAX_AUTO && relaxation != DPSM_RELAX_LOCAL_STEPS)
             fail(DPSM_ERR_UNKNOWN_ENUM, fn, "relaxation = ", relaxation,
-                 " is not DPSM_RELAX_TIME_ACCURATE, DPSM_RELAX_TO_REST or DPSM_RELAX_AUTO");
+                 " is not DPSM_RELAX_TIME_ACCURATE, DPSM_RELAX_TO_REST, DPSM_RELAX_AUTO or DPSM_RELAX_LOCAL_STEPS");
         g->core.set_relaxation(static_cast<dpsm::Relaxation>(relaxation));
     });
 }
@@ -693,11 +693,13 @@ int dpsm_get_step_info(const dpsm_grid *g, int item, double *value) {
             case DPSM_INFO_MESSAGES_SENT: *value = info.messages_sent; break;
             case DPSM_INFO_BYTES_SENT: *value = info.bytes_sent; break;
             case DPSM_INFO_SUBSTEPS_PER_EXCHANGE: *value = info.substeps_per_exchange; break;
+            case DPSM_INFO_SUBSTEPS_EVALUATED: *value = static_cast<double>(info.substeps_evaluated); break;
             default:
                 fail(DPSM_ERR_UNKNOWN_ENUM, fn, "item = ", item,
                      " is not DPSM_INFO_SUBSTEPS, DPSM_INFO_TIME_INTEGRATED, DPSM_INFO_AT_REST,"
                      " DPSM_INFO_MAX_EXCESS_SLOPE, DPSM_INFO_CELL_UPDATES, DPSM_INFO_RANK_CELL_UPDATES,"
-                     " DPSM_INFO_MESSAGES_SENT, DPSM_INFO_BYTES_SENT or DPSM_INFO_SUBSTEPS_PER_EXCHANGE");
+                     " DPSM_INFO_MESSAGES_SENT, DPSM_INFO_BYTES_SENT, DPSM_INFO_SUBSTEPS_PER_EXCHANGE or"
+                     " DPSM_INFO_SUBSTEPS_EVALUATED");
         }
     });
 }

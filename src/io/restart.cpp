@@ -80,9 +80,11 @@ constexpr std::uint32_t kMeshPart = 1u << 16;
 // Version 8: the mesh record's nodes are longitude and latitude in degrees
 // (dpsm_create_mesh_geographic and the dual's); no data of its own.
 constexpr std::uint32_t kMeshGeographic = 1u << 17;
+// Version 9: dpsm_step takes local time steps (DPSM_RELAX_LOCAL_STEPS); no data of its own.
+constexpr std::uint32_t kRelaxLocalSteps = 1u << 18;
 constexpr std::uint32_t kKnownFlags = kHasSource | kHasBed | kHasAngleField | kHasMoving | kIsBlock | kRelaxToRest |
                                       kRelaxAuto | kHasSideOutflows | kHasSideLevels | kRecordsFluxes | kIsMesh |
-                                      kHasEdgeKinds | kMeshFromOne | kMeshPart | kMeshGeographic;
+                                      kHasEdgeKinds | kMeshFromOne | kMeshPart | kMeshGeographic | kRelaxLocalSteps;
 // The flags a file of version 1 cannot hold, those version 2 cannot, and so on.
 constexpr std::uint32_t kVersion2Flags = kIsBlock | kRelaxToRest;
 constexpr std::uint32_t kVersion3Flags = kRelaxAuto;
@@ -91,6 +93,7 @@ constexpr std::uint32_t kVersion5Flags = kIsMesh | kHasEdgeKinds;
 constexpr std::uint32_t kVersion6Flags = kMeshFromOne;
 constexpr std::uint32_t kVersion7Flags = kMeshPart;
 constexpr std::uint32_t kVersion8Flags = kMeshGeographic;
+constexpr std::uint32_t kVersion9Flags = kRelaxLocalSteps;
 // The fixed part of the mesh record: kind, a reserved word, and four counts.
 constexpr std::size_t kMeshRecordBytes = 40;
 
@@ -98,6 +101,7 @@ constexpr std::uint32_t side_levels_flag(int side) { return kHasSideLevelsOfXMin
 
 // The oldest version that holds a file with these flags.
 std::uint32_t version_for(std::uint32_t flags) {
+    if (flags & kVersion9Flags) return 9;
     if (flags & kVersion8Flags) return 8;
     if (flags & kVersion7Flags) return 7;
     if (flags & kVersion6Flags) return 6;
@@ -235,6 +239,7 @@ std::uint32_t flags_of(const Grid &g) {
     if (!g.moving().empty()) flags |= kHasMoving;
     if (g.relaxation() == kToRest) flags |= kRelaxToRest;
     if (g.relaxation() == kAutoRelaxation) flags |= kRelaxAuto;
+    if (g.relaxation() == kLocalSteps) flags |= kRelaxLocalSteps;
     for (const CompensatedSum &account : g.ledger().side_outflow)
         if (account.sum() != 0.0 || account.correction() != 0.0) flags |= kHasSideOutflows;
     for (int side = 0; side < 4; ++side)
@@ -449,6 +454,7 @@ void read_header(Reader &r, Header &h, GridState &s) {
         *account = CompensatedSum(sum, correction);
     }
     s.last_step.substeps = r.i64();
+    s.last_step.substeps_evaluated = s.last_step.substeps;  // not in the file
     s.last_step.time_integrated = r.f64();
     h.at_rest = r.u32();
     s.last_step.max_excess_slope = r.f64();
@@ -563,12 +569,13 @@ void check_layout(const Header &h, const std::string &path, const char *fn) {
     if (h.flags & ~kKnownFlags) bad("unknown array flags ", hex32(h.flags & ~kKnownFlags));
     const std::pair<std::uint32_t, std::uint32_t> needs[] = {
         {kVersion2Flags, 2}, {kVersion3Flags, 3}, {kVersion4Flags, 4}, {kVersion5Flags, 5}, {kVersion6Flags, 6},
-        {kVersion7Flags, 7}, {kVersion8Flags, 8}};
+        {kVersion7Flags, 7}, {kVersion8Flags, 8}, {kVersion9Flags, 9}};
     for (const auto &[flags, version] : needs)
         if ((h.flags & flags) && h.version < version)
             bad("the flags ", hex32(h.flags & flags), " are set in a file of version ", h.version, " (they need version ",
                 version, ")");
-    if ((h.flags & kRelaxToRest) && (h.flags & kRelaxAuto)) bad("both relaxation flags are set");
+    const int relaxations = ((h.flags & kRelaxToRest) != 0) + ((h.flags & kRelaxAuto) != 0) + ((h.flags & kRelaxLocalSteps) != 0);
+    if (relaxations > 1) bad(relaxations, " relaxation flags are set; a file holds at most one");
     if ((h.flags & kRelaxToRest) && h.dim != 2) bad("a grid of dim = ", h.dim, " cannot relax to rest");
     if ((h.flags & kIsBlock) && h.dim != 2) bad("a block of a distributed grid must have dim = 2, not ", h.dim);
     if ((h.flags & kHasEdgeKinds) && !(h.flags & kIsMesh)) bad("edge kinds are set but the file holds no mesh");
@@ -849,9 +856,10 @@ void load_restart(const char *path, Geometry &geometry, GridState &state, Restar
     check_values(header, state, n, source, fn);
     check_block(header, block, source, fn);
     state.scheme = header.scheme == kIsotropic ? kIsotropic : kPairwise;
-    state.relaxation = (header.flags & kRelaxToRest)  ? kToRest
-                       : (header.flags & kRelaxAuto) ? kAutoRelaxation
-                                                     : kTimeAccurate;
+    state.relaxation = (header.flags & kRelaxToRest)       ? kToRest
+                       : (header.flags & kRelaxAuto)       ? kAutoRelaxation
+                       : (header.flags & kRelaxLocalSteps) ? kLocalSteps
+                                                           : kTimeAccurate;
     state.last_step.at_rest = header.at_rest != 0;
     state.record_fluxes = (header.flags & kRecordsFluxes) != 0;
     for (int side = 0; side < 4; ++side) state.side_open[side] = header.side_open[side] != 0;

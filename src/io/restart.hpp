@@ -22,7 +22,7 @@ namespace dpsm {
 // arrays are as a start_index = 1 constructor got them); a mesh from 0 is
 // still written as version 5. Version 7 holds a rank's part of a
 // distributed mesh (its local cells' global ids and owners).
-constexpr std::uint32_t kRestartVersion = 8;
+constexpr std::uint32_t kRestartVersion = 9;
 
 // Where a block file's grid lies in its distributed grid (version 2): its
 // place, which of how many ranks saved it, and the mark that all the files

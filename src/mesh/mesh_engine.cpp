@@ -44,17 +44,23 @@ constexpr std::int64_t kListItemsForThreads = 4096;
 // its own item's values (every pass is a gather), so the results do not
 // depend on the threads.
 template <class Work>
-void for_each_place(const std::vector<std::int64_t> &list, int threads, const Work &work) {
-    const std::int64_t count = static_cast<std::int64_t>(list.size());
-    const std::int64_t *items = list.data();
+void for_each_place(const std::int64_t *items, std::int64_t count, int threads, const Work &work) {
     const bool parallel = threads > 1 && count >= kListItemsForThreads;
 #pragma omp parallel for num_threads(threads) if (parallel) schedule(static)
     for (std::int64_t k = 0; k < count; ++k) work(k, items[k]);
 }
+template <class Work>
+void for_each_place(const std::vector<std::int64_t> &list, int threads, const Work &work) {
+    for_each_place(list.data(), static_cast<std::int64_t>(list.size()), threads, work);
+}
 // The same, work(item) alone.
 template <class Work>
+void for_each_item(const std::int64_t *items, std::int64_t count, int threads, const Work &work) {
+    for_each_place(items, count, threads, [&](std::int64_t, std::int64_t item) { work(item); });
+}
+template <class Work>
 void for_each_item(const std::vector<std::int64_t> &list, int threads, const Work &work) {
-    for_each_place(list, threads, [&](std::int64_t, std::int64_t item) { work(item); });
+    for_each_item(list.data(), static_cast<std::int64_t>(list.size()), threads, work);
 }
 // The share of the room to its bounds a cell's limiter lets the gradient
 // flow's excess fill.
@@ -434,10 +440,14 @@ public:
         // too and exchanges once per batch of sub-steps (mesh/mesh_parts.hpp);
         // the step ends with an exchange, so that a step starts exact.
         const int per_exchange = s.exchange ? m.substeps_per_exchange : 0;
+        // Local time steps: a serial mesh without a bed or a static angle (the stepper refuses the others).
+        const bool local = grid.relaxation() == kLocalSteps;
+        if (local) begin_local_steps(m, s);
         for (std::int64_t k = 0; k < plan.substeps; ++k) {
             double visited = 0.0;
             const int in_batch = per_exchange > 0 ? static_cast<int>(k % per_exchange) + 1 : 0;
-            SubstepSummary did = substep(grid, m, s, plan.sub_dt, static_cast<double>(k), record, visited, in_batch);
+            SubstepSummary did = local ? local_tick(grid, m, s, plan.sub_dt, k, plan.substeps, record, visited)
+                                       : substep(grid, m, s, plan.sub_dt, static_cast<double>(k), record, visited, in_batch);
             info.cell_updates += visited;
             if (parts) {
                 // Every rank takes the same sub-steps and stops at the same one.
@@ -446,10 +456,17 @@ public:
                 did = agreed[0];
             }
             if (s.lazy) did.source_may_steepen = source_may_steepen(grid, m, s, plan.sub_dt, did.moved, k + 1);
+            if (local && did.moved) {
+                // The ticks at which nothing is due pass at once.
+                const std::int64_t next = std::min(next_local_tick(s, k), plan.substeps);
+                if (next > k + 1) did.substeps = next - k;
+            }
             const bool go_on = book(did);
             if (in_batch > 0 && (!go_on || in_batch == per_exchange || k + 1 == plan.substeps)) end_batch(grid, m, s);
             if (!go_on) break;
+            k += did.substeps - 1;
         }
+        if (local) end_local_steps(s);
         if (s.lazy) info.cell_updates += catch_up_sources(grid, s, plan.sub_dt);
     }
 
@@ -479,6 +496,9 @@ private:
         // and where a cell's clock is kept.
         const Heights *lazy;
         double *since;
+        // The faces' fluxes are amounts, volumes over their spans (local
+        // time steps, no bed), not rates over dt.
+        bool amounts = false;
 
         bool operator()(std::int64_t c) const {
             bool carried = false;
@@ -489,10 +509,16 @@ private:
                 // and then takes what the source added since it was current.
                 if (!carried) return false;
                 const double q_c = lazy->q[c];
-                const double increment = dt * (rate + q_c) + source_lag(q_c, dt, lazy->now - since[c]);
+                const double own = amounts ? rate + dt * q_c : dt * (rate + q_c);
+                const double increment = own + source_lag(q_c, dt, lazy->now - since[c]);
                 if (increment != 0.0) add_with_residual(h[c], residual[c], increment);
                 if (q_c != 0.0) since[c] = lazy->now + 1.0;
                 return true;
+            }
+            if (amounts) {
+                if (!q.empty()) rate += dt * q[c];
+                if (rate != 0.0) add_with_residual(h[c], residual[c], rate);
+                return carried;
             }
             if (!q.empty()) rate += zb.empty() ? q[c] : source_applied(zb, h, q, c, dt);
             if (rate != 0.0) add_with_residual(h[c], residual[c], dt * rate);
@@ -679,17 +705,7 @@ private:
                 }
             };
             for (const std::int64_t c : act.hot_list) look_at_faces_of(c);
-            if (!s.flux_clean) {
-                std::fill(s.flux.begin(), s.flux.end(), 0.0);
-                std::fill(s.low.begin(), s.low.end(), 0.0);
-                std::fill(s.high.begin(), s.high.end(), 0.0);
-                std::fill(s.pull.begin(), s.pull.end(), 0.0);
-                std::fill(s.pull_x.begin(), s.pull_x.begin() + m.owned, 0.0);
-                std::fill(s.pull_y.begin(), s.pull_y.begin() + m.owned, 0.0);
-                std::fill(s.limit_in.begin(), s.limit_in.begin() + m.owned, 1.0);
-                std::fill(s.limit_out.begin(), s.limit_out.begin() + m.owned, 1.0);
-                s.flux_clean = true;
-            }
+            clear_passes(m, s);
             if (law.isotropic) {
                 for_each_item(s.gradient_cells, threads,
                               [&](std::int64_t c) { gradient_of(m, law.h, kind.data(), c, s.gx.data(), s.gy.data()); });
@@ -724,19 +740,8 @@ private:
             for_each_item(steep_faces, threads, [&](std::int64_t f) {
                 if (s.face_seen[f] != stamp) face_terms(f);
             });
-            // The owned cells of `faces`, each once, into `cells`.
-            const auto owned_cells_of = [&](const std::vector<std::int64_t> &faces, std::vector<std::int64_t> &cells) {
-                const std::uint32_t listed = next_stamp(s);
-                cells.clear();
-                for (const std::int64_t f : faces)
-                    for (const std::int64_t e : {m.face_a[f], m.face_b[f]})
-                        if (e >= 0 && e < m.owned && s.cell_seen[e] != listed) {
-                            s.cell_seen[e] = listed;
-                            cells.push_back(e);
-                        }
-            };
             // Pulls: the owned cells of steep faces.
-            owned_cells_of(steep_faces, s.pull_cells);
+            owned_cells_of(m, s, steep_faces, s.pull_cells);
             for_each_item(s.pull_cells, threads, [&](std::int64_t c) { pull_of(m, pull, c, pull_x, pull_y); });
             if (exchanges) {
                 // The ghosts that pull: those whose pull changed, and those that pulled before and still do.
@@ -770,39 +775,15 @@ private:
             for_each_item(s.faces, threads,
                           [&](std::int64_t f) { high[f] = gradient_flow_flux(m, law, f, high[f], pull_x, pull_y); });
             // Limiters: the owned cells of those faces.
-            owned_cells_of(s.faces, s.limit_cells);
+            owned_cells_of(m, s, s.faces, s.limit_cells);
             for_each_item(s.limit_cells, threads,
                           [&](std::int64_t c) { limits_of(m, law, low, high, bed, c, limit_in, limit_out); });
             if (exchanges) exchange_ghost_limits(s);
-            // The cells to update: those of faces that carried sand, and the sources.
-            const std::uint32_t update_stamp = next_stamp(s);
-            s.update_cells.clear();
-            const auto to_update = [&](std::int64_t c) {
-                if (c < m.owned && s.cell_seen[c] != update_stamp) {
-                    s.cell_seen[c] = update_stamp;
-                    s.update_cells.push_back(c);
-                }
-            };
             for_each_item(s.faces, threads,
                           [&](std::int64_t f) { flux[f] = limited_flux(m, law, f, low[f], high[f], limit_in, limit_out); });
-            for (const std::int64_t f : s.faces) {
-                if (flux[f] == 0.0) continue;
-                moved = true;
-                max_excess = std::max(max_excess, excess[f]);
-                for (const std::int64_t e : {m.face_a[f], m.face_b[f]})
-                    if (e >= 0) to_update(e);
-            }
-            // Sources at every sub-step (not lazy): every source cell changes.
-            if (!s.lazy)
-                for (const std::int64_t c : s.source_cells) to_update(c);
+            list_updates(m, s, moved, max_excess);
             for_each_item(s.update_cells, threads, [&](std::int64_t c) { update_cell(c); });
-            // Every cell a pass read or wrote, once.
-            const std::uint32_t counted = next_stamp(s);
-            double cells_visited = 0.0;
-            for (const std::vector<std::int64_t> *list : {&s.gradient_cells, &s.pull_cells, &s.limit_cells, &s.update_cells})
-                for (const std::int64_t c : *list)
-                    if (s.cell_seen[c] != counted) s.cell_seen[c] = counted, cells_visited += 1.0;
-            visited = cells_visited;
+            visited = cells_visited(s);
             if (exchanges) exchange_ghost_heights(grid, s, &s.update_cells, changed_ghosts);
             watch_near_moves(m, s, s.update_cells);
             watch_near_moves(m, s, changed_ghosts);
@@ -813,14 +794,7 @@ private:
             for (const std::int64_t c : s.pull_cells) pull_x[c] = pull_y[c] = 0.0;
             for (const std::int64_t c : s.limit_cells) limit_in[c] = limit_out[c] = 1.0;
         }
-        // What went into sinks, face by face in one order whatever the threads.
-        for (const std::int64_t f : s.sink_faces) {
-            const double v = s.flux[f];
-            if (v == 0.0) continue;
-            const std::int64_t b = m.face_b[f];
-            did.outflow_rate += b < 0 ? v : (kind[b] == kOpen ? v : -v);
-            if (b < 0) did.side_outflow_rate[0] += v;
-        }
+        into_sinks(m, s, kind.data(), did);
         if (record) {
             std::vector<double> &faces = grid.face_fluxes().x;
             // A part records the faces of its owned cells only (those beyond carry nothing here).
@@ -837,6 +811,338 @@ private:
         return did;
     }
 
+
+    // Between sparse sub-steps every face's values and every owned cell's
+    // pull hold 0, its limiters 1: after a dense one, they are set so.
+    static void clear_passes(const Mesh &m, MeshState &s) {
+        if (s.flux_clean) return;
+        for (std::vector<double> *v : {&s.flux, &s.low, &s.high, &s.pull}) std::fill(v->begin(), v->end(), 0.0);
+        std::fill(s.pull_x.begin(), s.pull_x.begin() + m.owned, 0.0);
+        std::fill(s.pull_y.begin(), s.pull_y.begin() + m.owned, 0.0);
+        std::fill(s.limit_in.begin(), s.limit_in.begin() + m.owned, 1.0);
+        std::fill(s.limit_out.begin(), s.limit_out.begin() + m.owned, 1.0);
+        s.flux_clean = true;
+    }
+
+    // The owned cells of `faces`, each once, into `cells`.
+    static void owned_cells_of(const Mesh &m, MeshState &s, const std::vector<std::int64_t> &faces,
+                               std::vector<std::int64_t> &cells) {
+        const std::uint32_t listed = next_stamp(s);
+        cells.clear();
+        for (const std::int64_t f : faces)
+            for (const std::int64_t e : {m.face_a[f], m.face_b[f]})
+                if (e >= 0 && e < m.owned && s.cell_seen[e] != listed) {
+                    s.cell_seen[e] = listed;
+                    cells.push_back(e);
+                }
+    }
+
+    // The cells a sparse sub-step updates, each once, into update_cells: the
+    // owned cells of its faces that carried sand and, with sources at every
+    // sub-step (not lazy), every source cell; whether a face carried sand,
+    // and the largest excess slope of those that did.
+    static void list_updates(const Mesh &m, MeshState &s, bool &moved, double &max_excess) {
+        const std::uint32_t listed = next_stamp(s);
+        s.update_cells.clear();
+        const auto to_update = [&](std::int64_t c) {
+            if (c < m.owned && s.cell_seen[c] != listed) {
+                s.cell_seen[c] = listed;
+                s.update_cells.push_back(c);
+            }
+        };
+        for (const std::int64_t f : s.faces) {
+            if (s.flux[f] == 0.0) continue;
+            moved = true;
+            max_excess = std::max(max_excess, s.excess[f]);
+            for (const std::int64_t e : {m.face_a[f], m.face_b[f]})
+                if (e >= 0) to_update(e);
+        }
+        if (!s.lazy)
+            for (const std::int64_t c : s.source_cells) to_update(c);
+    }
+
+    // The cells a sparse sub-step's passes read or wrote, each once.
+    static double cells_visited(MeshState &s) {
+        const std::uint32_t counted = next_stamp(s);
+        double cells = 0.0;
+        for (const std::vector<std::int64_t> *list : {&s.gradient_cells, &s.pull_cells, &s.limit_cells, &s.update_cells})
+            for (const std::int64_t c : *list)
+                if (s.cell_seen[c] != counted) s.cell_seen[c] = counted, cells += 1.0;
+        return cells;
+    }
+
+    // What went into sinks in a sub-step, face by face in one order whatever
+    // the threads, as rates (the faces' fluxes).
+    static void into_sinks(const Mesh &m, const MeshState &s, const std::uint8_t *kind, SubstepSummary &did) {
+        for (const std::int64_t f : s.sink_faces) {
+            const double v = s.flux[f];
+            if (v == 0.0) continue;
+            const std::int64_t b = m.face_b[f];
+            did.outflow_rate += b < 0 ? v : (kind[b] == kOpen ? v : -v);
+            if (b < 0) did.side_outflow_rate[0] += v;
+        }
+    }
+
+    // Local time steps (mesh/step_classes.hpp). Tick j of n of sub_dt fires
+    // the faces of the classes due at it; the faces' values are amounts over
+    // their spans, so the limiter's sub-step is 1. Between ticks every
+    // face's values and every cell's pull hold 0 and its limiters 1, as
+    // between sparse sub-steps. While every cell is hot a tick runs over the
+    // prefixes of the classes' lists; else over the due faces of the hot
+    // cells and the steep faces, as a sparse sub-step does, and a hot cell
+    // stays hot until all its faces have fired.
+    SubstepSummary local_tick(Grid &grid, const Mesh &m, MeshState &s, double sub_dt, std::int64_t j, std::int64_t n,
+                              bool record, double &visited) const {
+        const StepClasses &sc = *s.classes;
+        const int level = sc.level_of_tick(j);
+        const int threads = grid.step_threads();
+        const std::vector<std::uint8_t> &kind = grid.kinds();
+        MeshActivity &act = s.activity;
+        const FaceLaw law =
+            law_of(grid, heights_read(grid, s, sub_dt, static_cast<double>(j)), s.gx.data(), s.gy.data(), 1.0);
+        const CellUpdate update_cell{m,
+                                     s.flux.data(),
+                                     kind.data(),
+                                     grid.source(),
+                                     grid.bed(),
+                                     grid.heights_for_stepping(),
+                                     grid.residuals_for_stepping(),
+                                     sub_dt,
+                                     s.lazy ? &law.h : nullptr,
+                                     s.since.data(),
+                                     true};
+        double *low = s.low.data(), *high = s.high.data(), *pull = s.pull.data(), *flux = s.flux.data();
+        double *pull_x = s.pull_x.data(), *pull_y = s.pull_y.data(), *excess = s.excess.data();
+        double *limit_in = s.limit_in.data(), *limit_out = s.limit_out.data();
+        std::uint8_t *steep = s.steep.data();
+        // Face f's terms as amounts over its span.
+        const auto terms_of = [&](std::int64_t f) {
+            const FaceTerms t = law.terms(f);
+            const double span = static_cast<double>(StepClasses::span(sc.face_class[f], j, n)) * sub_dt;
+            low[f] = t.low * span, high[f] = t.two_point * span, pull[f] = t.pull * span, excess[f] = t.excess;
+            steep[f] = t.steep;
+            return t.steep;
+        };
+        const auto gradient = [&](std::int64_t c) { gradient_of(m, law.h, kind.data(), c, s.gx.data(), s.gy.data()); };
+        const auto flow = [&](std::int64_t f) { high[f] = gradient_flow_flux(m, law, f, high[f], pull_x, pull_y); };
+        const auto limit = [&](std::int64_t c) { limits_of(m, law, low, high, nullptr, c, limit_in, limit_out); };
+        const auto limited = [&](std::int64_t f) { flux[f] = limited_flux(m, law, f, low[f], high[f], limit_in, limit_out); };
+        SubstepSummary did;
+        const auto carried = [&](std::int64_t f) {
+            if (flux[f] == 0.0) return false;
+            did.moved = true;
+            did.max_excess_slope = std::max(did.max_excess_slope, excess[f]);
+            return true;
+        };
+        // The faces whose values the tick wrote, the cells whose pulls it wrote.
+        const std::int64_t *written_faces, *pulled_cells;
+        std::int64_t written_count, pulled_count;
+
+        if (act.all_hot) {
+            const std::int64_t *firing = sc.firing_faces.data(), *reading = sc.reading_cells.data();
+            const std::int64_t *carrying = sc.carrying_faces.data(), *taking = sc.taking_cells.data();
+            const std::int64_t firing_n = sc.firing_end[level], reading_n = sc.reading_end[level];
+            const std::int64_t carrying_n = sc.carrying_end[level], taking_n = sc.taking_end[level];
+            if (law.isotropic) for_each_item(reading, reading_n, threads, gradient);
+            for_each_item(firing, firing_n, threads, terms_of);
+            for_each_item(reading, reading_n, threads, [&](std::int64_t c) { pull_of(m, pull, c, pull_x, pull_y); });
+            for_each_item(carrying, carrying_n, threads, flow);
+            for_each_item(taking, taking_n, threads, limit);
+            for_each_item(carrying, carrying_n, threads, limited);
+            for (std::int64_t k = 0; k < carrying_n; ++k) carried(carrying[k]);
+            std::uint8_t *changed = s.carried.data();
+            for_each_item(taking, taking_n, threads, [&](std::int64_t c) {
+                changed[c] = update_cell(c);
+                limit_in[c] = limit_out[c] = 1.0;
+            });
+            std::int64_t changed_cells = 0;
+            for (std::int64_t k = 0; k < taking_n; ++k)
+                if (changed[taking[k]]) {
+                    ++changed_cells;
+                    if (s.lazy) watch_near_moves(m, s, taking[k]);
+                }
+            visited = static_cast<double>(taking_n);
+            // Where every face has fired and few cells changed, the ticks
+            // after look at those cells and the steep faces alone.
+            const double most = dense_share(threads, m.owned) * static_cast<double>(m.owned);
+            if (level == sc.top && !s.switches.visit_all_cells &&
+                static_cast<double>(changed_cells + kept_hot_by_sources(s)) <= most) {
+                act.all_hot = false;
+                for (std::int64_t c = 0; c < m.owned; ++c)
+                    if (changed[c]) wake_local_around(m, s, c);
+                if (s.lazy)
+                    for (const std::int64_t c : s.watched_cells) wake_local(s, c);
+                for (std::vector<std::int64_t> &listed : s.steep_by_level) listed.clear();
+                for (std::int64_t f = 0; f < m.live_faces; ++f)
+                    if (steep[f]) s.steep_by_level[sc.face_class[f]].push_back(f);
+            }
+            written_faces = carrying, written_count = carrying_n, pulled_cells = reading, pulled_count = reading_n;
+        } else {
+            const std::uint32_t stamp = next_stamp(s);
+            s.faces.clear();
+            s.gradient_cells.clear();
+            for (int l = 0; l <= level; ++l) {
+                std::vector<std::int64_t> &hot = s.hot_by_level[static_cast<std::size_t>(l)];
+                std::size_t kept = 0;
+                for (const std::int64_t c : hot) {
+                    for (std::int64_t k = m.cell_face_start[c]; k < m.cell_face_start[c + 1]; ++k) {
+                        const std::int64_t f = m.cell_faces[k];
+                        if (f >= m.live_faces || sc.face_class[f] > level || s.face_seen[f] == stamp) continue;
+                        s.face_seen[f] = stamp;
+                        s.faces.push_back(f);
+                        for (const std::int64_t e : {m.face_a[f], m.face_b[f]})
+                            if (e >= 0 && s.cell_seen[e] != stamp) {
+                                s.cell_seen[e] = stamp;
+                                s.gradient_cells.push_back(e);
+                            }
+                    }
+                    if (sc.coarsest[c] <= level)
+                        act.hot[c] = 0;
+                    else
+                        hot[kept++] = c;
+                }
+                hot.resize(kept);
+            }
+            if (law.isotropic) for_each_item(s.gradient_cells, threads, gradient);
+            std::vector<std::uint8_t> &became_steep = s.became_steep;
+            became_steep.resize(s.faces.size());
+            for_each_place(s.faces, threads, [&](std::int64_t k, std::int64_t f) {
+                const bool was = steep[f] != 0;
+                became_steep[static_cast<std::size_t>(k)] = terms_of(f) && !was;
+            });
+            for (std::size_t k = 0; k < s.faces.size(); ++k)
+                if (became_steep[k]) s.steep_by_level[sc.face_class[s.faces[k]]].push_back(s.faces[k]);
+            // Each due steep face once; those not looked at fire as they are.
+            std::vector<std::int64_t> &due = s.limit_cells;  // scratch until the limiters' list
+            due.clear();
+            for (int l = 0; l <= level; ++l) {
+                std::vector<std::int64_t> &listed = s.steep_by_level[static_cast<std::size_t>(l)];
+                std::size_t kept = 0;
+                for (const std::int64_t f : listed)
+                    if (steep[f] == 1) {
+                        steep[f] = 2, listed[kept++] = f;
+                        if (s.face_seen[f] != stamp) due.push_back(f);
+                    }
+                listed.resize(kept);
+                for (const std::int64_t f : listed) steep[f] = 1;
+            }
+            for_each_item(due, threads, terms_of);
+            // The due steep faces: their cells pull.
+            due.clear();
+            for (int l = 0; l <= level; ++l)
+                for (const std::int64_t f : s.steep_by_level[static_cast<std::size_t>(l)])
+                    if (steep[f]) due.push_back(f);
+            owned_cells_of(m, s, due, s.pull_cells);
+            for_each_item(s.pull_cells, threads, [&](std::int64_t c) { pull_of(m, pull, c, pull_x, pull_y); });
+            const std::uint32_t carrying = next_stamp(s);
+            std::vector<std::int64_t> &faces = s.update_cells;  // scratch until the updates' list
+            faces.clear();
+            const auto carry = [&](std::int64_t f) {
+                if (f >= m.live_faces || s.face_seen[f] == carrying) return;
+                s.face_seen[f] = carrying;
+                faces.push_back(f);
+            };
+            for (const std::int64_t f : due) carry(f);
+            for (const std::int64_t c : s.pull_cells)
+                for (std::int64_t k = m.cell_face_start[c]; k < m.cell_face_start[c + 1]; ++k) carry(m.cell_faces[k]);
+            s.faces.swap(faces);
+            for_each_item(s.faces, threads, flow);
+            owned_cells_of(m, s, s.faces, s.limit_cells);
+            for_each_item(s.limit_cells, threads, limit);
+            for_each_item(s.faces, threads, limited);
+            list_updates(m, s, did.moved, did.max_excess_slope);
+            for_each_item(s.update_cells, threads, [&](std::int64_t c) { update_cell(c); });
+            visited = cells_visited(s);
+            watch_near_moves(m, s, s.update_cells);
+            for (const std::int64_t c : s.update_cells) wake_local_around(m, s, c);
+            if (s.lazy)
+                for (const std::int64_t c : s.watched_cells) wake_local(s, c);
+            for (const std::int64_t c : s.limit_cells) limit_in[c] = limit_out[c] = 1.0;
+            written_faces = s.faces.data(), written_count = static_cast<std::int64_t>(s.faces.size());
+            pulled_cells = s.pull_cells.data(), pulled_count = static_cast<std::int64_t>(s.pull_cells.size());
+            // Most of the mesh hot: the ticks run over the classes' lists until every face has fired.
+            std::size_t hot_cells = 0;
+            for (const std::vector<std::int64_t> &hot : s.hot_by_level) hot_cells += hot.size();
+            if (static_cast<double>(hot_cells) > dense_share(threads, m.owned) * static_cast<double>(m.owned)) {
+                for (std::vector<std::int64_t> &hot : s.hot_by_level) {
+                    for (const std::int64_t c : hot) act.hot[c] = 0;
+                    hot.clear();
+                }
+                act.all_hot = true;
+            }
+        }
+        // The sinks' amounts as rates over the tick.
+        into_sinks(m, s, kind.data(), did);
+        did.outflow_rate /= sub_dt;
+        did.side_outflow_rate[0] /= sub_dt;
+        if (record) {
+            std::vector<double> &faces = grid.face_fluxes().x;
+            for (std::int64_t k = 0; k < written_count; ++k) faces[written_faces[k]] += flux[written_faces[k]];
+        }
+        for (std::int64_t k = 0; k < written_count; ++k) {
+            const std::int64_t f = written_faces[k];
+            flux[f] = low[f] = high[f] = pull[f] = excess[f] = 0.0;
+        }
+        for (std::int64_t k = 0; k < pulled_count; ++k) pull_x[pulled_cells[k]] = pull_y[pulled_cells[k]] = 0.0;
+        // Sand that may still move: it moved, or a hot cell waits for its
+        // faces' classes, or every cell is hot and not every face has fired.
+        did.moved = did.moved || next_local_tick(s, j) >= 0;
+        return did;
+    }
+
+    // After tick j: the next tick at which a face may fire (every tick while
+    // every cell is hot; else the first whose level reaches the finest class
+    // of a hot cell's faces, where a face may start to carry sand or keeps
+    // carrying it: one that carried sand at its last firing woke its cells),
+    // or -1 where no cell is hot. Between them nothing moves but the lazy
+    // sources, in closed form.
+    static std::int64_t next_local_tick(const MeshState &s, std::int64_t j) {
+        if (s.activity.all_hot || (!s.lazy && !s.source_cells.empty())) return j + 1;
+        for (std::size_t l = 0; l < s.hot_by_level.size(); ++l)
+            if (!s.hot_by_level[l].empty()) return ((j >> l) + 1) << l;
+        return -1;
+    }
+
+    // Local time steps: the hot cells kept by the finest class of their faces.
+    static void wake_local(MeshState &s, std::int64_t c) {
+        MeshActivity &act = s.activity;
+        if (act.all_hot || act.hot[c]) return;
+        act.hot[c] = 1;
+        s.hot_by_level[s.classes->finest[c]].push_back(c);
+    }
+    static void wake_local_around(const Mesh &m, MeshState &s, std::int64_t c) {
+        wake_local(s, c);
+        for (std::int64_t k = m.grad_start[c]; k < m.grad_start[c + 1]; ++k) wake_local(s, m.grad_cells[k]);
+    }
+
+    // Before the first tick of a step with local time steps: the classes
+    // (once per grid), the passes' values as between sparse sub-steps, and
+    // the hot cells by level.
+    static void begin_local_steps(const Mesh &m, MeshState &s) {
+        if (!s.classes) s.classes = std::make_unique<const StepClasses>(step_classes_of(m));
+        clear_passes(m, s);
+        std::fill(s.excess.begin(), s.excess.end(), 0.0);
+        s.hot_by_level.resize(static_cast<std::size_t>(s.classes->top) + 1);
+        MeshActivity &act = s.activity;
+        if (s.switches.visit_all_cells) act.wake_all();
+        for (const std::int64_t c : act.hot_list) s.hot_by_level[s.classes->finest[c]].push_back(c);
+        act.hot_list.clear();
+        s.steep_by_level.resize(s.hot_by_level.size());
+        for (const std::int64_t f : s.steep_faces) s.steep_by_level[s.classes->face_class[f]].push_back(f);
+        s.steep_faces.clear();
+    }
+    // After the last tick: the hot cells and the steep faces back where sub-steps keep them.
+    static void end_local_steps(MeshState &s) {
+        MeshActivity &act = s.activity;
+        for (std::vector<std::int64_t> &hot : s.hot_by_level) {
+            act.hot_list.insert(act.hot_list.end(), hot.begin(), hot.end());
+            hot.clear();
+        }
+        for (std::vector<std::int64_t> &listed : s.steep_by_level) {
+            s.steep_faces.insert(s.steep_faces.end(), listed.begin(), listed.end());
+            listed.clear();
+        }
+    }
 
     // Sources in closed form (lazy sources). A source that cannot make a
     // face steep needs no sub-steps: the stored height of a sand cell

@@ -5,8 +5,10 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <vector>
 
+#include "mesh/step_classes.hpp"
 #include "model/grid.hpp"
 #include "model/switches.hpp"
 
@@ -124,6 +126,16 @@ struct MeshState final : EngineState {
     std::vector<std::int64_t> ghost_source_cells;  // a part's ghosts with a source, stepped where they are in reach
     std::vector<std::int64_t> sink_faces;          // faces onto open edges or open cells
     bool lists_current = false;
+
+    // Local time steps (DPSM_RELAX_LOCAL_STEPS, mesh/step_classes.hpp): the
+    // classes, found at the first step that takes them; in a step, a bit per
+    // class found quiet since sand last moved.
+    std::unique_ptr<const StepClasses> classes;
+    // In a step, the hot cells (the activity's hot_list moves here) by the
+    // finest class of their faces: a tick reads the levels it fires.
+    std::vector<std::vector<std::int64_t>> hot_by_level;
+    // And the steep faces (steep_faces moves here) by their classes.
+    std::vector<std::vector<std::int64_t>> steep_by_level;
 };
 
 MeshState &mesh_state(Grid &grid);

@@ -32,6 +32,9 @@ struct SubstepSummary {
     // A lazy source may still make a face steep before the step ends: sand
     // moved near it after the step's start judged it (no rest before the end).
     bool source_may_steepen = false;
+    // The sub-steps it stands for: more than 1 where local time steps
+    // (mesh/step_classes.hpp) skip the ticks at which nothing is due.
+    std::int64_t substeps = 1;
 };
 
 // Books one sub-step in the ledger; false once the surface is found at rest

@@ -32,7 +32,7 @@ SideLevelRange side_level_range(const std::array<bool, 4> &open, const std::arra
 
 enum Scheme { kPairwise = 0, kIsotropic = 1 };
 // How dpsm_step moves the surface (the values of DPSM_RELAX_*).
-enum Relaxation { kTimeAccurate = 0, kToRest = 1, kAutoRelaxation = 2 };
+enum Relaxation { kTimeAccurate = 0, kToRest = 1, kAutoRelaxation = 2, kLocalSteps = 3 };
 
 struct Geometry {
     int dim;             // 1 or 2
@@ -70,6 +70,7 @@ class Distribution;
 // What the last step did, for dpsm_get_step_info.
 struct StepInfo {
     std::int64_t substeps = 0;
+    std::int64_t substeps_evaluated = 0;  // less than substeps where local time steps passed ticks over
     double time_integrated = 0.0;
     bool at_rest = false;
     double max_excess_slope = 0.0;

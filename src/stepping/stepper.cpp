@@ -118,6 +118,23 @@ void take_part_refusing(Grid &grid) {
     }
 }
 
+// Local time steps (DPSM_RELAX_LOCAL_STEPS) take a serial mesh without a bed
+// or a static angle in this version; on a grid, whose cells share one size,
+// they are the time-accurate sub-steps.
+void require_local_steps_apply(Grid &grid) {
+    const char *what = nullptr;
+    if (grid.distribution() && grid.geometry().is_mesh())
+        what = "a distributed mesh";
+    else if (!grid.bed().empty())
+        what = "a bed (dpsm_set_bedrock)";
+    else if (grid.hysteresis())
+        what = "a static angle (dpsm_set_static_angle)";
+    if (!what || !grid.geometry().is_mesh()) return;
+    take_part_refusing(grid);
+    fail(DPSM_ERR_NOT_APPLICABLE, "dpsm_step", "local time steps (DPSM_RELAX_LOCAL_STEPS) do not take ", what,
+         " in this version; step with DPSM_RELAX_AUTO");
+}
+
 }  // namespace
 
 void step(Grid &grid, double dt) {
@@ -126,6 +143,7 @@ void step(Grid &grid, double dt) {
         if (!std::isfinite(dt)) fail(DPSM_ERR_INVALID_VALUE, "dpsm_step", "dt = ", dt, " is not finite");
         fail(DPSM_ERR_INVALID_VALUE, "dpsm_step", "dt = ", dt, " must be positive");
     }
+    if (grid.relaxation() == kLocalSteps) require_local_steps_apply(grid);
     // The default advances the model's time by dt, as the time-accurate
     // steps do; relaxing straight to rest is a host's explicit choice.
     if (grid.relaxation() != kToRest) {
@@ -221,9 +239,10 @@ void step_in_time(Grid &grid, double dt, std::int64_t most) {
         if (source_capped)
             ledger.sourced.add(did.sourced_mass);
         else if (source_active && !lazy)
-            ledger.sourced.add(grid.source_mass_rate() * sub_dt);
+            ledger.sourced.add(grid.source_mass_rate() * sub_dt * static_cast<double>(did.substeps));
         if (did.unmet_mass != 0.0) ledger.unmet.add(did.unmet_mass);  // erosion that found no sand above the bed
-        ++info.substeps;
+        info.substeps += did.substeps;
+        ++info.substeps_evaluated;
         return true;
     };
     engine.advance(grid, plan, book, info);

@@ -569,6 +569,7 @@ bool relax_to_rest(Grid &grid, std::int64_t budget, double &cells_visited) {
     // time-accurate sub-step that finds rest is not: a step on a surface at
     // rest reads 0, however it was found so.
     info.substeps = rates.evaluations() - (rested ? 1 : 0);
+    info.substeps_evaluated = info.substeps;
     info.at_rest = rested;
     info.max_excess_slope = rested ? 0.0 : last_excess;
     info.cell_updates = rates.cells_visited() - (rested ? rates.cells_visited_last() : 0.0);

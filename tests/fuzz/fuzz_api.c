@@ -154,7 +154,9 @@ typedef struct {
 } slot_t;
 
 /* The step information items this header knows (a newer header may add some). */
-#if defined(DPSM_INFO_SUBSTEPS_PER_EXCHANGE)
+#if defined(DPSM_INFO_SUBSTEPS_EVALUATED)
+#define NINFO (DPSM_INFO_SUBSTEPS_EVALUATED + 1)
+#elif defined(DPSM_INFO_SUBSTEPS_PER_EXCHANGE)
 #define NINFO (DPSM_INFO_SUBSTEPS_PER_EXCHANGE + 1)
 #elif defined(DPSM_INFO_BYTES_SENT)
 #define NINFO (DPSM_INFO_BYTES_SENT + 1)
@@ -2457,9 +2459,15 @@ static void mesh_operation(mesh_state_t *ms, reader_t *r) {
             }
             break;
         }
-        case 8: { /* dpsm_set_max_substeps */
+        case 8: { /* b < 0x80: dpsm_set_max_substeps; else dpsm_set_relaxation, b & 1: local time steps, or the default */
             static const int64_t values[] = {1, 3, 50, MESH_MAX_SUBSTEPS};
-            const int64_t v = values[u8(r) % COUNT(values)];
+            const unsigned b = u8(r);
+            if (b & 0x80) {
+                const int relaxation = b & 1 ? DPSM_RELAX_LOCAL_STEPS : DPSM_RELAX_AUTO;
+                MESH_CALL(ms, DPSM_OK, "dpsm_set_relaxation", dpsm_set_relaxation(ms->g, relaxation));
+                break;
+            }
+            const int64_t v = values[b % COUNT(values)];
             MESH_CALL(ms, DPSM_OK, "dpsm_set_max_substeps", dpsm_set_max_substeps(ms->g, v));
             ms->max_substeps = v;
             break;

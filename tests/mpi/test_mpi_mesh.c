@@ -742,6 +742,32 @@ static int create_part(const part_t *p, dpsm_grid **g) {
                                 p->global_id, p->owner, g);
 }
 
+/* Local time steps (DPSM_RELAX_LOCAL_STEPS) are refused on a distributed
+ * mesh in this version, on every rank, the heights unchanged; the default
+ * steps again. */
+static void local_steps_refused(void) {
+    mesh_t m = lattice(12, 1);
+    int *owner = xcalloc((size_t)m.ncells, sizeof(int));
+    partition(&m, PART_STRIPS, owner);
+    part_t p = part_of(&m, owner, 2);
+    dpsm_grid *g = NULL;
+    OK(NULL, create_part(&p, &g));
+    double *h = xcalloc((size_t)p.ncells, sizeof(double)), *after = xcalloc((size_t)p.ncells, sizeof(double));
+    for (int64_t k = 0; k < p.ncells; ++k) h[k] = column(&m, p.global[k]);
+    OK(g, dpsm_set_heights(g, h));
+    OK(g, dpsm_set_relaxation(g, DPSM_RELAX_LOCAL_STEPS));
+    require_failed_alike(g, dpsm_step(g, 0.01), "distributed mesh", "local time steps on a distributed mesh");
+    OK(g, dpsm_get_heights(g, after));
+    require(memcmp(h, after, sizeof(double) * (size_t)p.ncells) == 0, "a refused step changed the heights");
+    OK(g, dpsm_set_relaxation(g, DPSM_RELAX_AUTO));
+    OK(g, dpsm_step(g, 0.01));
+    dpsm_destroy(g);
+    free(h), free(after);
+    free_part(&p);
+    free(owner);
+    free_mesh(&m);
+}
+
 static void inconsistent_partitions(void) {
     if (size_ < 2) return;
     mesh_t m = lattice(12, 1);
@@ -893,6 +919,7 @@ int main(int argc, char **argv) {
                    failed ? "FAILED, see above" : "heights bit for bit, ranks far from the pile idle");
         free_mesh(&m);
     }
+    local_steps_refused();
     inconsistent_partitions();
     long total = 0, all_checks = 0;
     MPI_Allreduce(&failures_, &total, 1, MPI_LONG, MPI_SUM, MPI_COMM_WORLD);

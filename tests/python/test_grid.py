@@ -273,15 +273,16 @@ class Test2D(LedgerMixin, unittest.TestCase):
             self.assertEqual(g.get_step_info(dpsm.INFO_AT_REST), 1.0)
             same_as_timed()
             self.assertLedger(g)
-            self.assertFails(dpsm.ERR_UNKNOWN_ENUM, g.set_relaxation, 3)
+            self.assertFails(dpsm.ERR_UNKNOWN_ENUM, g.set_relaxation, dpsm.RELAX_LOCAL_STEPS + 1)
 
     def test_step_to_rest(self):
         g = self.g
         g.set_repose_angle(0.6)
         for item in (dpsm.INFO_SUBSTEPS, dpsm.INFO_TIME_INTEGRATED, dpsm.INFO_AT_REST, dpsm.INFO_MAX_EXCESS_SLOPE,
-                     dpsm.INFO_CELL_UPDATES, dpsm.INFO_RANK_CELL_UPDATES, dpsm.INFO_MESSAGES_SENT, dpsm.INFO_BYTES_SENT, dpsm.INFO_SUBSTEPS_PER_EXCHANGE):
+                     dpsm.INFO_CELL_UPDATES, dpsm.INFO_RANK_CELL_UPDATES, dpsm.INFO_MESSAGES_SENT, dpsm.INFO_BYTES_SENT, dpsm.INFO_SUBSTEPS_PER_EXCHANGE,
+                     dpsm.INFO_SUBSTEPS_EVALUATED):
             self.assertEqual(g.get_step_info(item), 0.0)
-        self.assertFails(dpsm.ERR_UNKNOWN_ENUM, g.get_step_info, dpsm.INFO_SUBSTEPS_PER_EXCHANGE + 1)
+        self.assertFails(dpsm.ERR_UNKNOWN_ENUM, g.get_step_info, dpsm.INFO_SUBSTEPS_EVALUATED + 1)
         g.set_heights(self.cone)
         total = g.get_mass(dpsm.MASS_TOTAL)
         g.step(100.0)
@@ -825,6 +826,27 @@ class TestMesh(LedgerMixin, unittest.TestCase):
             # A mesh has no blocks and no x or y sides.
             self.assertFails(dpsm.ERR_NOT_APPLICABLE, g.get_heights_region, 0, 0, 1, 1)
             self.assertFails(dpsm.ERR_NOT_APPLICABLE, g.set_boundary, dpsm.XMIN, dpsm.OPEN)
+
+    def test_local_steps(self):
+        """RELAX_LOCAL_STEPS on a graded strip of squares (1, 2, 4, 8 wide): mass kept, the large cells' ticks
+        passed over (INFO_SUBSTEPS_EVALUATED below INFO_SUBSTEPS), and a bed refused."""
+        xs = [0.0]
+        for width in (1.0,) * 4 + (2.0,) * 4 + (4.0,) * 4 + (8.0,) * 4:
+            xs.append(xs[-1] + width)
+        node_xy = [(x, y) for y in (0.0, 8.0) for x in xs]
+        n = len(xs)
+        cell_nodes = [k for i in range(n - 1) for k in (i, i + 1, n + i + 1, n + i)]
+        with dpsm.Grid.create_mesh(node_xy, list(range(0, 4 * n - 3, 4)), cell_nodes) as g:
+            g.set_relaxation(dpsm.RELAX_LOCAL_STEPS)
+            g.set_heights([0.0] * 12 + [10.0, 0.0, 0.0, 0.0])
+            total = g.get_mass(dpsm.MASS_TOTAL)
+            g.step(1000.0)
+            self.assertEqual(g.get_step_info(dpsm.INFO_AT_REST), 1.0)
+            self.assertLess(g.get_step_info(dpsm.INFO_SUBSTEPS_EVALUATED), g.get_step_info(dpsm.INFO_SUBSTEPS))
+            self.assertAlmostEqual(g.get_mass(dpsm.MASS_TOTAL), total, delta=1e-12 * total)
+            self.assertLedger(g)
+            g.set_bedrock([0.0] * 16)
+            self.assertFails(dpsm.ERR_NOT_APPLICABLE, g.step, 1.0)
 
     def test_aliases_and_flat_input(self):
         flat_xy = [v for xy in self.node_xy for v in xy]

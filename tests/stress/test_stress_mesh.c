@@ -16,7 +16,9 @@
  *   sand that differ face by face, then all at one level, to rest;
  *   walls, open cells and sources mixed; erosion (far more than there is)
  *   and deposition over a bed;
- *   many small steps.
+ *   many small steps;
+ *   local time steps (DPSM_RELAX_LOCAL_STEPS) on graded meshes: time steps,
+ *   rough terrains under open edges, walls, sinks and sources.
  *
  * After every step one function (check_step) checks: every height finite;
  * the ledger closes (TOTAL = SOURCED + EXTERNAL - OUTFLOW to 1e-12 of the
@@ -138,14 +140,32 @@ static void make_graph(mesh_t *m) {
     free(e);
 }
 
-/* A mesh of about n cells along each side of [-half, half]^2. */
-static mesh_t mesh_make(int kind, int n, double half, unsigned seed) {
+static dpsm_grid *mesh_create(const mesh_t *m);
+
+/* A mesh of about n cells along each side of [-half, half]^2. Graded: its
+ * nodes moved by u -> half sinh(2.5 u / half) / sinh(2.5) along x and y, so
+ * that its cells grow about 2.5 times from the centre to the edges (their
+ * stable bounds about 6 times: local time steps take several classes), its
+ * cells' centres and areas as dpsm finds them. */
+static mesh_t mesh_make(int kind, int n, double half, unsigned seed, int graded) {
     mesh_t m;
     memset(&m, 0, sizeof m);
     m.kind = kind;
     static const scene_kind geo[NKINDS] = {SCENE_TRIANGLES, SCENE_HEXAGONS, SCENE_HEXAGONS, SCENE_DUAL};
     m.geo = scene_make(geo[kind], n, half, seed);
     REQUIRE(m.geo.cells > 0, "no cells in a %s mesh of n = %d", kKindNames[kind], n);
+    if (graded) {
+        for (int64_t k = 0; k < 2 * m.geo.nnodes; ++k)
+            m.geo.node_xy[k] = half * sinh(2.5 * m.geo.node_xy[k] / half) / sinh(2.5);
+        mesh_t polygons = m;
+        polygons.kind = kind == MESH_GRAPH ? MESH_HEXAGONS : kind;
+        dpsm_grid *g = mesh_create(&polygons);
+        double *xy = zeroed(2 * (size_t)m.geo.cells, sizeof(double));
+        REQUIRE(dpsm_get_cell_centres(g, xy, m.geo.area) == DPSM_OK, "%s", dpsm_last_error(g));
+        for (int64_t c = 0; c < m.geo.cells; ++c) m.geo.cx[c] = xy[2 * c], m.geo.cy[c] = xy[2 * c + 1];
+        free(xy);
+        dpsm_destroy(g);
+    }
     if (kind == MESH_GRAPH) make_graph(&m);
     return m;
 }
@@ -601,7 +621,7 @@ static int cells_along(int kind, int64_t n) {
 }
 
 static mesh_t make_mesh(int kind, int64_t n, double half, unsigned seed) {
-    return mesh_make(kind, cells_along(kind, n), half, seed);
+    return mesh_make(kind, cells_along(kind, n), half, seed, 0);
 }
 
 /* ------------------------------------------------------------------------ */
@@ -854,6 +874,99 @@ static void test_masks_sources_and_bed(void **state) {
     finish_test("meshes: walls, open cells, sources and a bed", &w);
 }
 
+/* Local time steps (DPSM_RELAX_LOCAL_STEPS) on graded meshes: a pile over a
+ * rough bed at every sixth decade of dt from 1e-12 to 1e12, edge closed or
+ * open, with a source (each step fits under the limit or fails at once with
+ * DPSM_ERR_WORK_LIMIT), then to rest; a rough terrain under open edge faces
+ * at levels that differ, some faces closed, then to rest; walls, sinks and
+ * sources, then to rest. */
+static void test_local_time_steps(void **state) {
+    (void)state;
+    mesh_worst_t w;
+    worst_reset(&w);
+    const int64_t n = scaled(12, 5);
+    for (int kind = 0; kind < NKINDS; ++kind) {
+        mesh_t m = mesh_make(kind, cells_along(kind, n), 2.5, 51u + (unsigned)kind, 1);
+        for (int e = -12; e <= 12; e += 6) {
+            const int open = (e / 6 + kind) & 1;
+            {
+                const double dt = pow(10.0, e);
+                mscene_t s;
+                ms_create(&s, &m, "local steps, graded, dt = 1e%d, edge %s, source", e, open ? "open" : "closed");
+                SCENE_OK(&s, dpsm_set_relaxation(s.g, DPSM_RELAX_LOCAL_STEPS));
+                SCENE_OK(&s, dpsm_set_max_substeps(s.g, 2000));
+                ms_set_edge(&s, open);
+                double *h = terrain(&s, 1.0, 0.3, 1.5, 0.8, 0.0, 5000u + (uint64_t)(e + 100 * kind));
+                ms_set_heights(&s, h);
+                for (int64_t c = 0; c < s.n; ++c) h[c] = c % 3 == 0 ? 1e-3 : (c % 3 == 1 ? -2e-4 : 0.0);
+                ms_set_source(&s, h);
+                for (int k = 0; k < 3; ++k) {
+                    if (ceil(dt / stable(&s)) > 2000.0)
+                        ms_expect_work_limit(&s, dt, &w);
+                    else
+                        ms_step(&s, dt, &w);
+                }
+                ms_set_source(&s, NULL);
+                ms_run_to_rest(&s, 1e12, 2, &w);
+                free(h);
+                ms_destroy(&s);
+            }
+        }
+        {
+            const int seed = kind & 1;
+            const double amp = seed ? 1.0 : 0.3, base = seed ? -3.0 : 0.6;
+            mscene_t s;
+            ms_create(&s, &m, "local steps, graded, terrain amp %g, levels +-%g about %g, mixed edge", amp, amp, base);
+            SCENE_OK(&s, dpsm_set_relaxation(s.g, DPSM_RELAX_LOCAL_STEPS));
+            uint64_t r = 6060u + (uint64_t)(seed + 10 * kind);
+            double *h = terrain(&s, 0.0, amp, 0.0, 0.0, 0.0, r);
+            for (int64_t c = 0; c < s.n; ++c) h[c] += 2.0 * amp * sin(1.3 * m.geo.cx[c]) * cos(0.9 * m.geo.cy[c] + 1.0);
+            ms_set_heights(&s, h);
+            double *levels = zeroed((size_t)s.nf, sizeof(double));
+            uint8_t *open = zeroed((size_t)s.nf, 1);
+            for (int64_t f = 0; f < s.nf; ++f) {
+                levels[f] = base + amp * (2.0 * rng_uniform(&r) - 1.0);
+                open[f] = rng_uniform(&r) < 0.5;
+            }
+            ms_set_levels(&s, levels);
+            ms_set_edge_kinds(&s, open);
+            ms_expect_work_limit(&s, 1e12, &w);
+            const double dt = stable(&s);
+            for (int k = 0; k < 12; ++k) ms_step(&s, dt * (k % 3 == 0 ? 1.0 : k % 3 == 1 ? 7.0 : 40.0), &w);
+            for (int64_t f = 0; f < s.nf; ++f) levels[f] = base;
+            ms_set_levels(&s, levels);
+            ms_run_to_rest(&s, 1e12, 2, &w);
+            free(h), free(levels), free(open);
+            ms_destroy(&s);
+        }
+        {
+            mscene_t s;
+            ms_create(&s, &m, "local steps, graded, walls, sinks and sources");
+            SCENE_OK(&s, dpsm_set_relaxation(s.g, DPSM_RELAX_LOCAL_STEPS));
+            uint64_t r = 7070u + (uint64_t)kind;
+            double *h = terrain(&s, 1.0, 0.5, 1.5, 0.9, 0.0, r), *q = zeroed((size_t)s.n, sizeof(double));
+            uint8_t *kinds = zeroed((size_t)s.n, 1);
+            for (int64_t c = 0; c < s.n; ++c) {
+                const double u = rng_uniform(&r);
+                kinds[c] = u < 0.7 ? DPSM_CELL_SAND : u < 0.85 ? DPSM_CELL_WALL : DPSM_CELL_OPEN;
+                if (kinds[c] == DPSM_CELL_OPEN) h[c] = 0.0;
+                q[c] = rng_uniform(&r) < 0.2 ? 0.05 * (rng_uniform(&r) - 0.3) : 0.0;
+            }
+            ms_set_heights(&s, h);
+            ms_set_kinds(&s, kinds);
+            ms_set_source(&s, q);
+            const double dt = 3.0 * stable(&s);
+            for (int k = 0; k < (int)scaled(30, 6); ++k) ms_step(&s, dt, &w);
+            ms_set_source(&s, NULL);
+            ms_run_to_rest(&s, 1e12, 2, &w);
+            free(h), free(q), free(kinds);
+            ms_destroy(&s);
+        }
+        mesh_free(&m);
+    }
+    finish_test("meshes: local time steps on graded meshes", &w);
+}
+
 /* Many small steps with a source, a wall, a sink and an open edge: the
  * ledger must still close to 1e-12 after each. */
 static void test_many_small_steps(void **state) {
@@ -897,7 +1010,8 @@ int main(int argc, char **argv) {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_time_steps),       cmocka_unit_test(test_height_jumps),
         cmocka_unit_test(test_repose_angles),    cmocka_unit_test(test_rough_terrains),
-        cmocka_unit_test(test_masks_sources_and_bed), cmocka_unit_test(test_many_small_steps),
+        cmocka_unit_test(test_masks_sources_and_bed), cmocka_unit_test(test_local_time_steps),
+        cmocka_unit_test(test_many_small_steps),
         cmocka_unit_test(test_summary),
     };
     return cmocka_run_group_tests_name("stress_mesh", tests, NULL, NULL);

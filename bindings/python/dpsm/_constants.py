@@ -70,6 +70,8 @@ DPSM_RELAX_TIME_ACCURATE = 0
 DPSM_RELAX_TO_REST = 1
 ## Relaxations (dpsm_set_relaxation): DPSM_RELAX_AUTO, as in dpsm.h.
 DPSM_RELAX_AUTO = 2
+## Relaxations (dpsm_set_relaxation): DPSM_RELAX_LOCAL_STEPS, as in dpsm.h.
+DPSM_RELAX_LOCAL_STEPS = 3
 
 # Cell kinds.
 ## Cell kinds: DPSM_CELL_SAND, as in dpsm.h.
@@ -110,6 +112,8 @@ DPSM_INFO_MESSAGES_SENT = 6
 DPSM_INFO_BYTES_SENT = 7
 ## Step information: DPSM_INFO_SUBSTEPS_PER_EXCHANGE, as in dpsm.h.
 DPSM_INFO_SUBSTEPS_PER_EXCHANGE = 8
+## Step information: DPSM_INFO_SUBSTEPS_EVALUATED, as in dpsm.h.
+DPSM_INFO_SUBSTEPS_EVALUATED = 9
 
 # Defaults.
 ## Defaults: DPSM_DEFAULT_REPOSE_ANGLE, as in dpsm.h.

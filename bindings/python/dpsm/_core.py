@@ -883,7 +883,8 @@ class Grid:
     def set_relaxation(self, relaxation):
         """``dpsm_set_relaxation``: ``RELAX_AUTO`` (the default: sub-steps over ``dt``, as
         ``RELAX_TIME_ACCURATE``), ``RELAX_TO_REST`` (each ``step`` brings the surface to rest in few flux
-        evaluations, without a time scale) or ``RELAX_TIME_ACCURATE`` (sub-steps over ``dt``)."""
+        evaluations, without a time scale), ``RELAX_TIME_ACCURATE`` (sub-steps over ``dt``) or
+        ``RELAX_LOCAL_STEPS`` (sub-steps over ``dt``, each cell of a mesh at the pace of its own size)."""
         f = "dpsm_set_relaxation"
         self._call(f, _c_int(relaxation, "relaxation", f, C.DPSM_ERR_UNKNOWN_ENUM))
 
@@ -1275,7 +1276,8 @@ class Grid:
         """``dpsm_get_step_info``: ``INFO_SUBSTEPS``, ``INFO_TIME_INTEGRATED``,
         ``INFO_AT_REST``, ``INFO_MAX_EXCESS_SLOPE``, ``INFO_CELL_UPDATES``, and on
         a distributed grid this rank's ``INFO_RANK_CELL_UPDATES``, ``INFO_MESSAGES_SENT``
-        and ``INFO_BYTES_SENT``, and ``INFO_SUBSTEPS_PER_EXCHANGE``, of the last step."""
+        and ``INFO_BYTES_SENT``, ``INFO_SUBSTEPS_PER_EXCHANGE`` and ``INFO_SUBSTEPS_EVALUATED``,
+        of the last step."""
         f = "dpsm_get_step_info"
         value = ctypes.c_double()
         self._call(f, _c_int(item, "item", f, C.DPSM_ERR_UNKNOWN_ENUM), ctypes.byref(value))
