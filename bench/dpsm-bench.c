@@ -283,6 +283,10 @@ static const command kCommands[] = {
      "[levels [coarse_across [seconds]]]  issue 34's graded mesh: squares from h to 2^levels h (9: 512 h), piles on the"
      " fine cells, on the coarse ones (and on a uniform mesh of them) and straddling the grading, each to rest or for"
      " `seconds` of stepping: sub-steps and cell updates"},
+    {"lts-compare", cmd_lts_compare,
+     "[m [levels]]  local time steps (DPSM_RELAX_LOCAL_STEPS) against the global sub-step on quadtrees of h..2^levels h"
+     " (m = 128 fine cells across, 3), a column on the fine, the coarse and straddling cells: the L1 difference over the"
+     " volume moved after every call, ticks, cell updates, seconds, mass"},
     {"lts", cmd_lts,
      "[m]  local time stepping study: quadtree meshes of cells h..8h (m = 256 fine cells across) against uniform"
      " squares of the same count, column collapse to rest: sub-steps, cell updates now and with local time steps"},

@@ -218,7 +218,7 @@ static void own_classes(const mesh_scene *s, dpsm_grid *g, double *klass, double
     free(sum);
 }
 
-static lts_result run(const char *name, const mesh_scene *s) {
+static lts_result run(const char *name, const mesh_scene *s, int relaxation) {
     lts_result r;
     memset(&r, 0, sizeof r);
     r.name = name;
@@ -240,6 +240,7 @@ static lts_result run(const char *name, const mesh_scene *s) {
     CHECK(g, dpsm_set_repose_angle(g, theta));
     CHECK(g, dpsm_set_boundary(g, DPSM_MESH_EDGE, DPSM_OPEN));
     CHECK(g, dpsm_set_heights(g, h));
+    CHECK(g, dpsm_set_relaxation(g, relaxation));
     CHECK(g, dpsm_stable_dt(g, &r.sub_dt));
     own_classes(s, g, klass, &r.own_bound_ratio);
     for (int64_t c = 0; c < s->cells; ++c) r.classes[klass[c] >= 8.0 ? 3 : klass[c] >= 4.0 ? 2 : klass[c] >= 2.0]++;
@@ -310,6 +311,8 @@ int cmd_lts(int argc, char **argv) {
            "the one sub-step (now) and each at its class's (lts); full = every cell\n");
     printf("# ratios to the uniform mesh: lib/uni (library against library), lts/uni (active, lts against the uniform's "
            "active), full lts/uni; classes: cells whose own bound allows 1/2/4/8+ times the sub-step\n");
+    printf("# \"the same, local steps\": the graded mesh stepped with DPSM_RELAX_LOCAL_STEPS (steps: the smallest "
+           "class's ticks; its act/full columns measured at the ticks as for the others)\n");
     printf("%-22s %7s %13s %9s %5s %6s %5s %7s %7s %6s | %9s %9s %9s %9s %9s | %5s %5s %5s | %s\n", "mesh", "cells",
            "sizes", "sub_dt", "own/l", "steps", "rest", "L1", "seconds", "s/uni", "lib", "act now", "act lts",
            "full now", "full lts", "lib/u", "lts/u", "full", "classes");
@@ -326,10 +329,17 @@ int cmd_lts(int argc, char **argv) {
         mesh_scene graded = quadtree_scene(&q);
         const int n = (int)lround(sqrt((double)graded.cells));
         mesh_scene uniform = scene_make(SCENE_QUADS, n, kHalf, 1u);
-        const lts_result ru = run("uniform, same count", &uniform);
-        const lts_result rg = run(placements[p].name, &graded);
+        const lts_result ru = run("uniform, same count", &uniform, DPSM_RELAX_AUTO);
+        const lts_result rg = run(placements[p].name, &graded, DPSM_RELAX_AUTO);
+        const lts_result rl = run("  the same, local steps", &graded, DPSM_RELAX_LOCAL_STEPS);
         print_result(&rg, &ru);
+        print_result(&rl, &ru);
         print_result(&ru, &ru);
+        printf("# %s: local time steps (DPSM_RELAX_LOCAL_STEPS) took %.4e cell updates, %.2f times the estimate of the "
+               "active cells at their classes' sub-steps (act lts, %.4e) and %.2f times the global sub-step's; L1 %.3f%% "
+               "against %.3f%%\n",
+               placements[p].name, rl.updates, rl.updates / rg.active_lts, rg.active_lts, rl.updates / rg.updates,
+               100.0 * rl.l1, 100.0 * rg.l1);
         scene_free(&graded);
         scene_free(&uniform);
         free(q.i0), free(q.j0), free(q.size);
@@ -367,7 +377,7 @@ typedef struct {
     int calls, at_rest;
 } pile_run;
 
-static pile_run run_pile(const mesh_scene *s, const pile *p, double call, double budget) {
+static pile_run run_pile(const mesh_scene *s, const pile *p, double call, double budget, int relaxation) {
     pile_run r;
     memset(&r, 0, sizeof r);
     double *h = xcalloc((size_t)s->cells, sizeof(double));
@@ -377,6 +387,7 @@ static pile_run run_pile(const mesh_scene *s, const pile *p, double call, double
     CHECK(g, dpsm_set_threads(g, 1));
     CHECK(g, dpsm_set_repose_angle(g, 30.0 * kPi / 180.0));
     CHECK(g, dpsm_set_heights(g, h));
+    CHECK(g, dpsm_set_relaxation(g, relaxation));
     while (r.seconds < budget) {
         const double t0 = now_seconds();
         CHECK(g, dpsm_step(g, call));
@@ -399,7 +410,7 @@ static pile_run run_pile(const mesh_scene *s, const pile *p, double call, double
 }
 
 static void print_pile(const char *mesh, const mesh_scene *s, const pile *p, double sub_dt, const pile_run *r) {
-    printf("%-9s %-8s %7lld %9.3e %6d %10.4e %-4s %10.4e %10.4e %10.4e %8.2f\n", mesh, p->name, (long long)s->cells,
+    printf("%-13s %-8s %7lld %9.3e %6d %10.4e %-4s %10.4e %10.4e %10.4e %8.2f\n", mesh, p->name, (long long)s->cells,
            sub_dt, r->calls, r->flow_time, r->at_rest ? "yes" : "no", r->substeps, r->updates,
            r->updates / r->flow_time, r->seconds);
     fflush(stdout);
@@ -439,31 +450,122 @@ int cmd_mesh_graded(int argc, char **argv) {
     CHECK(g, dpsm_stable_dt(g, &uniform_dt));
     dpsm_destroy(g);
     printf("# graded quadtree: %lld squares from h = %.4e to %d h = %.4e (fine within %.2f of (%.2f, %.2f)); uniform: "
-           "%lld squares of %.4e; piles of height half their radius, 30 deg, closed edge, 1 thread; graded calls of "
-           "4096 sub-steps, uniform calls of 0.05; a run stops at rest or after %.0f s of stepping\n",
+           "%lld squares of %.4e; piles of height half their radius, 30 deg, closed edge, 1 thread; a run stops at rest "
+           "or after %.0f s of stepping\n",
            (long long)graded.cells, q.h, 1 << levels, coarse, q.radius[0], q.px, q.py, (long long)uniform.cells,
            coarse, budget);
-    printf("%-9s %-8s %7s %9s %6s %10s %-4s %10s %10s %10s %8s\n", "mesh", "pile", "cells", "sub_dt", "calls",
+    printf("# graded: the global sub-step (DPSM_RELAX_AUTO), calls of 4096 sub-steps; graded-local: local time steps "
+           "(DPSM_RELAX_LOCAL_STEPS), calls of 0.05 as on the uniform mesh, their substeps the smallest class's ticks\n");
+    printf("%-13s %-8s %7s %9s %6s %10s %-4s %10s %10s %10s %8s\n", "mesh", "pile", "cells", "sub_dt", "calls",
            "flow_time", "rest", "substeps", "updates", "upd/time", "seconds");
-    const pile_run uniform_coarse = run_pile(&uniform, &far, 0.05, budget);
+    const double graded_call = 4096.0 * graded_dt;
+    const pile_run uniform_coarse = run_pile(&uniform, &far, 0.05, budget, DPSM_RELAX_AUTO);
     print_pile("uniform", &uniform, &far, uniform_dt, &uniform_coarse);
-    const pile_run graded_coarse = run_pile(&graded, &far, 4096.0 * graded_dt, budget);
-    print_pile("graded", &graded, &far, graded_dt, &graded_coarse);
-    const pile_run graded_fine = run_pile(&graded, &fine, 4096.0 * graded_dt, budget);
-    print_pile("graded", &graded, &fine, graded_dt, &graded_fine);
-    const pile_run graded_straddle = run_pile(&graded, &straddle, 4096.0 * graded_dt, budget);
-    print_pile("graded", &graded, &straddle, graded_dt, &graded_straddle);
+    const pile *piles[3] = {&far, &fine, &straddle};
+    pile_run global[3], local[3];
+    for (int k = 0; k < 3; ++k) {
+        global[k] = run_pile(&graded, piles[k], graded_call, budget, DPSM_RELAX_AUTO);
+        print_pile("graded", &graded, piles[k], graded_dt, &global[k]);
+        local[k] = run_pile(&graded, piles[k], 0.05, budget, DPSM_RELAX_LOCAL_STEPS);
+        print_pile("graded-local", &graded, piles[k], graded_dt, &local[k]);
+    }
     if (uniform_coarse.at_rest) {
-        const double projected = graded_coarse.at_rest
-                                     ? graded_coarse.updates
-                                     : graded_coarse.updates / graded_coarse.flow_time * uniform_coarse.flow_time;
-        printf("# coarse pile: the graded mesh %s %.4e cell updates to the uniform mesh's rest time (t = %.4g), %.1f "
-               "times the uniform mesh's %.4e (target: at most 2)\n",
-               graded_coarse.at_rest ? "took" : "would take, at its measured rate (extrapolated),", projected,
+        const double projected =
+            global[0].at_rest ? global[0].updates : global[0].updates / global[0].flow_time * uniform_coarse.flow_time;
+        printf("# coarse pile, global sub-step: the graded mesh %s %.4e cell updates to the uniform mesh's rest time "
+               "(t = %.4g), %.1f times the uniform mesh's %.4e\n",
+               global[0].at_rest ? "took" : "would take, at its measured rate (extrapolated),", projected,
                uniform_coarse.flow_time, projected / uniform_coarse.updates, uniform_coarse.updates);
     }
+    /* issue 34's targets, with local time steps */
+    printf("# targets, local time steps: coarse pile %.2f times the uniform mesh's cell updates (at most 2)%s; fine pile "
+           "%.2f times the global sub-step's (at most 1); straddling %.2f times the sum of the two (at most 2)\n",
+           local[0].updates / uniform_coarse.updates, local[0].at_rest ? "" : " (not at rest within the budget)",
+           local[1].updates / global[1].updates, local[2].updates / (local[0].updates + local[1].updates));
     scene_free(&graded);
     scene_free(&uniform);
     free(q.i0), free(q.j0), free(q.size);
+    return 0;
+}
+
+/* dpsm-bench lts-compare [m [levels]]: local time steps
+ * (DPSM_RELAX_LOCAL_STEPS) against the global sub-step on the quadtree
+ * meshes of cmd_lts, a column of height 0.5 on an open edge, calls of 0.05:
+ * after every call, the L1 difference of the heights over the volume moved
+ * so far (half the L1 change of the global run's heights); the ticks, the
+ * cell updates and the seconds of each, and the mass of each at the end. */
+int cmd_lts_compare(int argc, char **argv) {
+    const int m = argc > 0 ? atoi(argv[0]) : 128;
+    const int levels = argc > 1 ? atoi(argv[1]) : 3;
+    if (m < 64 || m % (1 << levels) != 0 || levels < 1 || levels >= kMostLevels) {
+        fprintf(stderr, "lts-compare: the fine cells across (%d) must be a multiple of 2^levels, at least 64\n", m);
+        return 2;
+    }
+    const double h = 2.0 * kHalf / m;
+    const struct {
+        const char *name;
+        double px, py, r1;
+    } placements[] = {{"fine", 0.0, 0.0, 1.6}, {"coarse", kHalf, kHalf, 0.9}, {"straddling", 1.2, 0.0, 0.6}};
+    printf("# local time steps against the global sub-step: quadtrees of h..%dh (h = %.5f), fine cells within r1 of "
+           "(px, py), a column of radius 1 and height 0.5 at the origin, open edge, 30 deg, calls of 0.05, 1 thread\n",
+           1 << levels, h);
+    printf("%-11s %7s %5s %10s %10s | %9s %9s | %10s %10s | %7s %7s | %s\n", "pile", "cells", "calls", "worst_diff",
+           "end_diff", "ticks_glo", "ticks_loc", "upd_glo", "upd_loc", "s_glo", "s_loc", "mass difference");
+    for (size_t p = 0; p < sizeof placements / sizeof placements[0]; ++p) {
+        quadtree q;
+        memset(&q, 0, sizeof q);
+        q.m = m, q.levels = levels, q.h = h, q.px = placements[p].px, q.py = placements[p].py;
+        q.radius[0] = placements[p].r1;
+        for (int k = 1; k < levels; ++k) q.radius[k] = q.radius[k - 1] + 4.0 * (double)(1 << k) * h;
+        mesh_scene s = quadtree_scene(&q);
+        double *h0 = xcalloc((size_t)s.cells, sizeof(double)), *hg = xcalloc((size_t)s.cells, sizeof(double)),
+               *hl = xcalloc((size_t)s.cells, sizeof(double));
+        scene_disk_fractions(&s, 1.0, h0);
+        for (int64_t c = 0; c < s.cells; ++c) h0[c] *= 0.5;
+        dpsm_grid *g[2] = {NULL, NULL};
+        for (int k = 0; k < 2; ++k) {
+            CHECK(NULL, scene_create(&s, &g[k]));
+            CHECK(g[k], dpsm_set_threads(g[k], 1));
+            CHECK(g[k], dpsm_set_repose_angle(g[k], 30.0 * kPi / 180.0));
+            CHECK(g[k], dpsm_set_boundary(g[k], DPSM_MESH_EDGE, DPSM_OPEN));
+            CHECK(g[k], dpsm_set_heights(g[k], h0));
+        }
+        CHECK(g[1], dpsm_set_relaxation(g[1], DPSM_RELAX_LOCAL_STEPS));
+        double worst = 0.0, last = 0.0, ticks[2] = {0, 0}, updates[2] = {0, 0}, seconds[2] = {0, 0};
+        int calls = 0;
+        for (; calls < 400; ++calls) {
+            double at_rest[2] = {0, 0};
+            for (int k = 0; k < 2; ++k) {
+                const double t0 = now_seconds();
+                CHECK(g[k], dpsm_step(g[k], 0.05));
+                seconds[k] += now_seconds() - t0;
+                double sub = 0, upd = 0;
+                CHECK(g[k], dpsm_get_step_info(g[k], DPSM_INFO_SUBSTEPS, &sub));
+                CHECK(g[k], dpsm_get_step_info(g[k], DPSM_INFO_CELL_UPDATES, &upd));
+                CHECK(g[k], dpsm_get_step_info(g[k], DPSM_INFO_AT_REST, &at_rest[k]));
+                ticks[k] += sub, updates[k] += upd;
+            }
+            CHECK(g[0], dpsm_get_heights(g[0], hg));
+            CHECK(g[1], dpsm_get_heights(g[1], hl));
+            double diff = 0.0, moved = 0.0;
+            for (int64_t c = 0; c < s.cells; ++c) {
+                diff += fabs(hl[c] - hg[c]) * s.area[c];
+                moved += fabs(hg[c] - h0[c]) * s.area[c];
+            }
+            moved *= 0.5;
+            if (moved > 0.0) worst = fmax(worst, diff / moved), last = diff / moved;
+            if (at_rest[0] > 0.0 && at_rest[1] > 0.0) break;
+        }
+        double mass[2];
+        for (int k = 0; k < 2; ++k) CHECK(g[k], dpsm_get_mass(g[k], DPSM_MASS_TOTAL, &mass[k]));
+        printf("%-11s %7lld %5d %10.3e %10.3e | %9.0f %9.0f | %10.4e %10.4e | %7.2f %7.2f | %.3e\n", placements[p].name,
+               (long long)s.cells, calls + 1, worst, last, ticks[0], ticks[1], updates[0], updates[1], seconds[0],
+               seconds[1], fabs(mass[1] - mass[0]) / mass[0]);
+        fflush(stdout);
+        dpsm_destroy(g[0]), dpsm_destroy(g[1]);
+        free(h0), free(hg), free(hl);
+        scene_free(&s);
+        free(q.i0), free(q.j0), free(q.size);
+    }
     return 0;
 }

@@ -3,7 +3,7 @@
 # mesh kind at three refinements and the cone on triangles (dpsm-bench
 # mesh-accuracy, with the gmsh disk when gmsh is installed), the 2D grid's
 # isotropic scheme beside them (docs/data/work_precision.csv), the speed of
-# the mesh engine (dpsm-bench mesh, mesh-wind, mesh-graded), the error-against-cells figure and the
+# the mesh engine (dpsm-bench mesh, mesh-wind, mesh-graded, lts, lts-compare), the error-against-cells figure and the
 # picture of a pile on a gmsh mesh (examples/python/mesh_pile.py).
 #
 #   bash bench/run_mesh_validation.sh     # about 45 minutes on 2 cores, on a quiet machine
@@ -48,9 +48,17 @@ echo ">> dpsm-bench mesh-wind, 1 and 2 threads, three runs each"
   done
 } | awk 'NR == 1 { print "build," $0; next } /^cells/ { next } { print "this," $0 }' > "$data/mesh_wind.csv"
 cat "$data/mesh_wind.csv"
-echo ">> dpsm-bench mesh-graded (issue 34's graded mesh, about 80 s)"
+echo ">> dpsm-bench mesh-graded (issue 34's graded mesh, with and without local time steps, about 100 s)"
 "$bench" mesh-graded > "$data/mesh_graded.txt" 2>&1
 cat "$data/mesh_graded.txt"
+echo ">> dpsm-bench lts, lts-compare (local time steps on quadtrees, about 2 minutes)"
+"$bench" lts > "$data/mesh_lts_local.txt" 2>&1
+cat "$data/mesh_lts_local.txt"
+{
+  echo "# dpsm-bench lts-compare 128 3"; "$bench" lts-compare 128 3
+  echo "# dpsm-bench lts-compare 128 1"; "$bench" lts-compare 128 1
+} > "$data/mesh_lts_compare.txt" 2>&1
+cat "$data/mesh_lts_compare.txt"
 "$python" "$root/bench/plot_mesh_accuracy.py" "$data/mesh_accuracy.csv" "$data/work_precision.csv" \
     "$figures/mesh_accuracy.png"
 PYTHONPATH=$root/bindings/python DPSM_LIBRARY=$build/src/libdpsm.so \
