@@ -318,6 +318,10 @@ def m_max_substeps(k):  # {1, 3, 50, 20000}[k]
     return [8, k]
 
 
+def m_relaxation(local):  # DPSM_RELAX_LOCAL_STEPS, or back to DPSM_RELAX_AUTO
+    return [8, 0x81 if local else 0x80]
+
+
 def m_step(k, restart=False):  # dt = 1e-3 * 10^(4 k / 127): k = 127 is 10, 95 about 1, 64 about 0.1
     return [9, k | (0x80 if restart else 0)]
 
@@ -350,6 +354,19 @@ seed("mesh_dual",
      mesh("dual", "triangles", 3, 8, dx=0.25, dy=4.0, jitter=4, seed=77, ops=[
          m_heights(2, 1.0, 100.0), m_boundary(0), m_levels(1, 100.0), m_fluxes(1), m_step(127, True),
          m_levels(2, 1.0, 0.0), m_step(64), m_step(127)]))
+# Local time steps (issue 34): piles, sources, masks, edges and restarts with
+# DPSM_RELAX_LOCAL_STEPS, and back to the default (at most 15 operations a mesh).
+seed("mesh_local_steps",
+     mesh("polygons", "mixed", 8, 8, dx=0.5, dy=2.0, jitter=4, seed=302, ops=[
+         m_relaxation(True), m_heights(1, 10.0, 0.0), m_fluxes(1), m_step(95), m_step(127, True), m_kinds(2),
+         m_step(127), m_edge_kinds(2), m_levels(3), m_step(127, True), m_source(2, 1e-3, 0.1),
+         m_relaxation(False), m_step(95), m_relaxation(True), m_step(127, True)]),
+     mesh("graph", "triangles", 6, 5, jitter=4, seed=12, ops=[
+         m_relaxation(True), m_heights(2, 0.0, 30.0), m_boundary(0), m_fluxes(1), m_step(127), m_kinds(3),
+         m_source(1, 0.1, 0.0), m_max_substeps(2), m_step(127), m_step(64, True)]),
+     mesh("dual", "triangles", 7, 6, jitter=4, seed=6, ops=[
+         m_relaxation(True), m_heights(1, 3.0, 0.0), m_kinds(1), m_fluxes(1), m_step(127, True), m_source(3, 1e-9),
+         m_step(127), m_levels(1, 1.0), m_boundary(0), m_step(95)]))
 seed("mesh_bad_polygons", *[mesh("polygons", ("quads", "triangles", "mixed")[k % 3], 3 + k % 4, 2 + k % 3,
                                   seed=k + 1, defect=k) for k in range(11)],
      mesh("polygons", "quads", 3, 3, ops=[m_heights(0, 1.0, plant=0), m_absent(2)]))
