@@ -16,7 +16,10 @@
  *  - a source (in closed form) keeps the balance, a source of 1e-300 takes
  *    the ticks of none, and recorded face fluxes add up to the heights'
  *    changes;
- *  - a bed, a static angle and an unknown relaxation are refused, the grid
+ *  - over a bed, with erosion beyond the sand there: mass (what could not be
+ *    eroded booked as unmet), no sand below the bed, rest, the same bits on
+ *    two threads;
+ *  - a static angle and an unknown relaxation are refused, the grid
  *    unchanged. */
 #include <math.h>
 #include <setjmp.h>
@@ -357,8 +360,8 @@ static void test_negligible_source(void **state) {
     free_graded(&m);
 }
 
-/* A bed and a static angle are refused, the grid unchanged; so is an
- * unknown relaxation. On a grid the relaxation is the time-accurate one. */
+/* A static angle is refused, the grid unchanged; so is an unknown
+ * relaxation. On a grid the relaxation is the time-accurate one. */
 static void test_refusals(void **state) {
     (void)state;
     graded_mesh m = make_graded(GRADED_SQUARES, 16, 8.0);
@@ -368,18 +371,14 @@ static void test_refusals(void **state) {
     const size_t n = (size_t)m.cells;
     double *h0 = malloc(sizeof(double) * n), *h = malloc(sizeof(double) * n), *zb = calloc(n, sizeof(double));
     CHECK_OK(m.g, dpsm_get_heights(m.g, h0));
-    for (int k = 0; k < 2; ++k) {
+    {
         graded_mesh other = make_graded(GRADED_SQUARES, 16, 8.0);
         CHECK_OK(other.g, dpsm_set_heights(other.g, h0));
         CHECK_OK(other.g, dpsm_set_relaxation(other.g, DPSM_RELAX_LOCAL_STEPS));
-        if (k == 0)
-            CHECK_OK(other.g, dpsm_set_bedrock(other.g, zb));
-        else
-            CHECK_OK(other.g, dpsm_set_static_angle(other.g, 33.0 * kDeg));
+        CHECK_OK(other.g, dpsm_set_static_angle(other.g, 33.0 * kDeg));
         assert_int_equal(dpsm_step(other.g, 1.0), DPSM_ERR_NOT_APPLICABLE);
         const char *msg = dpsm_last_error(other.g);
-        REQUIRE(strstr(msg, "DPSM_RELAX_LOCAL_STEPS") && strstr(msg, k == 0 ? "bed" : "static angle"),
-                "the message was: %s", msg);
+        REQUIRE(strstr(msg, "DPSM_RELAX_LOCAL_STEPS") && strstr(msg, "static angle"), "the message was: %s", msg);
         CHECK_OK(other.g, dpsm_get_heights(other.g, h));
         REQUIRE(memcmp(h, h0, sizeof(double) * n) == 0, "a refused step changed the heights");
         free_graded(&other);
@@ -407,6 +406,77 @@ static void test_refusals(void **state) {
     dpsm_destroy(g[0]), dpsm_destroy(g[1]);
 }
 
+/* A bed at a slope under a thin layer of sand, a column on it, erosion on
+ * some cells far beyond the sand there and deposition on others: after every
+ * call mass holds (what could not be eroded booked as unmet), no sand cell
+ * lies below its bed and two threads give the same bits; without the source
+ * the sand comes to rest within 5 % of the global sub-step's deposit. */
+static void test_over_a_bed(void **state) {
+    (void)state;
+    for (int kind = 0; kind < 3; ++kind) {
+        graded_mesh m[3];
+        const double w = width_of(24, 8.0);
+        for (int k = 0; k < 3; ++k) m[k] = make_graded((graded_kind)kind, 24, 8.0);
+        const size_t n = (size_t)m[0].cells;
+        double *zb = malloc(sizeof(double) * n), *h0 = malloc(sizeof(double) * n), *q = malloc(sizeof(double) * n);
+        double *h[3];
+        for (int k = 0; k < 3; ++k) h[k] = malloc(sizeof(double) * n);
+        for (size_t c = 0; c < n; ++c) {
+            zb[c] = 0.3 * (w - m[0].cx[c]);
+            h0[c] = zb[c] + (hypot(m[0].cx[c] - 0.4 * w, m[0].cy[c] - 0.4 * w) < 0.15 * w ? 0.1 * w : 1e-3 * (c % 3));
+            q[c] = c % 7 == 0 ? -10.0 : c % 5 == 0 ? 0.01 : 0.0;
+        }
+        for (int k = 0; k < 3; ++k) {
+            CHECK_OK(m[k].g, dpsm_set_bedrock(m[k].g, zb));
+            CHECK_OK(m[k].g, dpsm_set_heights(m[k].g, h0));
+            CHECK_OK(m[k].g, dpsm_set_source(m[k].g, q));
+            if (k > 0) CHECK_OK(m[k].g, dpsm_set_relaxation(m[k].g, DPSM_RELAX_LOCAL_STEPS));
+        }
+        CHECK_OK(m[2].g, dpsm_set_threads(m[2].g, 2));
+        for (int call = 0; call < 8; ++call) {
+            for (int k = 0; k < 3; ++k) {
+                CHECK_OK(m[k].g, dpsm_step(m[k].g, 4.0));
+                CHECK_OK(m[k].g, dpsm_get_heights(m[k].g, h[k]));
+                const double total = mass_of(m[k].g, DPSM_MASS_TOTAL);
+                REQUIRE(fabs(ledger_residual(m[k].g)) <= 1e-12 * fmax(1.0, total), "%s, call %d: the ledger's residual is %g",
+                        kKindNames[kind], call, ledger_residual(m[k].g));
+                for (size_t c = 0; c < n; ++c)
+                    REQUIRE(h[k][c] >= zb[c], "%s, call %d, cell %zu: %.17g below its bed %.17g", kKindNames[kind], call, c,
+                            h[k][c], zb[c]);
+            }
+            REQUIRE(memcmp(h[1], h[2], sizeof(double) * n) == 0, "%s, call %d: two threads changed the heights",
+                    kKindNames[kind], call);
+        }
+        REQUIRE(mass_of(m[1].g, DPSM_MASS_UNMET) > 0.0, "%s: erosion beyond the sand left nothing unmet",
+                kKindNames[kind]);
+        int rested = 0;
+        for (int call = 0; call < 400 && !rested; ++call) {
+            for (int k = 0; k < 2; ++k) {
+                if (call == 0) CHECK_OK(m[k].g, dpsm_set_source(m[k].g, NULL));
+                CHECK_OK(m[k].g, dpsm_step(m[k].g, 4.0));
+            }
+            rested = step_info_of(m[0].g, DPSM_INFO_AT_REST) > 0.0 && step_info_of(m[1].g, DPSM_INFO_AT_REST) > 0.0;
+        }
+        REQUIRE(rested, "%s: not at rest after 400 calls (global %g, local %g; excess %g, %g)", kKindNames[kind],
+                step_info_of(m[0].g, DPSM_INFO_AT_REST), step_info_of(m[1].g, DPSM_INFO_AT_REST),
+                step_info_of(m[0].g, DPSM_INFO_MAX_EXCESS_SLOPE), step_info_of(m[1].g, DPSM_INFO_MAX_EXCESS_SLOPE));
+        for (int k = 0; k < 2; ++k) CHECK_OK(m[k].g, dpsm_get_heights(m[k].g, h[k]));
+        double diff = 0.0, sand = 0.0;
+        for (size_t c = 0; c < n; ++c) {
+            diff += fabs(h[1][c] - h[0][c]) * m[0].area[c];
+            sand += (h[0][c] - zb[c]) * m[0].area[c];
+        }
+        print_message("%s over a bed: at rest, L1 difference from the global sub-step %.3e of the sand left\n",
+                      kKindNames[kind], diff / sand);
+        /* The large cells' own time error (0.9 to 1.5 % measured); a face
+         * taking more than the sand its cell may give strays 16 to 21 %. */
+        REQUIRE(diff / sand <= 0.05, "%s over a bed: at rest %.3e of the sand left from the global sub-step's deposit",
+                kKindNames[kind], diff / sand);
+        for (int k = 0; k < 3; ++k) free(h[k]), free_graded(&m[k]);
+        free(zb), free(h0), free(q);
+    }
+}
+
 int main(void) {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_one_class_is_the_global_sub_step),
@@ -415,6 +485,7 @@ int main(void) {
         cmocka_unit_test(test_same_bits_whatever_the_visits),
         cmocka_unit_test(test_sources_and_face_fluxes),
         cmocka_unit_test(test_negligible_source),
+        cmocka_unit_test(test_over_a_bed),
         cmocka_unit_test(test_refusals),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

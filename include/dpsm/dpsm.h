@@ -714,7 +714,9 @@ DPSM_API int dpsm_set_scheme(dpsm_grid *g, int scheme);
  * fifth of the volume moved during the flow and 2 % at rest;
  * \ref guide_meshes). A host's explicit choice. dpsm_step() refuses it
  * (::DPSM_ERR_NOT_APPLICABLE, the grid unchanged) on distributed meshes and
- * with a bed or a static angle; on a grid it is ::DPSM_RELAX_TIME_ACCURATE.
+ * with a static angle; on a grid it is ::DPSM_RELAX_TIME_ACCURATE. Over a bed
+ * every tick looks at every cell (as a sub-step with a bed does), and a face
+ * takes at most its share of the sand its cell may give in that tick.
  *
  * @param g           the grid.
  * @param relaxation  ::DPSM_RELAX_AUTO, ::DPSM_RELAX_TO_REST,

@@ -440,9 +440,9 @@ public:
         // too and exchanges once per batch of sub-steps (mesh/mesh_parts.hpp);
         // the step ends with an exchange, so that a step starts exact.
         const int per_exchange = s.exchange ? m.substeps_per_exchange : 0;
-        // Local time steps: a serial mesh without a bed or a static angle (the stepper refuses the others).
+        // Local time steps: a serial mesh without a static angle (the stepper refuses the others).
         const bool local = grid.relaxation() == kLocalSteps;
-        if (local) begin_local_steps(m, s);
+        if (local) begin_local_steps(grid, m, s);
         for (std::int64_t k = 0; k < plan.substeps; ++k) {
             double visited = 0.0;
             const int in_batch = per_exchange > 0 ? static_cast<int>(k % per_exchange) + 1 : 0;
@@ -516,12 +516,12 @@ private:
                 return true;
             }
             if (amounts) {
-                if (!q.empty()) rate += dt * q[c];
+                if (!q.empty()) rate += dt * (zb.empty() ? q[c] : source_applied(zb, h, q, c, dt));
                 if (rate != 0.0) add_with_residual(h[c], residual[c], rate);
-                return carried;
+            } else {
+                if (!q.empty()) rate += zb.empty() ? q[c] : source_applied(zb, h, q, c, dt);
+                if (rate != 0.0) add_with_residual(h[c], residual[c], dt * rate);
             }
-            if (!q.empty()) rate += zb.empty() ? q[c] : source_applied(zb, h, q, c, dt);
-            if (rate != 0.0) add_with_residual(h[c], residual[c], dt * rate);
             if (!zb.empty() && h[c] < zb[c]) {
                 residual[c] = static_cast<float>(static_cast<double>(residual[c]) - (zb[c] - h[c]));
                 h[c] = zb[c];
@@ -898,8 +898,15 @@ private:
         const int threads = grid.step_threads();
         const std::vector<std::uint8_t> &kind = grid.kinds();
         MeshActivity &act = s.activity;
-        const FaceLaw law =
-            law_of(grid, heights_read(grid, s, sub_dt, static_cast<double>(j)), s.gx.data(), s.gy.data(), 1.0);
+        SubstepSummary did;
+        FaceLaw law = law_of(grid, heights_read(grid, s, sub_dt, static_cast<double>(j)), s.gx.data(), s.gy.data(), 1.0);
+        // A bed: the sand each cell may give in this tick, after its source
+        // (every tick looks at every cell, as a sub-step with a bed does).
+        const double *bed = grid.bed().empty() ? nullptr : grid.bed().data();
+        if (bed) {
+            prepare_bed(grid, m, s, sub_dt, did);
+            law.available = s.available.data();
+        }
         const CellUpdate update_cell{m,
                                      s.flux.data(),
                                      kind.data(),
@@ -925,9 +932,8 @@ private:
         };
         const auto gradient = [&](std::int64_t c) { gradient_of(m, law.h, kind.data(), c, s.gx.data(), s.gy.data()); };
         const auto flow = [&](std::int64_t f) { high[f] = gradient_flow_flux(m, law, f, high[f], pull_x, pull_y); };
-        const auto limit = [&](std::int64_t c) { limits_of(m, law, low, high, nullptr, c, limit_in, limit_out); };
+        const auto limit = [&](std::int64_t c) { limits_of(m, law, low, high, bed, c, limit_in, limit_out); };
         const auto limited = [&](std::int64_t f) { flux[f] = limited_flux(m, law, f, low[f], high[f], limit_in, limit_out); };
-        SubstepSummary did;
         const auto carried = [&](std::int64_t f) {
             if (flux[f] == 0.0) return false;
             did.moved = true;
@@ -955,6 +961,12 @@ private:
                 changed[c] = update_cell(c);
                 limit_in[c] = limit_out[c] = 1.0;
             });
+            if (bed) {
+                // Sources at every tick (with a bed they are not in closed
+                // form): the cells beyond the tick's lists take theirs too.
+                for (const std::int64_t c : s.source_cells)
+                    if (sc.taking_level[c] > level) changed[c] = update_cell(c);
+            }
             std::int64_t changed_cells = 0;
             for (std::int64_t k = 0; k < taking_n; ++k)
                 if (changed[taking[k]]) {
@@ -965,7 +977,7 @@ private:
             // Where every face has fired and few cells changed, the ticks
             // after look at those cells and the steep faces alone.
             const double most = dense_share(threads, m.owned) * static_cast<double>(m.owned);
-            if (level == sc.top && !s.switches.visit_all_cells &&
+            if (level == sc.top && !s.switches.visit_all_cells && !bed &&
                 static_cast<double>(changed_cells + kept_hot_by_sources(s)) <= most) {
                 act.all_hot = false;
                 for (std::int64_t c = 0; c < m.owned; ++c)
@@ -1086,7 +1098,7 @@ private:
         for (std::int64_t k = 0; k < pulled_count; ++k) pull_x[pulled_cells[k]] = pull_y[pulled_cells[k]] = 0.0;
         // Sand that may still move: it moved, or a hot cell waits for its
         // faces' classes, or every cell is hot and not every face has fired.
-        did.moved = did.moved || next_local_tick(s, j) >= 0;
+        did.moved = did.moved || (act.all_hot ? level < sc.top : next_local_tick(s, j) >= 0);
         return did;
     }
 
@@ -1118,13 +1130,13 @@ private:
     // Before the first tick of a step with local time steps: the classes
     // (once per grid), the passes' values as between sparse sub-steps, and
     // the hot cells by level.
-    static void begin_local_steps(const Mesh &m, MeshState &s) {
+    static void begin_local_steps(const Grid &grid, const Mesh &m, MeshState &s) {
         if (!s.classes) s.classes = std::make_unique<const StepClasses>(step_classes_of(m));
         clear_passes(m, s);
         std::fill(s.excess.begin(), s.excess.end(), 0.0);
         s.hot_by_level.resize(static_cast<std::size_t>(s.classes->top) + 1);
         MeshActivity &act = s.activity;
-        if (s.switches.visit_all_cells) act.wake_all();
+        if (s.switches.visit_all_cells || !grid.bed().empty()) act.wake_all();
         for (const std::int64_t c : act.hot_list) s.hot_by_level[s.classes->finest[c]].push_back(c);
         act.hot_list.clear();
         s.steep_by_level.resize(s.hot_by_level.size());

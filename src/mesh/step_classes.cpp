@@ -73,6 +73,7 @@ StepClasses step_classes_of(const Mesh &m) {
         carrying[static_cast<std::size_t>(f)] = b >= 0 ? std::min(la, reading[static_cast<std::size_t>(b)]) : la;
     }
     const std::vector<std::uint8_t> taking = finest_face_of(carrying);
+    out.taking_level = taking;
     sort_by_level(out.face_class, top, out.firing_faces, out.firing_end);
     sort_by_level(reading, top, out.reading_cells, out.reading_end);
     sort_by_level(carrying, top, out.carrying_faces, out.carrying_end);

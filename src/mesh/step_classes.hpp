@@ -37,6 +37,7 @@ struct StepClasses {
     // Per cell, the finest and the coarsest class of its faces: the first
     // tick level at which a face of it fires, and the first at which all do.
     std::vector<std::uint8_t> finest, coarsest;
+    std::vector<std::uint8_t> taking_level;  // per cell, the first level whose ticks update it
     // Faces that fire; cells whose gradients and pulls they read; faces
     // that carry those pulls; cells that limit and take those fluxes.
     std::vector<std::int64_t> firing_faces, reading_cells, carrying_faces, taking_cells;

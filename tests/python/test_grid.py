@@ -829,7 +829,7 @@ class TestMesh(LedgerMixin, unittest.TestCase):
 
     def test_local_steps(self):
         """RELAX_LOCAL_STEPS on a graded strip of squares (1, 2, 4, 8 wide): mass kept, the large cells' ticks
-        passed over (INFO_SUBSTEPS_EVALUATED below INFO_SUBSTEPS), and a bed refused."""
+        passed over (INFO_SUBSTEPS_EVALUATED below INFO_SUBSTEPS), and a static angle refused."""
         xs = [0.0]
         for width in (1.0,) * 4 + (2.0,) * 4 + (4.0,) * 4 + (8.0,) * 4:
             xs.append(xs[-1] + width)
@@ -845,7 +845,7 @@ class TestMesh(LedgerMixin, unittest.TestCase):
             self.assertLess(g.get_step_info(dpsm.INFO_SUBSTEPS_EVALUATED), g.get_step_info(dpsm.INFO_SUBSTEPS))
             self.assertAlmostEqual(g.get_mass(dpsm.MASS_TOTAL), total, delta=1e-12 * total)
             self.assertLedger(g)
-            g.set_bedrock([0.0] * 16)
+            g.set_static_angle(0.7)
             self.assertFails(dpsm.ERR_NOT_APPLICABLE, g.step, 1.0)
 
     def test_aliases_and_flat_input(self):

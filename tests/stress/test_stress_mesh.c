@@ -18,7 +18,7 @@
  *   and deposition over a bed;
  *   many small steps;
  *   local time steps (DPSM_RELAX_LOCAL_STEPS) on graded meshes: time steps,
- *   rough terrains under open edges, walls, sinks and sources.
+ *   rough terrains under open edges, walls, sinks and sources, a bed.
  *
  * After every step one function (check_step) checks: every height finite;
  * the ledger closes (TOTAL = SOURCED + EXTERNAL - OUTFLOW to 1e-12 of the
@@ -879,7 +879,7 @@ static void test_masks_sources_and_bed(void **state) {
  * open, with a source (each step fits under the limit or fails at once with
  * DPSM_ERR_WORK_LIMIT), then to rest; a rough terrain under open edge faces
  * at levels that differ, some faces closed, then to rest; walls, sinks and
- * sources, then to rest. */
+ * sources, then to rest; a bed eroded far beyond its sand, then to rest. */
 static void test_local_time_steps(void **state) {
     (void)state;
     mesh_worst_t w;
@@ -960,6 +960,31 @@ static void test_local_time_steps(void **state) {
             ms_set_source(&s, NULL);
             ms_run_to_rest(&s, 1e12, 2, &w);
             free(h), free(q), free(kinds);
+            ms_destroy(&s);
+        }
+        {
+            /* Over a bed at slope 0.5, eroded far beyond its sand on some cells. */
+            mscene_t s;
+            ms_create(&s, &m, "local steps, graded, bed eroded beyond its sand");
+            SCENE_OK(&s, dpsm_set_relaxation(s.g, DPSM_RELAX_LOCAL_STEPS));
+            uint64_t r = 8080u + (uint64_t)kind;
+            double *zb = zeroed((size_t)s.n, sizeof(double)), *h = zeroed((size_t)s.n, sizeof(double));
+            double *q = zeroed((size_t)s.n, sizeof(double));
+            for (int64_t c = 0; c < s.n; ++c) {
+                zb[c] = 0.5 * (2.5 - m.geo.cx[c]) + 0.1 * rng_uniform(&r);
+                h[c] = zb[c] + (rng_uniform(&r) < 0.5 ? 1e-3 : 0.6);
+                const double u = rng_uniform(&r);
+                q[c] = u < 0.2 ? -1e3 : u < 0.35 ? 0.1 : 0.0;
+            }
+            ms_set_bed(&s, zb);
+            ms_set_heights(&s, h);
+            ms_set_source(&s, q);
+            const double dt = stable(&s);
+            for (int k = 0; k < 12; ++k) ms_step(&s, dt * (k % 3 == 0 ? 1.0 : k % 3 == 1 ? 10.0 : 100.0), &w);
+            REQUIRE(mass_of(s.g, DPSM_MASS_UNMET) > 0.0, "[%s] erosion beyond the sand left nothing unmet", s.name);
+            ms_set_source(&s, NULL);
+            ms_run_to_rest(&s, 1e12, 2, &w);
+            free(zb), free(h), free(q);
             ms_destroy(&s);
         }
         mesh_free(&m);
