@@ -122,11 +122,13 @@ void take_owners_edges(Grid &grid, GhostExchange &exchange, int most_edge_faces)
         for (std::int64_t k = m.cell_face_start[c]; k < m.cell_face_start[c + 1]; ++k)
             if (m.other[k] < 0) out.push_back(m.cell_faces[k]);
     };
-    // Per cell, its k-th edge face's kind and level (0 beyond its last).
-    std::vector<std::vector<double>> values(2 * most, std::vector<double>(cells, 0.0));
+    // Per cell, its k-th edge face's kind and level (0 beyond its last), and how many it has.
+    std::vector<std::vector<double>> values(2 * most + 1, std::vector<double>(cells, 0.0));
+    std::vector<double> &edge_count = values.back();
     std::vector<std::int64_t> faces;
     for (std::int64_t c = 0; c < m.owned; ++c) {
         edge_faces(c, faces);
+        edge_count[static_cast<std::size_t>(c)] = static_cast<double>(faces.size());
         for (std::size_t k = 0; k < faces.size(); ++k) {
             values[2 * k][static_cast<std::size_t>(c)] = open[faces[k]];
             values[2 * k + 1][static_cast<std::size_t>(c)] = level[faces[k]];
@@ -138,10 +140,14 @@ void take_owners_edges(Grid &grid, GhostExchange &exchange, int most_edge_faces)
     const std::vector<std::uint8_t> open_before = open;
     const std::vector<double> level_before = level;
     for (std::int64_t c = m.owned; c < m.cells; ++c) {
-        // Only a ghost whose faces are all here orders them as its owner does;
-        // the passes before the update read the others' faces for nothing.
+        // Only a ghost whose faces are all here orders them as its owner
+        // does; the passes before the update read the others' faces for
+        // nothing. A ghost on the layer's rim may hold as many faces as its
+        // owner, some of them onto cells beyond the layer, which read as
+        // edge faces here: it has more edge faces than its owner.
         if (static_cast<double>(m.cell_face_start[c + 1] - m.cell_face_start[c]) != m.face_count[c]) continue;
         edge_faces(c, faces);
+        if (static_cast<double>(faces.size()) != edge_count[static_cast<std::size_t>(c)]) continue;
         for (std::size_t k = 0; k < faces.size(); ++k) {
             open[faces[k]] = values[2 * k][static_cast<std::size_t>(c)] != 0.0;
             level[faces[k]] = values[2 * k + 1][static_cast<std::size_t>(c)];
