@@ -263,16 +263,17 @@ static void test_converges_to_the_global_sub_step(void **state) {
     }
 }
 
-/* Visiting every cell, and two threads, change no bit, wherever the column. */
+/* Visiting every cell, and two threads, change no bit, wherever the column,
+ * and find rest at the same tick. */
 static void test_same_bits_whatever_the_visits(void **state) {
     (void)state;
     for (int run = 0; run < 9; ++run) {
         const int kind = run % 3;
         const pile *p = &kPiles[run / 3];
         graded_mesh m[3];
-        const double w = width_of(40, 8.0);
+        const double w = width_of(28, 8.0);
         for (int k = 0; k < 3; ++k) {
-            m[k] = make_graded((graded_kind)kind, 40, 8.0);
+            m[k] = make_graded((graded_kind)kind, 28, 8.0);
             pour(&m[k], p->x * w, p->y * w, p->r * w, 0.5 * p->r * w);
             CHECK_OK(m[k].g, dpsm_set_relaxation(m[k].g, DPSM_RELAX_LOCAL_STEPS));
         }
@@ -280,20 +281,34 @@ static void test_same_bits_whatever_the_visits(void **state) {
         const size_t n = (size_t)m[0].cells;
         double *h[3];
         for (int k = 0; k < 3; ++k) h[k] = malloc(sizeof(double) * n);
-        for (int call = 0; call < 12; ++call) {
+        int rested = 0;
+        double visits[2] = {0.0, 0.0};
+        /* Calls in the flow, then one to rest and one after it (which finds nothing to do). */
+        for (int call = 0; call < 14; ++call) {
             for (int k = 0; k < 3; ++k) {
                 if (k == 1) setenv("DPSM_VISIT_ALL_CELLS", "1", 1);
-                CHECK_OK(m[k].g, dpsm_step(m[k].g, 3.0));
+                CHECK_OK(m[k].g, dpsm_step(m[k].g, call < 12 ? 3.0 : 1e4));
                 unsetenv("DPSM_VISIT_ALL_CELLS");
                 CHECK_OK(m[k].g, dpsm_get_heights(m[k].g, h[k]));
+                if (k < 2) visits[k] += step_info_of(m[k].g, DPSM_INFO_CELL_UPDATES);
             }
-            for (int k = 1; k < 3; ++k)
+            for (int k = 1; k < 3; ++k) {
                 REQUIRE(memcmp(h[0], h[k], sizeof(double) * n) == 0, "%s, %s column, call %d: %s changed the heights",
                         kKindNames[kind], p->name, call, k == 1 ? "visiting every cell" : "two threads");
+                /* Rest is found at the same tick however the ticks run. */
+                for (int item = DPSM_INFO_SUBSTEPS; item <= DPSM_INFO_AT_REST; ++item)
+                    REQUIRE(step_info_of(m[0].g, item) == step_info_of(m[k].g, item),
+                            "%s, %s column, call %d: %s gave step information %d = %g, not %g", kKindNames[kind],
+                            p->name, call, k == 1 ? "visiting every cell" : "two threads", item,
+                            step_info_of(m[k].g, item), step_info_of(m[0].g, item));
+            }
+            if (step_info_of(m[0].g, DPSM_INFO_AT_REST) > 0.0) ++rested;
         }
-        REQUIRE(step_info_of(m[0].g, DPSM_INFO_CELL_UPDATES) < step_info_of(m[1].g, DPSM_INFO_CELL_UPDATES),
-                "%s, %s column: the last call visited %g cells, every cell %g", kKindNames[kind], p->name,
-                step_info_of(m[0].g, DPSM_INFO_CELL_UPDATES), step_info_of(m[1].g, DPSM_INFO_CELL_UPDATES));
+        REQUIRE(rested == 2, "%s, %s column: %d calls ended at rest, not the last two", kKindNames[kind], p->name, rested);
+        REQUIRE(step_info_of(m[0].g, DPSM_INFO_SUBSTEPS) == 0.0, "%s, %s column: %g ticks after rest", kKindNames[kind],
+                p->name, step_info_of(m[0].g, DPSM_INFO_SUBSTEPS));
+        REQUIRE(visits[0] < visits[1], "%s, %s column: the calls visited %g cells, every cell %g", kKindNames[kind],
+                p->name, visits[0], visits[1]);
         for (int k = 0; k < 3; ++k) free(h[k]), free_graded(&m[k]);
     }
 }

@@ -151,7 +151,10 @@ typedef struct dpsm_grid dpsm_grid;
  *  advances by `dt`, mass is exact and no new extremum appears, but the
  *  large cells' sub-steps are not those of ::DPSM_RELAX_TIME_ACCURATE, so the
  *  heights differ from its by their own time error. A host's explicit
- *  choice; on a grid the same as ::DPSM_RELAX_TIME_ACCURATE. */
+ *  choice; on a grid the same as ::DPSM_RELAX_TIME_ACCURATE. On a distributed
+ *  mesh the parts exchange in every tick and step bit for bit as the serial
+ *  mesh does. dpsm_step() refuses it with a static angle
+ *  (::DPSM_ERR_NOT_APPLICABLE). */
 #define DPSM_RELAX_LOCAL_STEPS 3
 /** @} */
 

@@ -439,10 +439,12 @@ public:
         // A part whose ghost layer is deep enough steps its ghosts in reach
         // too and exchanges once per batch of sub-steps (mesh/mesh_parts.hpp);
         // the step ends with an exchange, so that a step starts exact.
-        const int per_exchange = s.exchange ? m.substeps_per_exchange : 0;
-        // Local time steps: a serial mesh without a static angle (the stepper refuses the others).
+        const int per_exchange = s.exchange && grid.relaxation() != kLocalSteps ? m.substeps_per_exchange : 0;
+        // Local time steps: not with a static angle (the stepper refuses it).
+        // A part exchanges in every tick.
         const bool local = grid.relaxation() == kLocalSteps;
         if (local) begin_local_steps(grid, m, s);
+        bool rested = false;
         for (std::int64_t k = 0; k < plan.substeps; ++k) {
             double visited = 0.0;
             const int in_batch = per_exchange > 0 ? static_cast<int>(k % per_exchange) + 1 : 0;
@@ -463,10 +465,13 @@ public:
             }
             const bool go_on = book(did);
             if (in_batch > 0 && (!go_on || in_batch == per_exchange || k + 1 == plan.substeps)) end_batch(grid, m, s);
-            if (!go_on) break;
+            if (!go_on) {
+                rested = true;
+                break;
+            }
             k += did.substeps - 1;
         }
-        if (local) end_local_steps(s);
+        if (local) end_local_steps(m, s, rested);
         if (s.lazy) info.cell_updates += catch_up_sources(grid, s, plan.sub_dt);
     }
 
@@ -944,16 +949,37 @@ private:
         const std::int64_t *written_faces, *pulled_cells;
         std::int64_t written_count, pulled_count;
 
+        // Sand that may still move after this tick: it moved, or a cell woken
+        // by a change waits for its faces to fire (a source may keep it so).
+        bool pending = false;
         if (act.all_hot) {
+            // A part of a distributed mesh runs this way in every tick: its
+            // owned cells and the faces that touch them, with the ghosts'
+            // gradients, pulls, limiters and heights from their owners, as
+            // in a dense sub-step.
+            const bool parts = s.exchange != nullptr;
+            std::vector<std::int64_t> &changed_ghosts = s.changed_ghosts;
+            changed_ghosts.clear();
             const std::int64_t *firing = sc.firing_faces.data(), *reading = sc.reading_cells.data();
             const std::int64_t *carrying = sc.carrying_faces.data(), *taking = sc.taking_cells.data();
             const std::int64_t firing_n = sc.firing_end[level], reading_n = sc.reading_end[level];
             const std::int64_t carrying_n = sc.carrying_end[level], taking_n = sc.taking_end[level];
-            if (law.isotropic) for_each_item(reading, reading_n, threads, gradient);
+            if (law.isotropic) {
+                for_each_item(reading, reading_n, threads, gradient);
+                if (parts) {
+                    exchange_ghost_gradients(s, changed_ghosts);
+                    watch_near_moves(m, s, changed_ghosts);
+                }
+            }
             for_each_item(firing, firing_n, threads, terms_of);
             for_each_item(reading, reading_n, threads, [&](std::int64_t c) { pull_of(m, pull, c, pull_x, pull_y); });
+            if (parts) {
+                exchange_ghost_pulls(s, changed_ghosts);
+                changed_ghosts.clear();
+            }
             for_each_item(carrying, carrying_n, threads, flow);
             for_each_item(taking, taking_n, threads, limit);
+            if (parts) exchange_ghost_limits(s);
             for_each_item(carrying, carrying_n, threads, limited);
             for (std::int64_t k = 0; k < carrying_n; ++k) carried(carrying[k]);
             std::uint8_t *changed = s.carried.data();
@@ -967,26 +993,34 @@ private:
                 for (const std::int64_t c : s.source_cells)
                     if (sc.taking_level[c] > level) changed[c] = update_cell(c);
             }
+            if (parts) {
+                exchange_ghost_heights(grid, s, nullptr, changed_ghosts);
+                watch_near_moves(m, s, changed_ghosts);
+                changed_ghosts.clear();
+            }
             std::int64_t changed_cells = 0;
+            int woken = -1;  // the coarsest class the changes woke
             for (std::int64_t k = 0; k < taking_n; ++k)
                 if (changed[taking[k]]) {
                     ++changed_cells;
+                    woken = std::max<int>(woken, sc.waking[taking[k]]);
                     if (s.lazy) watch_near_moves(m, s, taking[k]);
                 }
+            if (woken >= 0) s.pending_until = std::max(s.pending_until, StepClasses::next_tick_at(woken, j));
+            pending = s.pending_until > j || waits_for_sources(s);
             visited = static_cast<double>(taking_n);
             // Where every face has fired and few cells changed, the ticks
-            // after look at those cells and the steep faces alone.
+            // after look at those cells and the steep faces alone (not on a
+            // part, whose ticks exchange as the whole mesh's do).
             const double most = dense_share(threads, m.owned) * static_cast<double>(m.owned);
-            if (level == sc.top && !s.switches.visit_all_cells && !bed &&
+            if (level == sc.top && !s.switches.visit_all_cells && !bed && !parts &&
                 static_cast<double>(changed_cells + kept_hot_by_sources(s)) <= most) {
                 act.all_hot = false;
                 for (std::int64_t c = 0; c < m.owned; ++c)
                     if (changed[c]) wake_local_around(m, s, c);
                 if (s.lazy)
                     for (const std::int64_t c : s.watched_cells) wake_local(s, c);
-                for (std::vector<std::int64_t> &listed : s.steep_by_level) listed.clear();
-                for (std::int64_t f = 0; f < m.live_faces; ++f)
-                    if (steep[f]) s.steep_by_level[sc.face_class[f]].push_back(f);
+                list_steep_faces_by_level(m, s);
             }
             written_faces = carrying, written_count = carrying_n, pulled_cells = reading, pulled_count = reading_n;
         } else {
@@ -1075,9 +1109,14 @@ private:
             // Most of the mesh hot: the ticks run over the classes' lists until every face has fired.
             std::size_t hot_cells = 0;
             for (const std::vector<std::int64_t> &hot : s.hot_by_level) hot_cells += hot.size();
+            pending = hot_cells > 0 || waits_for_sources(s);
             if (static_cast<double>(hot_cells) > dense_share(threads, m.owned) * static_cast<double>(m.owned)) {
+                // Each hot cell would cool at the first tick whose level reaches its coarsest face.
                 for (std::vector<std::int64_t> &hot : s.hot_by_level) {
-                    for (const std::int64_t c : hot) act.hot[c] = 0;
+                    for (const std::int64_t c : hot) {
+                        act.hot[c] = 0;
+                        s.pending_until = std::max(s.pending_until, StepClasses::next_tick_at(sc.coarsest[c], j));
+                    }
                     hot.clear();
                 }
                 act.all_hot = true;
@@ -1096,10 +1135,21 @@ private:
             flux[f] = low[f] = high[f] = pull[f] = excess[f] = 0.0;
         }
         for (std::int64_t k = 0; k < pulled_count; ++k) pull_x[pulled_cells[k]] = pull_y[pulled_cells[k]] = 0.0;
-        // Sand that may still move: it moved, or a hot cell waits for its
-        // faces' classes, or every cell is hot and not every face has fired.
-        did.moved = did.moved || (act.all_hot ? level < sc.top : next_local_tick(s, j) >= 0);
+        did.moved = did.moved || pending;
         return did;
+    }
+
+    // Sources that keep cells hot in every tick: the lazy sources' watched
+    // cells, or sources at every tick.
+    static bool waits_for_sources(const MeshState &s) {
+        return s.lazy ? !s.watched_cells.empty() : !s.source_cells.empty();
+    }
+
+    // The steep faces by their classes, from the faces' flags (after ticks over the classes' lists).
+    static void list_steep_faces_by_level(const Mesh &m, MeshState &s) {
+        for (std::vector<std::int64_t> &listed : s.steep_by_level) listed.clear();
+        for (std::int64_t f = 0; f < m.live_faces; ++f)
+            if (s.steep[f]) s.steep_by_level[s.classes->face_class[f]].push_back(f);
     }
 
     // After tick j: the next tick at which a face may fire (every tick while
@@ -1130,22 +1180,32 @@ private:
     // Before the first tick of a step with local time steps: the classes
     // (once per grid), the passes' values as between sparse sub-steps, and
     // the hot cells by level.
+    // A part runs every tick over the classes' lists (collective: the
+    // classes come from the ranks together).
     static void begin_local_steps(const Grid &grid, const Mesh &m, MeshState &s) {
-        if (!s.classes) s.classes = std::make_unique<const StepClasses>(step_classes_of(m));
+        if (!s.classes)
+            s.classes = std::make_unique<const StepClasses>(
+                s.exchange ? step_classes_of(m, *s.exchange, *grid.distribution()) : step_classes_of(m));
         clear_passes(m, s);
         std::fill(s.excess.begin(), s.excess.end(), 0.0);
         s.hot_by_level.resize(static_cast<std::size_t>(s.classes->top) + 1);
+        s.pending_until = 0;
         MeshActivity &act = s.activity;
-        if (s.switches.visit_all_cells || !grid.bed().empty()) act.wake_all();
+        if (s.switches.visit_all_cells || !grid.bed().empty() || s.exchange) act.wake_all();
         for (const std::int64_t c : act.hot_list) s.hot_by_level[s.classes->finest[c]].push_back(c);
         act.hot_list.clear();
         s.steep_by_level.resize(s.hot_by_level.size());
         for (const std::int64_t f : s.steep_faces) s.steep_by_level[s.classes->face_class[f]].push_back(f);
         s.steep_faces.clear();
     }
-    // After the last tick: the hot cells and the steep faces back where sub-steps keep them.
-    static void end_local_steps(MeshState &s) {
+    // After the last tick: the hot cells and the steep faces back where
+    // sub-steps keep them; where the step found rest, no cell is hot.
+    static void end_local_steps(const Mesh &m, MeshState &s, bool rested) {
         MeshActivity &act = s.activity;
+        if (rested && act.all_hot) {
+            act.all_hot = false;
+            list_steep_faces_by_level(m, s);
+        }
         for (std::vector<std::int64_t> &hot : s.hot_by_level) {
             act.hot_list.insert(act.hot_list.end(), hot.begin(), hot.end());
             hot.clear();

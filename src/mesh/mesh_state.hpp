@@ -136,6 +136,11 @@ struct MeshState final : EngineState {
     std::vector<std::vector<std::int64_t>> hot_by_level;
     // And the steep faces (steep_faces moves here) by their classes.
     std::vector<std::vector<std::int64_t>> steep_by_level;
+    // While every cell is hot: the tick by which every cell a change woke
+    // has seen all its faces fire since (the same tick at which those cells
+    // would cool on the lists), so that sand at rest is found at the same
+    // tick whichever way a tick runs.
+    std::int64_t pending_until = 0;
 };
 
 MeshState &mesh_state(Grid &grid);

@@ -19,6 +19,11 @@
 // fluxes. Each list below is sorted by the finest tick level at which an
 // item takes part (then by index), so that the items of a tick at level L
 // are a prefix: list[0 .. end[L]).
+//
+// On a part of a distributed mesh the lists hold the owned cells and the
+// faces that touch them; a ghost's levels are its owner's, and the top
+// class is the largest on any rank, so that every rank ticks alike and each
+// item fires at the tick it fires at on the whole mesh.
 #pragma once
 
 #include <cstdint>
@@ -27,6 +32,9 @@
 #include "model/mesh.hpp"
 
 namespace dpsm {
+
+class GhostExchange;
+class Collectives;
 
 // Spans of up to 2^20 ticks: a mesh whose cells' bounds span a millionfold.
 constexpr int kMaxStepClass = 20;
@@ -38,6 +46,10 @@ struct StepClasses {
     // tick level at which a face of it fires, and the first at which all do.
     std::vector<std::uint8_t> finest, coarsest;
     std::vector<std::uint8_t> taking_level;  // per cell, the first level whose ticks update it
+    // Per cell, the coarsest class of the faces of the cells a change of it
+    // wakes (itself and the cells whose gradients read it): they have all
+    // fired again by the first tick after the change whose level reaches it.
+    std::vector<std::uint8_t> waking;
     // Faces that fire; cells whose gradients and pulls they read; faces
     // that carry those pulls; cells that limit and take those fluxes.
     std::vector<std::int64_t> firing_faces, reading_cells, carrying_faces, taking_cells;
@@ -53,9 +65,14 @@ struct StepClasses {
     static std::int64_t span(int face_class, std::int64_t j, std::int64_t n) {
         return std::min<std::int64_t>(std::int64_t{1} << face_class, n - j);
     }
+    // The first tick after tick j whose level is at least `level`.
+    static std::int64_t next_tick_at(int level, std::int64_t j) { return ((j >> level) + 1) << level; }
 };
 
 // The classes of a serial mesh's cells and the lists of every tick level.
 StepClasses step_classes_of(const Mesh &m);
+// The same on a part of a distributed mesh; collective: its ghosts' levels
+// come from their owners through `exchange`, the top class from `ranks`.
+StepClasses step_classes_of(const Mesh &m, GhostExchange &exchange, const Collectives &ranks);
 
 }  // namespace dpsm

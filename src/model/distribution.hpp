@@ -50,6 +50,8 @@ public:
     virtual int ranks() const = 0;
     // The sum over all ranks, the same on every rank (added in rank order).
     virtual double sum(double local) const = 0;
+    // The largest over all ranks, the same on every rank.
+    virtual double max(double local) const = 0;
     // As sum(), for a call that a rank may have refused (its `local` is then
     // ignored): false on every rank when any rank refused.
     virtual bool sum_unless_refused(double local, bool refused, double &total) const = 0;

@@ -138,6 +138,12 @@ double Communicator::sum(double local) const {
     return total;
 }
 
+double Communicator::max(double local) const {
+    double largest = local;
+    check_mpi(MPI_Allreduce(MPI_IN_PLACE, &largest, 1, MPI_DOUBLE, MPI_MAX, comm_), "MPI_Allreduce of a maximum");
+    return largest;
+}
+
 int Communicator::rank() const {
     int rank = 0;
     MPI_Comm_rank(comm_, &rank);

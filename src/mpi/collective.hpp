@@ -29,6 +29,7 @@ public:
     int rank() const override;
     int ranks() const override;
     double sum(double local) const override;
+    double max(double local) const override;
     bool sum_unless_refused(double local, bool refused, double &total) const override;
     Failure first_failure(int status, const std::string &message) const override;
     std::uint64_t shared_mark() const override;
@@ -48,6 +49,7 @@ public:
     int rank() const override { return ranks_.rank(); }
     int ranks() const override { return ranks_.ranks(); }
     double sum(double local) const override { return ranks_.sum(local); }
+    double max(double local) const override { return ranks_.max(local); }
     bool sum_unless_refused(double local, bool refused, double &total) const override {
         return ranks_.sum_unless_refused(local, refused, total);
     }

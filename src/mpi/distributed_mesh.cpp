@@ -378,11 +378,11 @@ public:
 
     DistributedPlace place() const override { return {links_.global_cells, 1, 0, 0}; }
 
-    // K sub-steps per exchange where the ghost layer allows K >= 1, else an
-    // exchange of gradients and one of heights in every sub-step.
+    // K sub-steps per exchange where the ghost layer allows K >= 1, else
+    // exchanges in every sub-step (0.5); local time steps exchange in every tick.
     double substeps_per_exchange(const Grid &grid) const override {
         const int k = grid.geometry().mesh->substeps_per_exchange;
-        return k > 0 ? static_cast<double>(k) : 0.5;
+        return k > 0 && grid.relaxation() != kLocalSteps ? static_cast<double>(k) : 0.5;
     }
 
     void changed(const Grid &, unsigned what, const ChangedCells *) override {

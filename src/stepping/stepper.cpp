@@ -118,15 +118,11 @@ void take_part_refusing(Grid &grid) {
     }
 }
 
-// Local time steps (DPSM_RELAX_LOCAL_STEPS) take a serial mesh without a
-// static angle in this version; on a grid, whose cells share one size, they
-// are the time-accurate sub-steps.
+// Local time steps (DPSM_RELAX_LOCAL_STEPS) take a mesh without a static
+// angle in this version; on a grid, whose cells share one size, they are
+// the time-accurate sub-steps.
 void require_local_steps_apply(Grid &grid) {
-    const char *what = nullptr;
-    if (grid.distribution() && grid.geometry().is_mesh())
-        what = "a distributed mesh";
-    else if (grid.hysteresis())
-        what = "a static angle (dpsm_set_static_angle)";
+    const char *what = grid.hysteresis() ? "a static angle (dpsm_set_static_angle)" : nullptr;
     if (!what || !grid.geometry().is_mesh()) return;
     take_part_refusing(grid);
     fail(DPSM_ERR_NOT_APPLICABLE, "dpsm_step", "local time steps (DPSM_RELAX_LOCAL_STEPS) do not take ", what,

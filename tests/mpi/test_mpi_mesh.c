@@ -17,6 +17,7 @@
  *   - the faces of its owned cells carried what the serial faces did, bit for bit.
  *   - with a deep layer, several sub-steps per exchange and at most one
  *     message to each other rank per batch of sub-steps.
+ * The same with local time steps (DPSM_RELAX_LOCAL_STEPS) on graded lattices.
  * Then a refusing rank and inconsistent partitions must fail on every rank
  * with a message naming the problem.
  */
@@ -139,6 +140,16 @@ static mesh_t lattice(int n, int triangles) {
 
 static void free_mesh(mesh_t *m) {
     free(m->node_xy), free(m->cell_start), free(m->cell_nodes), free(m->adj_start), free(m->adj);
+}
+
+/* The lattice with its nodes drawn towards x = 0 and y = 0: cells about 7
+ * times smaller across at one corner than at the other, so that local time
+ * steps (DPSM_RELAX_LOCAL_STEPS) step them in several classes. */
+static mesh_t graded_lattice(int n, int triangles) {
+    mesh_t m = lattice(n, triangles);
+    const double a = 2.0;
+    for (int64_t k = 0; k < 2 * m.nnodes; ++k) m.node_xy[k] = expm1(a * m.node_xy[k]) / expm1(a);
+    return m;
 }
 
 static void centre(const mesh_t *m, int64_t c, double *x, double *y) {
@@ -313,6 +324,9 @@ static const char *const scene_names[] = {"column collapse, open edge", "sources
                                           "bed, erosion, angle field, static angle, edge levels",
                                           "relaxation to rest"};
 
+/* The scenes stepped with local time steps (no static angle: they refuse it). */
+static int local_steps_;
+
 static double column(const mesh_t *m, int64_t c) {
     double x, y;
     centre(m, c, &x, &y);
@@ -366,7 +380,7 @@ static void set_scene(const mesh_t *m, int scene, run_t *r) {
         OK(r->g, dpsm_set_bedrock(r->g, v));
         FILL(4, 0.2)
         OK(r->g, dpsm_set_repose_angle_field(r->g, v));
-        OK(r->g, dpsm_set_static_angle(r->g, 36.0 * M_PI / 180.0));
+        if (!local_steps_) OK(r->g, dpsm_set_static_angle(r->g, 36.0 * M_PI / 180.0));
     }
     FILL(1, DPSM_CELL_WALL)
     for (int64_t k = 0; k < r->ncells; ++k) kinds[k] = (uint8_t)v[k];
@@ -394,6 +408,7 @@ static void set_scene(const mesh_t *m, int scene, run_t *r) {
         free(edge), free(levels);
     }
     if (scene == SCENE_TO_REST) OK(r->g, dpsm_set_relaxation(r->g, DPSM_RELAX_TO_REST));
+    if (local_steps_) OK(r->g, dpsm_set_relaxation(r->g, DPSM_RELAX_LOCAL_STEPS));
     free(v), free(kinds);
 }
 
@@ -448,6 +463,11 @@ static void check_exchanges(const dpsm_grid *part, int layers, int step, const c
     OK(part, dpsm_get_step_info(part, DPSM_INFO_SUBSTEPS, &substeps));
     OK(part, dpsm_get_step_info(part, DPSM_INFO_MESSAGES_SENT, &messages));
     per_exchange_ = per_exchange;
+    if (local_steps_) {
+        require(per_exchange == 0.5, "%s: local time steps exchange every %g sub-steps, not in every tick", at,
+                per_exchange);
+        return;
+    }
     if (substeps_limit_ >= 0) {
         const double want = substeps_limit_ == 0 ? 0.5 : substeps_limit_;
         require(per_exchange == want, "%s: DPSM_MPI_SUBSTEPS_PER_EXCHANGE=%d gave %g sub-steps per exchange", at,
@@ -611,6 +631,15 @@ static void run_scene(const mesh_t *m, int scene, int kind, int graph, int layer
             OK(part.g, dpsm_get_step_info(part.g, item, &b));
             require(a == b, "%s: step info %d is %.17g, serial %.17g", at, item, b, a);
         }
+        if (local_steps_ && step == 0) {
+            /* Several classes: the serial mesh's ticks did not all update every cell. */
+            double updates = 0.0, ticks = 0.0;
+            OK(serial.g, dpsm_get_step_info(serial.g, DPSM_INFO_CELL_UPDATES, &updates));
+            OK(serial.g, dpsm_get_step_info(serial.g, DPSM_INFO_SUBSTEPS, &ticks));
+            require(ticks > 1.0 && updates < 0.75 * ticks * (double)m->ncells,
+                    "%s: %g cell updates in %g ticks of %lld cells: one class", at, updates, ticks,
+                    (long long)m->ncells);
+        }
         double total = 0.0;
         OK(serial.g, dpsm_get_mass(serial.g, DPSM_MASS_TOTAL, &total));
         for (int q = DPSM_MASS_TOTAL; q <= DPSM_MASS_UNMET; ++q) {
@@ -724,6 +753,65 @@ static double local_pile(const mesh_t *m, double at, double quiet_from, const ch
     return sent;
 }
 
+/* Local time steps to rest on a graded lattice of quads in strips: the
+ * heights and the step information bit for bit with the serial mesh's
+ * local time steps after every step, and after rest a step in which no
+ * rank visits a cell or sends a message. */
+static int create_part(const part_t *p, dpsm_grid **g);
+
+static void local_steps_to_rest(void) {
+    const long before = failures_;
+    mesh_t m = graded_lattice(12, 0);
+    int *owner = xcalloc((size_t)m.ncells, sizeof(int));
+    partition(&m, PART_STRIPS, owner);
+    part_t p = part_of(&m, owner, 1);
+    dpsm_grid *serial = NULL, *part = NULL;
+    OK(NULL, dpsm_create_mesh(m.nnodes, m.node_xy, m.ncells, m.cell_start, m.cell_nodes, &serial));
+    OK(NULL, create_part(&p, &part));
+    double *hs = xcalloc((size_t)m.ncells, sizeof(double)), *hp = xcalloc((size_t)p.ncells, sizeof(double));
+    for (int64_t c = 0; c < m.ncells; ++c) hs[c] = column(&m, c);
+    for (int64_t k = 0; k < p.ncells; ++k) hp[k] = hs[p.global[k]];
+    OK(serial, dpsm_set_heights(serial, hs));
+    OK(part, dpsm_set_heights(part, hp));
+    OK(serial, dpsm_set_relaxation(serial, DPSM_RELAX_LOCAL_STEPS));
+    OK(part, dpsm_set_relaxation(part, DPSM_RELAX_LOCAL_STEPS));
+    int rested = 0, step = 0;
+    for (; step < 40 && rested < 2; ++step) {
+        OK(serial, dpsm_step(serial, 0.5));
+        OK(part, dpsm_step(part, 0.5));
+        OK(serial, dpsm_get_heights(serial, hs));
+        OK(part, dpsm_get_heights(part, hp));
+        long differ = 0;
+        for (int64_t k = 0; k < p.ncells; ++k) differ += memcmp(&hp[k], &hs[p.global[k]], sizeof(double)) != 0;
+        require(differ == 0, "local time steps to rest, step %d: %ld local cells differ from the serial mesh", step + 1,
+                differ);
+        double info[DPSM_INFO_MESSAGES_SENT + 1], serial_info[DPSM_INFO_MAX_EXCESS_SLOPE + 1];
+        for (int item = 0; item <= DPSM_INFO_MESSAGES_SENT; ++item) OK(part, dpsm_get_step_info(part, item, &info[item]));
+        for (int item = 0; item <= DPSM_INFO_MAX_EXCESS_SLOPE; ++item)
+            OK(serial, dpsm_get_step_info(serial, item, &serial_info[item]));
+        for (int item = DPSM_INFO_SUBSTEPS; item <= DPSM_INFO_MAX_EXCESS_SLOPE; ++item)
+            require(info[item] == serial_info[item], "local time steps to rest, step %d: step info %d is %.17g, serial %.17g",
+                    step + 1, item, info[item], serial_info[item]);
+        if (rested)
+            require(info[DPSM_INFO_SUBSTEPS] == 0.0 && info[DPSM_INFO_RANK_CELL_UPDATES] == 0.0 &&
+                        info[DPSM_INFO_MESSAGES_SENT] == 0.0,
+                    "local time steps, a step after rest: %g ticks, %g cells visited and %g messages here",
+                    info[DPSM_INFO_SUBSTEPS], info[DPSM_INFO_RANK_CELL_UPDATES], info[DPSM_INFO_MESSAGES_SENT]);
+        if (info[DPSM_INFO_AT_REST] > 0.0) ++rested;
+    }
+    require(rested == 2, "local time steps: not at rest after %d steps of 0.5", step);
+    long mine = failures_ - before, total = 0;
+    MPI_Allreduce(&mine, &total, 1, MPI_LONG, MPI_SUM, MPI_COMM_WORLD);
+    if (rank_ == 0)
+        printf("  graded quads, local time steps to rest: strips, 1 layer of ghosts: %s\n",
+               total == 0 ? "heights bit for bit, at rest at the serial mesh's tick, then idle" : "FAILED, see above");
+    dpsm_destroy(serial), dpsm_destroy(part);
+    free(hs), free(hp);
+    free_part(&p);
+    free(owner);
+    free_mesh(&m);
+}
+
 /* ---- failures on every rank ---------------------------------------------- */
 
 /* Every rank got `status` (not DPSM_OK) and the same one; rank 0's message contains `phrase`. */
@@ -742,9 +830,9 @@ static int create_part(const part_t *p, dpsm_grid **g) {
                                 p->global_id, p->owner, g);
 }
 
-/* Local time steps (DPSM_RELAX_LOCAL_STEPS) are refused on a distributed
- * mesh in this version, on every rank, the heights unchanged; the default
- * steps again. */
+/* Local time steps (DPSM_RELAX_LOCAL_STEPS) with a static angle are refused
+ * on a distributed mesh as on a serial one, on every rank, the heights
+ * unchanged; the default steps again. */
 static void local_steps_refused(void) {
     mesh_t m = lattice(12, 1);
     int *owner = xcalloc((size_t)m.ncells, sizeof(int));
@@ -756,7 +844,8 @@ static void local_steps_refused(void) {
     for (int64_t k = 0; k < p.ncells; ++k) h[k] = column(&m, p.global[k]);
     OK(g, dpsm_set_heights(g, h));
     OK(g, dpsm_set_relaxation(g, DPSM_RELAX_LOCAL_STEPS));
-    require_failed_alike(g, dpsm_step(g, 0.01), "distributed mesh", "local time steps on a distributed mesh");
+    OK(g, dpsm_set_static_angle(g, 36.0 * M_PI / 180.0));
+    require_failed_alike(g, dpsm_step(g, 0.01), "static angle", "local time steps with a static angle");
     OK(g, dpsm_get_heights(g, after));
     require(memcmp(h, after, sizeof(double) * (size_t)p.ncells) == 0, "a refused step changed the heights");
     OK(g, dpsm_set_relaxation(g, DPSM_RELAX_AUTO));
@@ -918,6 +1007,46 @@ int main(int argc, char **argv) {
             printf("  triangles: local piles in strips: %s\n",
                    failed ? "FAILED, see above" : "heights bit for bit, ranks far from the pile idle");
         free_mesh(&m);
+    }
+    {
+        /* Local time steps on graded lattices: three scenes (the third
+         * without its static angle), each partition, polygons and graphs,
+         * one layer of ghosts and a deep one, bit for bit with the serial
+         * mesh's local time steps. With a deep layer of ghosts on a graded
+         * lattice some ghosts on the layer's rim hold as many faces as their
+         * owners (mesh/mesh_parts.cpp, take_owners_edges). */
+        /* Every tick exchanges, and the graded lattice's smallest cells set
+         * the ticks: a selection of the runs above keeps the test short. */
+        static const struct {
+            int local, triangles, scene, kind, graph, layers;
+        } runs[] = {
+            {1, 1, SCENE_COLLAPSE, PART_METIS, 0, 1},   {1, 1, SCENE_COLLAPSE, PART_STRIPS, 0, kDeepLayers},
+            {1, 1, SCENE_COLLAPSE, PART_RANDOM, 1, 1},  {1, 1, SCENE_COLLAPSE, PART_METIS, 1, kDeepLayers},
+            {1, 1, SCENE_SOURCES, PART_METIS, 0, 1},    {1, 1, SCENE_SOURCES, PART_STRIPS, 0, kDeepLayers},
+            {1, 1, SCENE_PHYSICS, PART_STRIPS, 0, 1},   {1, 1, SCENE_PHYSICS, PART_METIS, 0, kDeepLayers},
+            {1, 0, SCENE_COLLAPSE, PART_STRIPS, 0, 1},  {1, 0, SCENE_SOURCES, PART_METIS, 1, kDeepLayers},
+            {1, 0, SCENE_PHYSICS, PART_RANDOM, 0, 1},
+            /* The default's sub-steps on the same deep strips: rim ghosts, batches of sub-steps. */
+            {0, 1, SCENE_COLLAPSE, PART_STRIPS, 0, kDeepLayers},
+        };
+        mesh_t shapes[2] = {graded_lattice(12, 0), graded_lattice(14, 1)};
+        for (size_t k = 0; k < sizeof runs / sizeof runs[0]; ++k) {
+            local_steps_ = runs[k].local;
+            const long before = failures_;
+            run_scene(&shapes[runs[k].triangles], runs[k].scene, runs[k].kind, runs[k].graph, runs[k].layers);
+            long mine = failures_ - before, total = 0;
+            MPI_Allreduce(&mine, &total, 1, MPI_LONG, MPI_SUM, MPI_COMM_WORLD);
+            if (rank_ == 0)
+                printf("  graded %s, %s, %s%s: %s, %s partition, %d layers of ghosts: %s\n",
+                       runs[k].triangles ? "triangles" : "quads", runs[k].local ? "local time steps" : "the default",
+                       scene_names[runs[k].scene],
+                       runs[k].local && runs[k].scene == SCENE_PHYSICS ? " (but the static angle)" : "",
+                       runs[k].graph ? "graph" : "polygons", partition_names[runs[k].kind], runs[k].layers,
+                       total == 0 ? "heights bit for bit" : "FAILED, see above");
+        }
+        free_mesh(&shapes[0]), free_mesh(&shapes[1]);
+        local_steps_ = 0;
+        local_steps_to_rest();
     }
     local_steps_refused();
     inconsistent_partitions();
