@@ -275,7 +275,8 @@ static void check_restart(made_t *m, double dt, double *h, double *hs) {
 
 /* The scene on a grid made: heights (and a source, an open edge) from the
  * input, steps, a restart; then both grids are destroyed.
- * Bytes: mode, v, w, edge, source, steps, then one dt factor per step. */
+ * Bytes: mode, v, w, edge, source, steps, then one dt factor per step; on a
+ * mesh, bit 0 of edge / 12 steps both with DPSM_RELAX_LOCAL_STEPS. */
 static void run_scene(made_t *m, reader_t *r) {
     int64_t sx = 0, sy = 0;
     g_op = "dpsm_get_shape";
@@ -303,6 +304,13 @@ static void run_scene(made_t *m, reader_t *r) {
         const int side = m->edge == DPSM_MESH_EDGE ? DPSM_MESH_EDGE : (int)(edge / 3 % 4);
         if (dpsm_set_boundary(m->g, side, DPSM_OPEN) != DPSM_OK || dpsm_set_boundary(m->serial, side, DPSM_OPEN) != DPSM_OK)
             die("dpsm_set_boundary(%d, open) failed: %s", side, dpsm_last_error(m->g));
+    }
+    if (m->edge == DPSM_MESH_EDGE && edge / 12 % 2 == 1) {
+        /* Local time steps on the part and its twin. */
+        g_op = "dpsm_set_relaxation";
+        if (dpsm_set_relaxation(m->g, DPSM_RELAX_LOCAL_STEPS) != DPSM_OK ||
+            dpsm_set_relaxation(m->serial, DPSM_RELAX_LOCAL_STEPS) != DPSM_OK)
+            die("dpsm_set_relaxation(local steps) failed: %s", dpsm_last_error(m->g));
     }
     if (source % 4 == 1) {
         g_op = "dpsm_set_source";
