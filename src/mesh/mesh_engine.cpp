@@ -451,6 +451,12 @@ public:
             SubstepSummary did = local ? local_tick(grid, m, s, plan.sub_dt, k, plan.substeps, record, visited)
                                        : substep(grid, m, s, plan.sub_dt, static_cast<double>(k), record, visited, in_batch);
             info.cell_updates += visited;
+            if (local) {
+                // The ticks at which nothing is due here pass at once (the
+                // ranks take the fewest any rank may pass).
+                const std::int64_t next = next_local_tick(s, k);
+                did.substeps = (next < 0 ? plan.substeps : std::min(next, plan.substeps)) - k;
+            }
             if (parts) {
                 // Every rank takes the same sub-steps and stops at the same one.
                 std::vector<SubstepSummary> agreed{did};
@@ -458,11 +464,7 @@ public:
                 did = agreed[0];
             }
             if (s.lazy) did.source_may_steepen = source_may_steepen(grid, m, s, plan.sub_dt, did.moved, k + 1);
-            if (local && did.moved) {
-                // The ticks at which nothing is due pass at once.
-                const std::int64_t next = std::min(next_local_tick(s, k), plan.substeps);
-                if (next > k + 1) did.substeps = next - k;
-            }
+            if (!did.moved) did.substeps = 1;
             const bool go_on = book(did);
             if (in_batch > 0 && (!go_on || in_batch == per_exchange || k + 1 == plan.substeps)) end_batch(grid, m, s);
             if (!go_on) {
@@ -610,13 +612,7 @@ private:
             for (std::int64_t f = 0; f < pass_faces; ++f) face_terms(f);
 #pragma omp parallel for num_threads(threads) if (parallel) schedule(static)
             for (std::int64_t c = 0; c < pass_cells; ++c) pull_of(m, pull, c, pull_x, pull_y);
-            if (parts && !in_batch) {
-                exchange_ghost_pulls(s, changed_ghosts);
-                changed_ghosts.clear();
-                s.pulling_ghosts.clear();
-                for (std::int64_t c = m.owned; c < m.cells; ++c)
-                    if (pull_x[c] != 0.0 || pull_y[c] != 0.0) s.pulling_ghosts.push_back(c);
-            }
+            if (parts && !in_batch) take_every_ghosts_pull(m, s);
 #pragma omp parallel for num_threads(threads) if (parallel) schedule(static)
             for (std::int64_t f = 0; f < pass_faces; ++f) high[f] = gradient_flow_flux(m, law, f, high[f], pull_x, pull_y);
 #pragma omp parallel for num_threads(threads) if (parallel) schedule(static)
@@ -748,21 +744,7 @@ private:
             // Pulls: the owned cells of steep faces.
             owned_cells_of(m, s, steep_faces, s.pull_cells);
             for_each_item(s.pull_cells, threads, [&](std::int64_t c) { pull_of(m, pull, c, pull_x, pull_y); });
-            if (exchanges) {
-                // The ghosts that pull: those whose pull changed, and those that pulled before and still do.
-                exchange_ghost_pulls(s, changed_ghosts);
-                std::vector<std::int64_t> &ghosts = s.pulling_ghosts;
-                ghosts.insert(ghosts.end(), changed_ghosts.begin(), changed_ghosts.end());
-                changed_ghosts.clear();
-                const std::uint32_t listed = next_stamp(s);
-                std::size_t still = 0;
-                for (const std::int64_t c : ghosts)
-                    if ((pull_x[c] != 0.0 || pull_y[c] != 0.0) && s.cell_seen[c] != listed) {
-                        s.cell_seen[c] = listed;
-                        ghosts[still++] = c;
-                    }
-                ghosts.resize(still);
-            }
+            if (exchanges) list_pulling_ghosts(s);
             // The gradient flow's flux: the steep faces and the faces of the pulling cells.
             const std::uint32_t carrying = next_stamp(s);
             s.faces.clear();
@@ -816,6 +798,38 @@ private:
         return did;
     }
 
+
+    // On a part, after every owned cell's pull: the ghosts' pulls from
+    // their owners, and every ghost that pulls.
+    static void take_every_ghosts_pull(const Mesh &m, MeshState &s) {
+        std::vector<std::int64_t> &changed_ghosts = s.changed_ghosts;
+        changed_ghosts.clear();
+        exchange_ghost_pulls(s, changed_ghosts);
+        changed_ghosts.clear();
+        s.pulling_ghosts.clear();
+        for (std::int64_t c = m.owned; c < m.cells; ++c)
+            if (s.pull_x[c] != 0.0 || s.pull_y[c] != 0.0) s.pulling_ghosts.push_back(c);
+    }
+
+    // On a part, after its owned cells' pulls: the ghosts' pulls from their
+    // owners, and the ghosts that pull (those whose pull changed, and those
+    // that pulled before and still do), each once.
+    static void list_pulling_ghosts(MeshState &s) {
+        std::vector<std::int64_t> &changed_ghosts = s.changed_ghosts;
+        changed_ghosts.clear();
+        exchange_ghost_pulls(s, changed_ghosts);
+        std::vector<std::int64_t> &ghosts = s.pulling_ghosts;
+        ghosts.insert(ghosts.end(), changed_ghosts.begin(), changed_ghosts.end());
+        changed_ghosts.clear();
+        const std::uint32_t listed = next_stamp(s);
+        std::size_t still = 0;
+        for (const std::int64_t c : ghosts)
+            if ((s.pull_x[c] != 0.0 || s.pull_y[c] != 0.0) && s.cell_seen[c] != listed) {
+                s.cell_seen[c] = listed;
+                ghosts[still++] = c;
+            }
+        ghosts.resize(still);
+    }
 
     // Between sparse sub-steps every face's values and every owned cell's
     // pull hold 0, its limiters 1: after a dense one, they are set so.
@@ -973,10 +987,7 @@ private:
             }
             for_each_item(firing, firing_n, threads, terms_of);
             for_each_item(reading, reading_n, threads, [&](std::int64_t c) { pull_of(m, pull, c, pull_x, pull_y); });
-            if (parts) {
-                exchange_ghost_pulls(s, changed_ghosts);
-                changed_ghosts.clear();
-            }
+            if (parts) take_every_ghosts_pull(m, s);
             for_each_item(carrying, carrying_n, threads, flow);
             for_each_item(taking, taking_n, threads, limit);
             if (parts) exchange_ghost_limits(s);
@@ -996,7 +1007,6 @@ private:
             if (parts) {
                 exchange_ghost_heights(grid, s, nullptr, changed_ghosts);
                 watch_near_moves(m, s, changed_ghosts);
-                changed_ghosts.clear();
             }
             std::int64_t changed_cells = 0;
             int woken = -1;  // the coarsest class the changes woke
@@ -1010,38 +1020,49 @@ private:
             pending = s.pending_until > j || waits_for_sources(s);
             visited = static_cast<double>(taking_n);
             // Where every face has fired and few cells changed, the ticks
-            // after look at those cells and the steep faces alone (not on a
-            // part, whose ticks exchange as the whole mesh's do).
+            // after look at those cells and the steep faces alone.
             const double most = dense_share(threads, m.owned) * static_cast<double>(m.owned);
-            if (level == sc.top && !s.switches.visit_all_cells && !bed && !parts &&
+            if (level == sc.top && !s.switches.visit_all_cells && !bed &&
                 static_cast<double>(changed_cells + kept_hot_by_sources(s)) <= most) {
                 act.all_hot = false;
                 for (std::int64_t c = 0; c < m.owned; ++c)
                     if (changed[c]) wake_local_around(m, s, c);
+                for (const std::int64_t c : changed_ghosts) wake_local_around(m, s, c);
                 if (s.lazy)
                     for (const std::int64_t c : s.watched_cells) wake_local(s, c);
                 list_steep_faces_by_level(m, s);
             }
             written_faces = carrying, written_count = carrying_n, pulled_cells = reading, pulled_count = reading_n;
         } else {
+            // On a part, with the exchanges of a sparse sub-step: a ghost
+            // whose gradient changed has its due faces looked at now and
+            // stays hot as its owner keeps it; the faces of the ghosts that
+            // pull carry; the ghosts whose heights changed wake the cells
+            // that read them.
+            const bool parts = s.exchange != nullptr;
+            std::vector<std::int64_t> &changed_ghosts = s.changed_ghosts;
+            changed_ghosts.clear();
             const std::uint32_t stamp = next_stamp(s);
             s.faces.clear();
             s.gradient_cells.clear();
+            const auto look_at_due_faces_of = [&](std::int64_t c) {
+                for (std::int64_t k = m.cell_face_start[c]; k < m.cell_face_start[c + 1]; ++k) {
+                    const std::int64_t f = m.cell_faces[k];
+                    if (f >= m.live_faces || sc.face_class[f] > level || s.face_seen[f] == stamp) continue;
+                    s.face_seen[f] = stamp;
+                    s.faces.push_back(f);
+                    for (const std::int64_t e : {m.face_a[f], m.face_b[f]})
+                        if (e >= 0 && e < m.owned && s.cell_seen[e] != stamp) {
+                            s.cell_seen[e] = stamp;
+                            s.gradient_cells.push_back(e);
+                        }
+                }
+            };
             for (int l = 0; l <= level; ++l) {
                 std::vector<std::int64_t> &hot = s.hot_by_level[static_cast<std::size_t>(l)];
                 std::size_t kept = 0;
                 for (const std::int64_t c : hot) {
-                    for (std::int64_t k = m.cell_face_start[c]; k < m.cell_face_start[c + 1]; ++k) {
-                        const std::int64_t f = m.cell_faces[k];
-                        if (f >= m.live_faces || sc.face_class[f] > level || s.face_seen[f] == stamp) continue;
-                        s.face_seen[f] = stamp;
-                        s.faces.push_back(f);
-                        for (const std::int64_t e : {m.face_a[f], m.face_b[f]})
-                            if (e >= 0 && s.cell_seen[e] != stamp) {
-                                s.cell_seen[e] = stamp;
-                                s.gradient_cells.push_back(e);
-                            }
-                    }
+                    look_at_due_faces_of(c);
                     if (sc.coarsest[c] <= level)
                         act.hot[c] = 0;
                     else
@@ -1049,7 +1070,18 @@ private:
                 }
                 hot.resize(kept);
             }
-            if (law.isotropic) for_each_item(s.gradient_cells, threads, gradient);
+            if (law.isotropic) {
+                for_each_item(s.gradient_cells, threads, gradient);
+                if (parts) {
+                    exchange_ghost_gradients(s, changed_ghosts);
+                    watch_near_moves(m, s, changed_ghosts);
+                    for (const std::int64_t c : changed_ghosts) {
+                        look_at_due_faces_of(c);
+                        if (sc.coarsest[c] > level) wake_local(s, c);
+                    }
+                    changed_ghosts.clear();
+                }
+            }
             std::vector<std::uint8_t> &became_steep = s.became_steep;
             became_steep.resize(s.faces.size());
             for_each_place(s.faces, threads, [&](std::int64_t k, std::int64_t f) {
@@ -1080,6 +1112,7 @@ private:
                     if (steep[f]) due.push_back(f);
             owned_cells_of(m, s, due, s.pull_cells);
             for_each_item(s.pull_cells, threads, [&](std::int64_t c) { pull_of(m, pull, c, pull_x, pull_y); });
+            if (parts) list_pulling_ghosts(s);
             const std::uint32_t carrying = next_stamp(s);
             std::vector<std::int64_t> &faces = s.update_cells;  // scratch until the updates' list
             faces.clear();
@@ -1089,18 +1122,23 @@ private:
                 faces.push_back(f);
             };
             for (const std::int64_t f : due) carry(f);
-            for (const std::int64_t c : s.pull_cells)
-                for (std::int64_t k = m.cell_face_start[c]; k < m.cell_face_start[c + 1]; ++k) carry(m.cell_faces[k]);
+            for (const std::vector<std::int64_t> *cells : {&s.pull_cells, &s.pulling_ghosts})
+                for (const std::int64_t c : *cells)
+                    for (std::int64_t k = m.cell_face_start[c]; k < m.cell_face_start[c + 1]; ++k) carry(m.cell_faces[k]);
             s.faces.swap(faces);
             for_each_item(s.faces, threads, flow);
             owned_cells_of(m, s, s.faces, s.limit_cells);
             for_each_item(s.limit_cells, threads, limit);
+            if (parts) exchange_ghost_limits(s);
             for_each_item(s.faces, threads, limited);
             list_updates(m, s, did.moved, did.max_excess_slope);
             for_each_item(s.update_cells, threads, [&](std::int64_t c) { update_cell(c); });
             visited = cells_visited(s);
+            if (parts) exchange_ghost_heights(grid, s, &s.update_cells, changed_ghosts);
             watch_near_moves(m, s, s.update_cells);
+            watch_near_moves(m, s, changed_ghosts);
             for (const std::int64_t c : s.update_cells) wake_local_around(m, s, c);
+            for (const std::int64_t c : changed_ghosts) wake_local_around(m, s, c);
             if (s.lazy)
                 for (const std::int64_t c : s.watched_cells) wake_local(s, c);
             for (const std::int64_t c : s.limit_cells) limit_in[c] = limit_out[c] = 1.0;
@@ -1180,8 +1218,7 @@ private:
     // Before the first tick of a step with local time steps: the classes
     // (once per grid), the passes' values as between sparse sub-steps, and
     // the hot cells by level.
-    // A part runs every tick over the classes' lists (collective: the
-    // classes come from the ranks together).
+    // On a part, collective: the classes come from the ranks together.
     static void begin_local_steps(const Grid &grid, const Mesh &m, MeshState &s) {
         if (!s.classes)
             s.classes = std::make_unique<const StepClasses>(
@@ -1191,7 +1228,7 @@ private:
         s.hot_by_level.resize(static_cast<std::size_t>(s.classes->top) + 1);
         s.pending_until = 0;
         MeshActivity &act = s.activity;
-        if (s.switches.visit_all_cells || !grid.bed().empty() || s.exchange) act.wake_all();
+        if (s.switches.visit_all_cells || !grid.bed().empty()) act.wake_all();
         for (const std::int64_t c : act.hot_list) s.hot_by_level[s.classes->finest[c]].push_back(c);
         act.hot_list.clear();
         s.steep_by_level.resize(s.hot_by_level.size());

@@ -115,7 +115,8 @@ public:
     // (the refusing rank's caller reports its own reason).
     virtual StepAgreement agree_before_step(Grid &grid, const Engine &engine, double dt, bool refused) = 0;
     // Collective, after each sweep: whether each of its sub-steps moved
-    // anything and its largest excess slope, over all ranks.
+    // anything and its largest excess slope, over all ranks, and the fewest
+    // sub-steps any rank says it stands for.
     virtual void agree_on_substeps(std::vector<SubstepSummary> &levels) const = 0;
     virtual DistributedPlace place() const = 0;
     // The sub-steps taken between two exchanges of ghost values (0.5: two

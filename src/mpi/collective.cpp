@@ -110,12 +110,14 @@ void CollectiveDistribution::agree_on_substeps(std::vector<SubstepSummary> &leve
     for (const SubstepSummary &level : levels) {
         v.push_back(level.moved ? 1.0 : 0.0);
         v.push_back(level.max_excess_slope);
+        v.push_back(-static_cast<double>(level.substeps));  // the fewest
     }
     check_mpi(MPI_Allreduce(MPI_IN_PLACE, v.data(), static_cast<int>(v.size()), MPI_DOUBLE, MPI_MAX, comm_),
               "MPI_Allreduce after a sweep");
     for (std::size_t s = 0; s < levels.size(); ++s) {
-        levels[s].moved = v[2 * s] != 0.0;
-        levels[s].max_excess_slope = v[2 * s + 1];
+        levels[s].moved = v[3 * s] != 0.0;
+        levels[s].max_excess_slope = v[3 * s + 1];
+        levels[s].substeps = static_cast<std::int64_t>(-v[3 * s + 2]);
     }
 }
 
