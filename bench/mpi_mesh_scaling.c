@@ -28,6 +28,16 @@
  * the fully active scene in the same run; it
  * prints per rank the cells visited and the messages sent per sub-step, and
  * how many ranks did neither (local_run).
+ *
+ *   mpiexec -n P dpsm-bench-mpi-mesh N STEPS graded
+ *
+ * grades the lattice (nodes drawn towards one corner: cells about 55 times
+ * smaller across there than at the other), puts the cone on the coarse cells
+ * and steps it STEPS calls of 4096 of the default's sub-steps each, with
+ * local time steps (DPSM_RELAX_LOCAL_STEPS) and with the default's global
+ * sub-step, on the same parts in the same run (graded_run): seconds, ticks
+ * evaluated, cell updates and messages per call of each, and the L1
+ * difference of the two deposits over the volume moved.
  */
 #include <malloc.h>
 #include <math.h>
@@ -287,18 +297,82 @@ static void local_run(const mesh_t *m, const part_t *p, int steps, const char *w
     }
 }
 
+/* The graded scene (see the header): local time steps against the global
+ * sub-step, STEPS calls each; one CSV line. */
+static void graded_run(const mesh_t *m, const part_t *p, int steps) {
+    local_scene = 1;
+    pile_x = pile_y = 0.8 * (double)m->n;
+    double totals[2][4] = {{0}};  /* seconds, ticks evaluated, cell updates (all ranks), messages (this rank) */
+    double *h[2] = {xcalloc((size_t)p->ncells, sizeof(double)), xcalloc((size_t)p->ncells, sizeof(double))};
+    double *h0 = xcalloc((size_t)p->ncells, sizeof(double));
+    double dt = 0.0;
+    for (int local = 0; local < 2; ++local) {
+        dpsm_grid *g = make_grid(m, p, 1, 0);
+        if (local) CHECK(g, dpsm_set_relaxation(g, DPSM_RELAX_LOCAL_STEPS));
+        CHECK(g, dpsm_get_heights(g, h0));
+        CHECK(g, dpsm_stable_dt(g, &dt));
+        CHECK(g, dpsm_set_max_substeps(g, 1 << 20));
+        for (int s = 0; s < steps; ++s) {
+            MPI_Barrier(MPI_COMM_WORLD);
+            const double t0 = MPI_Wtime();
+            CHECK(g, dpsm_step(g, 4096.0 * dt));
+            double t = MPI_Wtime() - t0, v = 0.0;
+            MPI_Allreduce(MPI_IN_PLACE, &t, 1, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
+            totals[local][0] += t;
+            CHECK(g, dpsm_get_step_info(g, DPSM_INFO_SUBSTEPS_EVALUATED, &v));
+            totals[local][1] += v;
+            CHECK(g, dpsm_get_step_info(g, DPSM_INFO_CELL_UPDATES, &v));
+            totals[local][2] += v;
+            CHECK(g, dpsm_get_step_info(g, DPSM_INFO_MESSAGES_SENT, &v));
+            totals[local][3] += v;
+        }
+        CHECK(g, dpsm_get_heights(g, h[local]));
+        dpsm_destroy(g);
+    }
+    /* Over the owned cells, areas from the nodes (the parts hold the same cells). */
+    double sums[2] = {0.0, 0.0}, messages[2] = {totals[0][3], totals[1][3]};
+    for (int64_t k = 0; k < p->ncells; ++k) {
+        if (p->owner[k] != rank_) continue;
+        const int64_t *v = m->cell_nodes + 3 * p->global[k];
+        const double *a = m->node_xy + 2 * v[0], *b = m->node_xy + 2 * v[1], *c = m->node_xy + 2 * v[2];
+        const double area = 0.5 * fabs((b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]));
+        sums[0] += fabs(h[1][k] - h[0][k]) * area;
+        sums[1] += 0.5 * fabs(h[0][k] - h0[k]) * area;
+    }
+    MPI_Allreduce(MPI_IN_PLACE, sums, 2, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
+    MPI_Allreduce(MPI_IN_PLACE, messages, 2, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
+    if (rank_ == 0) {
+        fprintf(stderr, "dpsm-bench-mpi-mesh, a pile on the coarse cells of a graded mesh: %d ranks, %lld cells, %d calls "
+                        "of 4096 global sub-steps\n", size_, (long long)m->ncells, steps);
+        printf("scene,ranks,cells,calls,global_seconds_per_call,local_seconds_per_call,seconds_ratio,global_ticks_per_call,"
+               "local_ticks_per_call,global_cell_updates_per_call,local_cell_updates_per_call,updates_ratio,"
+               "global_messages_per_call_max_rank,local_messages_per_call_max_rank,l1_difference_over_moved\n");
+        printf("graded,%d,%lld,%d,%.4e,%.4e,%.4f,%.0f,%.0f,%.4e,%.4e,%.5f,%.1f,%.1f,%.3e\n", size_, (long long)m->ncells, steps,
+               totals[0][0] / steps, totals[1][0] / steps, totals[1][0] / totals[0][0], totals[0][1] / steps,
+               totals[1][1] / steps, totals[0][2] / steps, totals[1][2] / steps, totals[1][2] / totals[0][2],
+               messages[0] / steps, messages[1] / steps, sums[1] > 0.0 ? sums[0] / sums[1] : 0.0);
+    }
+    free(h[0]), free(h[1]), free(h0);
+}
+
 int main(int argc, char **argv) {
     MPI_Init(&argc, &argv);
     MPI_Comm_rank(MPI_COMM_WORLD, &rank_);
     MPI_Comm_size(MPI_COMM_WORLD, &size_);
     if (argc < 2) {
-        if (rank_ == 0) fprintf(stderr, "usage: mpiexec -n P dpsm-bench-mpi-mesh N [STEPS [corner|centre]]\n");
+        if (rank_ == 0) fprintf(stderr, "usage: mpiexec -n P dpsm-bench-mpi-mesh N [STEPS [LAYERS|corner|centre|graded]]\n");
         MPI_Finalize();
         return 2;
     }
     const int64_t n = atoll(argv[1]);
     const int steps = argc > 2 ? atoi(argv[2]) : 5;
     mesh_t m = triangles(n);
+    const int graded = argc > 3 && strcmp(argv[3], "graded") == 0;
+    if (graded) {
+        /* Nodes drawn towards (0, 0): spacing 4 / expm1(4) there, 4 e^4 / expm1(4) at the far corner. */
+        for (int64_t k = 0; k < 2 * m.nnodes; ++k)
+            m.node_xy[k] = (double)n * expm1(4.0 * m.node_xy[k] / (double)n) / expm1(4.0);
+    }
 
     /* METIS on rank 0, the partition to every rank. */
     int *owner = xcalloc((size_t)m.ncells, sizeof(int));
@@ -318,7 +392,7 @@ int main(int argc, char **argv) {
     }
     MPI_Bcast(owner, (int)m.ncells, MPI_INT, 0, MPI_COMM_WORLD);
     const int local = argc > 3 && (strcmp(argv[3], "corner") == 0 || strcmp(argv[3], "centre") == 0);
-    const int layers = argc > 3 && !local ? atoi(argv[3]) : 2;
+    const int layers = argc > 3 && !local && !graded ? atoi(argv[3]) : graded ? 1 : 2;
     if (layers < 1) {
         if (rank_ == 0) fprintf(stderr, "dpsm-bench-mpi-mesh: LAYERS is %s, not a number of layers from 1\n", argv[3]);
         MPI_Finalize();
@@ -326,9 +400,12 @@ int main(int argc, char **argv) {
     }
     part_t p = part_of(&m, owner, layers);
 
-    if (local) {
+    if (local || graded) {
         if (strcmp(argv[3], "centre") == 0) pile_x = pile_y = 0.5 * (double)n;
-        local_run(&m, &p, steps, argv[3]);
+        if (graded)
+            graded_run(&m, &p, steps);
+        else
+            local_run(&m, &p, steps, argv[3]);
         free(owner), free(p.global), free(p.owner);
         free(m.node_xy), free(m.cell_nodes), free(m.adj_start), free(m.adj);
         MPI_Finalize();

@@ -7,7 +7,9 @@
 # and 4 ranks (oversubscribed past the cores), with two layers of ghosts and
 # with deeper ones (MESH_LAYERS, default "8 12": 2 and 4 sub-steps per
 # exchange), into docs/data/mpi_mesh_scaling.csv, a local pile on the same mesh (what ranks
-# at rest compute and send) into docs/data/mpi_mesh_rest.csv, and the cost
+# at rest compute and send) into docs/data/mpi_mesh_rest.csv, local time steps on a
+# graded mesh of 180,000 triangles against the global sub-step into
+# docs/data/mpi_mesh_graded.csv, and the cost
 # model extrapolated to 1,024 ranks into docs/data/mpi_mesh_model.txt.
 # MESH_ONLY=1 runs the mesh alone.
 #
@@ -62,6 +64,14 @@ mesh_n=${MESH_N:-708}
     done
   done
 } >"$data/mpi_mesh_rest.csv"
+# Local time steps on a graded mesh against the global sub-step (a pile on the coarse cells).
+{
+  head=1
+  for p in 1 2; do
+    mpiexec -n "$p" --bind-to core "$mesh_bench" 300 5 graded | if [[ $head == 1 ]]; then cat; else tail -n 1; fi
+    head=0
+  done
+} >"$data/mpi_mesh_graded.csv"
 {
   echo "generated: $(date -u +%Y-%m-%dT%H:%M:%SZ) by bench/run_mpi_scaling.sh, source tree $(git -C "$root" describe --always --dirty 2>/dev/null || echo unknown)"
   echo "machine: $(uname -m), $(nproc --all) cores, $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2- | sed 's/^ //'); load average after the runs: $(cut -d' ' -f1-3 /proc/loadavg)"
