@@ -692,19 +692,7 @@ private:
             const std::uint32_t stamp = next_stamp(s);
             s.faces.clear();
             s.gradient_cells.clear();
-            const auto look_at_faces_of = [&](std::int64_t c) {
-                for (std::int64_t k = m.cell_face_start[c]; k < m.cell_face_start[c + 1]; ++k) {
-                    const std::int64_t f = m.cell_faces[k];
-                    if (f >= m.live_faces || s.face_seen[f] == stamp) continue;
-                    s.face_seen[f] = stamp;
-                    s.faces.push_back(f);
-                    for (const std::int64_t e : {m.face_a[f], m.face_b[f]})
-                        if (e >= 0 && e < m.owned && s.cell_seen[e] != stamp) {
-                            s.cell_seen[e] = stamp;
-                            s.gradient_cells.push_back(e);
-                        }
-                }
-            };
+            const auto look_at_faces_of = [&](std::int64_t c) { look_at_faces(m, s, c, stamp, nullptr, 0); };
             for (const std::int64_t c : act.hot_list) look_at_faces_of(c);
             clear_passes(m, s);
             if (law.isotropic) {
@@ -798,6 +786,25 @@ private:
         return did;
     }
 
+
+    // The faces of cell c that touch an owned cell (with classes given,
+    // those of a class at most `level`), each once a sub-step (`stamp`), into
+    // s.faces, and their owned cells, whose gradients the sub-step finds,
+    // into s.gradient_cells.
+    static void look_at_faces(const Mesh &m, MeshState &s, std::int64_t c, std::uint32_t stamp,
+                              const std::uint8_t *face_class, int level) {
+        for (std::int64_t k = m.cell_face_start[c]; k < m.cell_face_start[c + 1]; ++k) {
+            const std::int64_t f = m.cell_faces[k];
+            if (f >= m.live_faces || (face_class && face_class[f] > level) || s.face_seen[f] == stamp) continue;
+            s.face_seen[f] = stamp;
+            s.faces.push_back(f);
+            for (const std::int64_t e : {m.face_a[f], m.face_b[f]})
+                if (e >= 0 && e < m.owned && s.cell_seen[e] != stamp) {
+                    s.cell_seen[e] = stamp;
+                    s.gradient_cells.push_back(e);
+                }
+        }
+    }
 
     // On a part, after every owned cell's pull: the ghosts' pulls from
     // their owners, and every ghost that pulls.
@@ -1046,17 +1053,7 @@ private:
             s.faces.clear();
             s.gradient_cells.clear();
             const auto look_at_due_faces_of = [&](std::int64_t c) {
-                for (std::int64_t k = m.cell_face_start[c]; k < m.cell_face_start[c + 1]; ++k) {
-                    const std::int64_t f = m.cell_faces[k];
-                    if (f >= m.live_faces || sc.face_class[f] > level || s.face_seen[f] == stamp) continue;
-                    s.face_seen[f] = stamp;
-                    s.faces.push_back(f);
-                    for (const std::int64_t e : {m.face_a[f], m.face_b[f]})
-                        if (e >= 0 && e < m.owned && s.cell_seen[e] != stamp) {
-                            s.cell_seen[e] = stamp;
-                            s.gradient_cells.push_back(e);
-                        }
-                }
+                look_at_faces(m, s, c, stamp, sc.face_class.data(), level);
             };
             for (int l = 0; l <= level; ++l) {
                 std::vector<std::int64_t> &hot = s.hot_by_level[static_cast<std::size_t>(l)];

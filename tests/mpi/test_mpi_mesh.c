@@ -669,19 +669,28 @@ done:
 
 /* ---- a local pile: ranks at rest ------------------------------------------ */
 
-/* A small pile on a mesh in strips: at x = `at`, closed edges, stepped in
- * short steps until it rests. Besides the heights (bit for bit with the
- * serial mesh after every step) it checks what each rank did: the ranks'
- * cell updates add up to the step's; a rank whose strip lies beyond
+/* How local_pile steps: the partition, the ghost layers, DPSM_RELAX_LOCAL_STEPS
+ * or the default, the step's dt and the most steps. */
+typedef struct {
+    int kind, layers, local_steps;
+    double dt;
+    int most_steps;
+} pile_run_t;
+
+/* A small pile on a mesh: at x = `at`, closed edges, stepped in short steps
+ * until it rests. Besides the heights (bit for bit with the serial mesh,
+ * stepped alike, after every step) it checks what each rank did: the ranks'
+ * cell updates add up to the step's; a rank whose cells lie beyond
  * `quiet_from` (where the pile never reaches) computes and sends nothing
- * after the first step (whose first sub-step looks at every cell); and
- * the rank holding the pile visits fewer cells than its owned cells times the
- * sub-steps once the pile has mostly settled (the active set). Returns the
- * messages this rank sent over all steps. */
-static double local_pile(const mesh_t *m, double at, double quiet_from, const char *where) {
+ * after the first step (whose first sub-step looks at every cell); the rank
+ * holding the pile visits fewer cells than its owned cells times the
+ * sub-steps once the pile has mostly settled (the active set); and the step
+ * after rest visits and sends nothing on any rank. Returns the messages this
+ * rank sent over all steps. */
+static double local_pile(const mesh_t *m, double at, double quiet_from, const char *where, pile_run_t how) {
     int *owner = xcalloc((size_t)m->ncells, sizeof(int));
-    partition(m, PART_STRIPS, owner);
-    part_t p = part_of(m, owner, 2);
+    partition(m, how.kind, owner);
+    part_t p = part_of(m, owner, how.layers);
     dpsm_grid *serial = NULL, *part = NULL;
     OK(NULL, dpsm_create_mesh(m->nnodes, m->node_xy, m->ncells, m->cell_start, m->cell_nodes, &serial));
     OK(NULL, dpsm_create_mesh_mpi(MPI_COMM_WORLD, p.nnodes, p.node_xy, p.ncells, p.cell_start, p.cell_nodes,
@@ -703,12 +712,16 @@ static double local_pile(const mesh_t *m, double at, double quiet_from, const ch
             x0 = fmin(x0, x);
             owned += 1.0;
         }
-    int sparse_seen = 0, moving_rank = 0;
-    for (int step = 0; step < 40; ++step) {
+    if (how.local_steps) {
+        OK(serial, dpsm_set_relaxation(serial, DPSM_RELAX_LOCAL_STEPS));
+        OK(part, dpsm_set_relaxation(part, DPSM_RELAX_LOCAL_STEPS));
+    }
+    int sparse_seen = 0, moving_rank = 0, rested = 0, step = 0;
+    for (; step < how.most_steps && rested < 2; ++step) {
         char at_step[300];
         snprintf(at_step, sizeof at_step, "%s, step %d", where, step + 1);
-        OK(serial, dpsm_step(serial, 0.01));
-        OK(part, dpsm_step(part, 0.01));
+        OK(serial, dpsm_step(serial, how.dt));
+        OK(part, dpsm_step(part, how.dt));
         OK(serial, dpsm_get_heights(serial, hs));
         OK(part, dpsm_get_heights(part, hp));
         long differ = 0;
@@ -735,11 +748,17 @@ static double local_pile(const mesh_t *m, double at, double quiet_from, const ch
                     "messages (%g bytes)", at_step, x0, info[DPSM_INFO_RANK_CELL_UPDATES],
                     info[DPSM_INFO_MESSAGES_SENT], info[DPSM_INFO_BYTES_SENT]);
         }
+        if (rested)
+            require(info[DPSM_INFO_SUBSTEPS] == 0.0 && info[DPSM_INFO_RANK_CELL_UPDATES] == 0.0 &&
+                        info[DPSM_INFO_MESSAGES_SENT] == 0.0,
+                    "%s, after rest: %g sub-steps, %g cells visited and %g messages here", at_step,
+                    info[DPSM_INFO_SUBSTEPS], info[DPSM_INFO_RANK_CELL_UPDATES], info[DPSM_INFO_MESSAGES_SENT]);
         if (info[DPSM_INFO_RANK_CELL_UPDATES] > 0.0) moving_rank = 1;
         if (info[DPSM_INFO_RANK_CELL_UPDATES] > 0.0 && info[DPSM_INFO_RANK_CELL_UPDATES] < owned * info[DPSM_INFO_SUBSTEPS])
             sparse_seen = 1;
-        if (info[DPSM_INFO_AT_REST] == 1.0 && step > 0) break;
+        if (info[DPSM_INFO_AT_REST] == 1.0 && step > 0) ++rested;
     }
+    require(rested == 2, "%s: not at rest after %d steps of %g", where, step, how.dt);
     int any_sparse = 0, any_moving = 0;
     MPI_Allreduce(&sparse_seen, &any_sparse, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
     MPI_Allreduce(&moving_rank, &any_moving, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
@@ -751,85 +770,6 @@ static double local_pile(const mesh_t *m, double at, double quiet_from, const ch
     free_part(&p);
     free(owner);
     return sent;
-}
-
-/* Local time steps to rest on a graded lattice in a partition of `kind`, a pile at x = `at`
- * that spreads less than 0.2 from there: the heights and the step
- * information bit for bit with the serial mesh's local time steps after
- * every step; a rank whose strip lies beyond x = `quiet_from` visits no cell
- * and sends nothing after the first step (whose first tick looks at every
- * cell); after rest a step in which no rank visits a cell or sends a
- * message. */
-static int create_part(const part_t *p, dpsm_grid **g);
-
-static void local_steps_to_rest(int triangles, int kind, double at, double quiet_from, const char *where) {
-    const long before = failures_;
-    mesh_t m = graded_lattice(12, triangles);
-    int *owner = xcalloc((size_t)m.ncells, sizeof(int));
-    partition(&m, kind, owner);
-    part_t p = part_of(&m, owner, 1);
-    dpsm_grid *serial = NULL, *part = NULL;
-    OK(NULL, dpsm_create_mesh(m.nnodes, m.node_xy, m.ncells, m.cell_start, m.cell_nodes, &serial));
-    OK(NULL, create_part(&p, &part));
-    double *hs = xcalloc((size_t)m.ncells, sizeof(double)), *hp = xcalloc((size_t)p.ncells, sizeof(double));
-    for (int64_t c = 0; c < m.ncells; ++c) {
-        double x, y;
-        centre(&m, c, &x, &y);
-        hs[c] = fmax(0.0, 0.3 - 3.0 * hypot(x - at, y - 0.5));
-    }
-    for (int64_t k = 0; k < p.ncells; ++k) hp[k] = hs[p.global[k]];
-    double x0 = 1.0;
-    for (int64_t k = 0; k < p.ncells; ++k)
-        if (p.owner[k] == rank_) {
-            double x, y;
-            centre(&m, p.global[k], &x, &y);
-            x0 = fmin(x0, x);
-        }
-    OK(serial, dpsm_set_heights(serial, hs));
-    OK(part, dpsm_set_heights(part, hp));
-    OK(serial, dpsm_set_relaxation(serial, DPSM_RELAX_LOCAL_STEPS));
-    OK(part, dpsm_set_relaxation(part, DPSM_RELAX_LOCAL_STEPS));
-    int rested = 0, step = 0;
-    for (; step < 60 && rested < 2; ++step) {
-        OK(serial, dpsm_step(serial, 0.05));
-        OK(part, dpsm_step(part, 0.05));
-        OK(serial, dpsm_get_heights(serial, hs));
-        OK(part, dpsm_get_heights(part, hp));
-        long differ = 0;
-        for (int64_t k = 0; k < p.ncells; ++k) differ += memcmp(&hp[k], &hs[p.global[k]], sizeof(double)) != 0;
-        require(differ == 0, "local time steps to rest, step %d: %ld local cells differ from the serial mesh", step + 1,
-                differ);
-        double info[DPSM_INFO_MESSAGES_SENT + 1], serial_info[DPSM_INFO_MAX_EXCESS_SLOPE + 1];
-        for (int item = 0; item <= DPSM_INFO_MESSAGES_SENT; ++item) OK(part, dpsm_get_step_info(part, item, &info[item]));
-        for (int item = 0; item <= DPSM_INFO_MAX_EXCESS_SLOPE; ++item)
-            OK(serial, dpsm_get_step_info(serial, item, &serial_info[item]));
-        for (int item = DPSM_INFO_SUBSTEPS; item <= DPSM_INFO_MAX_EXCESS_SLOPE; ++item)
-            require(info[item] == serial_info[item], "local time steps to rest, step %d: step info %d is %.17g, serial %.17g",
-                    step + 1, item, info[item], serial_info[item]);
-        if (step > 0 && x0 >= quiet_from)
-            require(info[DPSM_INFO_RANK_CELL_UPDATES] == 0.0 && info[DPSM_INFO_MESSAGES_SENT] == 0.0,
-                    "local time steps, step %d: this rank's strip (x from %.3f) lies far from the pile, yet it visited "
-                    "%g cells and sent %g messages", step + 1, x0, info[DPSM_INFO_RANK_CELL_UPDATES],
-                    info[DPSM_INFO_MESSAGES_SENT]);
-        if (rested)
-            require(info[DPSM_INFO_SUBSTEPS] == 0.0 && info[DPSM_INFO_RANK_CELL_UPDATES] == 0.0 &&
-                        info[DPSM_INFO_MESSAGES_SENT] == 0.0,
-                    "local time steps, a step after rest: %g ticks, %g cells visited and %g messages here",
-                    info[DPSM_INFO_SUBSTEPS], info[DPSM_INFO_RANK_CELL_UPDATES], info[DPSM_INFO_MESSAGES_SENT]);
-        if (info[DPSM_INFO_AT_REST] > 0.0) ++rested;
-    }
-    require(rested == 2, "local time steps: not at rest after %d steps of 0.05", step);
-    long mine = failures_ - before, total = 0;
-    MPI_Allreduce(&mine, &total, 1, MPI_LONG, MPI_SUM, MPI_COMM_WORLD);
-    if (rank_ == 0)
-        printf("  graded %s, local time steps, %s, to rest: 1 layer of ghosts: %s\n", triangles ? "triangles" : "quads",
-               where, total == 0 ? "heights bit for bit, ranks far from the pile idle, at rest at the serial mesh's "
-                                   "tick, then idle" : "FAILED, see above");
-    dpsm_destroy(serial), dpsm_destroy(part);
-    free(hs), free(hp);
-    free_part(&p);
-    free(owner);
-    free_mesh(&m);
 }
 
 /* ---- failures on every rank ---------------------------------------------- */
@@ -1016,8 +956,9 @@ int main(int argc, char **argv) {
         mesh_t m = lattice(24, 1);
         const long before = failures_;
         const double quiet = size_ > 1 ? 1.0 - 1.0 / size_ : 2.0;
-        local_pile(&m, 0.1, quiet > 0.45 ? quiet : 2.0, "a pile at x = 0.1, strips");
-        const double crossing = local_pile(&m, size_ > 1 ? 1.0 / size_ : 0.5, 2.0, "a pile across two strips");
+        const pile_run_t strips = {PART_STRIPS, 2, 0, 0.01, 60};
+        local_pile(&m, 0.1, quiet > 0.45 ? quiet : 2.0, "a pile at x = 0.1, strips", strips);
+        const double crossing = local_pile(&m, size_ > 1 ? 1.0 / size_ : 0.5, 2.0, "a pile across two strips", strips);
         double all = 0.0;
         MPI_Allreduce(&crossing, &all, 1, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
         require(size_ == 1 || all > 0.0, "a pile across two strips: no rank sent a message");
@@ -1064,12 +1005,22 @@ int main(int argc, char **argv) {
                        runs[k].graph ? "graph" : "polygons", partition_names[runs[k].kind], runs[k].layers,
                        total == 0 ? "heights bit for bit" : "FAILED, see above");
         }
-        free_mesh(&shapes[0]), free_mesh(&shapes[1]);
         local_steps_ = 0;
-        local_steps_to_rest(0, PART_STRIPS, 0.15, size_ > 1 ? 0.45 : 2.0, "a pile in one strip");
-        local_steps_to_rest(1, PART_STRIPS, size_ > 1 ? 1.0 / size_ : 0.5, 2.0, "a pile across two strips");
-        /* Most ghosts' gradients read cells beyond the part: their owners' exchanges say when they change. */
-        local_steps_to_rest(1, PART_RANDOM, 0.1, 2.0, "a pile on a random partition");
+        /* Piles to rest with local time steps, one layer of ghosts. On a
+         * random partition most ghosts' gradients read cells beyond the
+         * part: their owners' exchanges say when they change. */
+        const long before = failures_;
+        const pile_run_t strips = {PART_STRIPS, 1, 1, 0.05, 60}, random = {PART_RANDOM, 1, 1, 0.05, 60};
+        local_pile(&shapes[0], 0.15, size_ > 1 ? 0.45 : 2.0, "local time steps, a pile in one strip", strips);
+        local_pile(&shapes[1], size_ > 1 ? 1.0 / size_ : 0.5, 2.0, "local time steps, a pile across two strips", strips);
+        local_pile(&shapes[1], 0.1, 2.0, "local time steps, a pile on a random partition", random);
+        long mine = failures_ - before, total = 0;
+        MPI_Allreduce(&mine, &total, 1, MPI_LONG, MPI_SUM, MPI_COMM_WORLD);
+        if (rank_ == 0)
+            printf("  graded quads and triangles, local time steps: piles to rest in one strip, across two, on a random "
+                   "partition: %s\n", total == 0 ? "heights bit for bit, ranks far from the pile idle, then every rank "
+                                                   "idle" : "FAILED, see above");
+        free_mesh(&shapes[0]), free_mesh(&shapes[1]);
     }
     local_steps_refused();
     inconsistent_partitions();

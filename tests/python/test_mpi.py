@@ -416,38 +416,28 @@ class TestDistributedMesh(MpiTestCase):
                 shutil.rmtree(directory)
 
     def test_one_layer_of_ghosts_steps_as_the_serial_mesh(self):
-        # Every pair of a cell's gradient stencil shares a face: the cells across the part's own faces suffice.
-        part = Part(layers=1)
-        serial = dpsm.Grid.create_mesh(NODES, [3 * k for k in range(len(CELLS) + 1)], [n for c in CELLS for n in c])
-        with serial as s, part.create("mesh") as g:
-            setup_mesh(s)
-            setup_mesh(g, part)
-            for n in range(3):
-                s.step(0.02)
-                g.step(0.02)
-                owned = [k for k, c in enumerate(part.cells) if not part.ghost[k]]
-                with self.subTest(step=n):
-                    self.assertEqual([flat(g.get_heights())[k] for k in owned],
-                                     [flat(s.get_heights())[part.cells[k]] for k in owned])
-            self.assertGreater(s.get_mass(dpsm.MASS_OUTFLOW), 0.0)
-
-    def test_local_time_steps_step_as_the_serial_mesh(self):
-        # RELAX_LOCAL_STEPS on a part: every tick exchanges; heights and ticks as on the serial mesh.
-        part = Part(layers=1)
-        serial = dpsm.Grid.create_mesh(NODES, [3 * k for k in range(len(CELLS) + 1)], [n for c in CELLS for n in c])
-        with serial as s, part.create("mesh") as g:
-            setup_mesh(s)
-            setup_mesh(g, part)
-            s.set_relaxation(dpsm.RELAX_LOCAL_STEPS)
-            g.set_relaxation(dpsm.RELAX_LOCAL_STEPS)
-            for n in range(3):
-                s.step(0.02)
-                g.step(0.02)
-                with self.subTest(step=n):
-                    self.assertEqual(flat(g.get_heights()), [flat(s.get_heights())[c] for c in part.cells])
-                    self.assertEqual(g.get_step_info(dpsm.INFO_SUBSTEPS), s.get_step_info(dpsm.INFO_SUBSTEPS))
-                    self.assertEqual(g.get_step_info(dpsm.INFO_SUBSTEPS_PER_EXCHANGE), 0.5)
-            self.assertGreater(s.get_mass(dpsm.MASS_OUTFLOW), 0.0)
+        # Every pair of a cell's gradient stencil shares a face: the cells across the part's own faces suffice,
+        # with the default's sub-steps and with local time steps (every tick exchanges).
+        for relaxation in (dpsm.RELAX_AUTO, dpsm.RELAX_LOCAL_STEPS):
+            part = Part(layers=1)
+            serial = dpsm.Grid.create_mesh(NODES, [3 * k for k in range(len(CELLS) + 1)],
+                                           [n for c in CELLS for n in c])
+            with serial as s, part.create("mesh") as g:
+                setup_mesh(s)
+                setup_mesh(g, part)
+                s.set_relaxation(relaxation)
+                g.set_relaxation(relaxation)
+                for n in range(3):
+                    s.step(0.02)
+                    g.step(0.02)
+                    owned = [k for k, c in enumerate(part.cells) if not part.ghost[k]]
+                    with self.subTest(relaxation=relaxation, step=n):
+                        self.assertEqual([flat(g.get_heights())[k] for k in owned],
+                                         [flat(s.get_heights())[part.cells[k]] for k in owned])
+                        self.assertEqual(g.get_step_info(dpsm.INFO_SUBSTEPS), s.get_step_info(dpsm.INFO_SUBSTEPS))
+                        if relaxation == dpsm.RELAX_LOCAL_STEPS:
+                            self.assertEqual(g.get_step_info(dpsm.INFO_SUBSTEPS_PER_EXCHANGE), 0.5)
+                self.assertGreater(s.get_mass(dpsm.MASS_OUTFLOW), 0.0)
 
     def test_inconsistent_partitions_fail_on_every_rank(self):
         part = Part()
