@@ -974,10 +974,9 @@ private:
         // by a change waits for its faces to fire (a source may keep it so).
         bool pending = false;
         if (act.all_hot) {
-            // A part of a distributed mesh runs this way in every tick: its
-            // owned cells and the faces that touch them, with the ghosts'
-            // gradients, pulls, limiters and heights from their owners, as
-            // in a dense sub-step.
+            // On a part, its owned cells and the faces that touch them, with
+            // the ghosts' gradients, pulls, limiters and heights from their
+            // owners, as in a dense sub-step.
             const bool parts = s.exchange != nullptr;
             std::vector<std::int64_t> &changed_ghosts = s.changed_ghosts;
             changed_ghosts.clear();
@@ -1213,9 +1212,9 @@ private:
     }
 
     // Before the first tick of a step with local time steps: the classes
-    // (once per grid), the passes' values as between sparse sub-steps, and
-    // the hot cells by level.
-    // On a part, collective: the classes come from the ranks together.
+    // (once per grid; on a part, collective: the ranks find them together),
+    // the passes' values as between sparse sub-steps, and the hot cells by
+    // level.
     static void begin_local_steps(const Grid &grid, const Mesh &m, MeshState &s) {
         if (!s.classes)
             s.classes = std::make_unique<const StepClasses>(
