@@ -991,7 +991,16 @@ int main(int argc, char **argv) {
             {0, 1, SCENE_COLLAPSE, PART_STRIPS, 0, kDeepLayers},
         };
         mesh_t shapes[2] = {graded_lattice(12, 0), graded_lattice(14, 1)};
-        for (size_t k = 0; k < sizeof runs / sizeof runs[0]; ++k) {
+#ifdef DPSM_TESTS_UNDER_ASAN
+        /* Under AddressSanitizer the first four runs (every exchange of a
+         * tick, dense and sparse, both layers) and one pile: every tick
+         * exchanges, and the rest would take a minute of the stage for code
+         * that these runs pass through; the main stage runs them all. */
+        const size_t run_count = 4;
+#else
+        const size_t run_count = sizeof runs / sizeof runs[0];
+#endif
+        for (size_t k = 0; k < run_count; ++k) {
             local_steps_ = runs[k].local;
             const long before = failures_;
             run_scene(&shapes[runs[k].triangles], runs[k].scene, runs[k].kind, runs[k].graph, runs[k].layers);
@@ -1010,15 +1019,17 @@ int main(int argc, char **argv) {
          * random partition most ghosts' gradients read cells beyond the
          * part: their owners' exchanges say when they change. */
         const long before = failures_;
-        const pile_run_t strips = {PART_STRIPS, 1, 1, 0.05, 60}, random = {PART_RANDOM, 1, 1, 0.05, 60};
-        local_pile(&shapes[0], 0.15, size_ > 1 ? 0.45 : 2.0, "local time steps, a pile in one strip", strips);
+        const pile_run_t strips = {PART_STRIPS, 1, 1, 0.05, 60};
         local_pile(&shapes[1], size_ > 1 ? 1.0 / size_ : 0.5, 2.0, "local time steps, a pile across two strips", strips);
+#ifndef DPSM_TESTS_UNDER_ASAN
+        const pile_run_t random = {PART_RANDOM, 1, 1, 0.05, 60};
+        local_pile(&shapes[0], 0.15, size_ > 1 ? 0.45 : 2.0, "local time steps, a pile in one strip", strips);
         local_pile(&shapes[1], 0.1, 2.0, "local time steps, a pile on a random partition", random);
+#endif
         long mine = failures_ - before, total = 0;
         MPI_Allreduce(&mine, &total, 1, MPI_LONG, MPI_SUM, MPI_COMM_WORLD);
         if (rank_ == 0)
-            printf("  graded quads and triangles, local time steps: piles to rest in one strip, across two, on a random "
-                   "partition: %s\n", total == 0 ? "heights bit for bit, ranks far from the pile idle, then every rank "
+            printf("  graded quads and triangles, local time steps: piles to rest: %s\n", total == 0 ? "heights bit for bit, ranks far from the pile idle, then every rank "
                                                    "idle" : "FAILED, see above");
         free_mesh(&shapes[0]), free_mesh(&shapes[1]);
     }
