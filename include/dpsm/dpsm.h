@@ -153,8 +153,7 @@ typedef struct dpsm_grid dpsm_grid;
  *  heights differ from its by their own time error. A host's explicit
  *  choice; on a grid the same as ::DPSM_RELAX_TIME_ACCURATE. On a distributed
  *  mesh the parts exchange in every tick and step bit for bit as the serial
- *  mesh does. dpsm_step() refuses it with a static angle
- *  (::DPSM_ERR_NOT_APPLICABLE). */
+ *  mesh does. */
 #define DPSM_RELAX_LOCAL_STEPS 3
 /** @} */
 
@@ -715,11 +714,13 @@ DPSM_API int dpsm_set_scheme(dpsm_grid *g, int scheme);
  * step at their own stable size, so the heights differ from the default's
  * by the time error of that size (on meshes graded from h to 8 h, up to a
  * fifth of the volume moved during the flow and 2 % at rest;
- * \ref guide_meshes). A host's explicit choice. dpsm_step() refuses it
- * (::DPSM_ERR_NOT_APPLICABLE, the grid unchanged) on distributed meshes and
- * with a static angle; on a grid it is ::DPSM_RELAX_TIME_ACCURATE. Over a bed
- * every tick looks at every cell (as a sub-step with a bed does), and a face
- * takes at most its share of the sand its cell may give in that tick.
+ * \ref guide_meshes). A host's explicit choice. On a grid it is
+ * ::DPSM_RELAX_TIME_ACCURATE; on a distributed mesh the parts step bit for
+ * bit as the serial mesh does. Over a bed every tick looks at every cell (as
+ * a sub-step with a bed does), and a face takes at most its share of the
+ * sand its cell may give in that tick. With a static angle a cell is moving
+ * while a face of it carried sand since all its faces last fired together
+ * (dpsm_set_static_angle()), and every tick looks at every cell.
  *
  * @param g           the grid.
  * @param relaxation  ::DPSM_RELAX_AUTO, ::DPSM_RELAX_TO_REST,
@@ -1212,7 +1213,8 @@ DPSM_API int dpsm_set_flux_exponent(dpsm_grid *g, double p);
  *
  * As on dune slip faces: a slope between the two angles holds; one steeper
  * than the static angle avalanches down to the angle of repose. A cell is
- * moving while one of its faces carried sand in the last sub-step; a face with
+ * moving while one of its faces carried sand in the last sub-step (under
+ * ::DPSM_RELAX_LOCAL_STEPS: since all its faces last fired); a face with
  * a moving cell on either side uses the angle of repose, a face between two
  * cells at rest the larger of the static angle and the angle of repose. By
  * default the static angle equals the angle of repose (and follows it), which

@@ -440,8 +440,7 @@ public:
         // too and exchanges once per batch of sub-steps (mesh/mesh_parts.hpp);
         // the step ends with an exchange, so that a step starts exact.
         const int per_exchange = s.exchange && grid.relaxation() != kLocalSteps ? m.substeps_per_exchange : 0;
-        // Local time steps: not with a static angle (the stepper refuses it).
-        // A part exchanges in every tick.
+        // Local time steps: a part exchanges in every tick.
         const bool local = grid.relaxation() == kLocalSteps;
         if (local) begin_local_steps(grid, m, s);
         bool rested = false;
@@ -1004,9 +1003,11 @@ private:
                 changed[c] = update_cell(c);
                 limit_in[c] = limit_out[c] = 1.0;
             });
-            if (bed) {
-                // Sources at every tick (with a bed they are not in closed
-                // form): the cells beyond the tick's lists take theirs too.
+            if (grid.hysteresis()) note_moving_cells(grid, s, taking, taking_n, level, threads);
+            if (!s.lazy) {
+                // Sources at every tick (with a bed or a static angle they
+                // are not in closed form): the cells beyond the tick's lists
+                // take theirs too.
                 for (const std::int64_t c : s.source_cells)
                     if (sc.taking_level[c] > level) changed[c] = update_cell(c);
             }
@@ -1028,7 +1029,7 @@ private:
             // Where every face has fired and few cells changed, the ticks
             // after look at those cells and the steep faces alone.
             const double most = dense_share(threads, m.owned) * static_cast<double>(m.owned);
-            if (level == sc.top && !s.switches.visit_all_cells && !bed &&
+            if (level == sc.top && !s.switches.visit_all_cells && !bed && !grid.hysteresis() &&
                 static_cast<double>(changed_cells + kept_hot_by_sources(s)) <= most) {
                 act.all_hot = false;
                 for (std::int64_t c = 0; c < m.owned; ++c)
@@ -1173,6 +1174,31 @@ private:
         return did;
     }
 
+    // With a static angle a cell is moving while a face of it carried sand
+    // since all its faces last fired together (its coarsest class's span),
+    // so that a face of a coarse class reads its cells as moving while sand
+    // crosses it though finer ticks in between found nothing to carry. On a
+    // mesh of one class, and at tick 0, where every face fires, this is
+    // what a sub-step does: moving where a face carried. A cycle starts
+    // with the step (tick 0 fires every face), so nothing of it outlives a
+    // step but the flags themselves.
+    static void note_moving_cells(Grid &grid, MeshState &s, const std::int64_t *taking, std::int64_t count, int level,
+                                  int threads) {
+        const StepClasses &sc = *s.classes;
+        const std::uint8_t *kind = grid.kinds().data(), *changed = s.carried.data();
+        std::uint8_t *moving = grid.moving_for_stepping().data(), *cycle = s.carried_in_cycle.data();
+        for_each_item(taking, count, threads, [&](std::int64_t c) {
+            const std::uint8_t carried = kind[c] == kSand && changed[c];
+            if (sc.coarsest[c] <= level) {
+                moving[c] = cycle[c] | carried;
+                cycle[c] = 0;
+            } else {
+                moving[c] |= carried;
+                cycle[c] |= carried;
+            }
+        });
+    }
+
     // Sources that keep cells hot in every tick: the lazy sources' watched
     // cells, or sources at every tick.
     static bool waits_for_sources(const MeshState &s) {
@@ -1224,7 +1250,8 @@ private:
         s.hot_by_level.resize(static_cast<std::size_t>(s.classes->top) + 1);
         s.pending_until = 0;
         MeshActivity &act = s.activity;
-        if (s.switches.visit_all_cells || !grid.bed().empty()) act.wake_all();
+        if (s.switches.visit_all_cells || !grid.bed().empty() || grid.hysteresis()) act.wake_all();
+        if (grid.hysteresis()) s.carried_in_cycle.assign(static_cast<std::size_t>(m.owned), 0);
         for (const std::int64_t c : act.hot_list) s.hot_by_level[s.classes->finest[c]].push_back(c);
         act.hot_list.clear();
         s.steep_by_level.resize(s.hot_by_level.size());

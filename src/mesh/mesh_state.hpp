@@ -128,8 +128,7 @@ struct MeshState final : EngineState {
     bool lists_current = false;
 
     // Local time steps (DPSM_RELAX_LOCAL_STEPS, mesh/step_classes.hpp): the
-    // classes, found at the first step that takes them; in a step, a bit per
-    // class found quiet since sand last moved.
+    // classes, found at the first step that takes them.
     std::unique_ptr<const StepClasses> classes;
     // In a step, the hot cells (the activity's hot_list moves here) by the
     // finest class of their faces: a tick reads the levels it fires.
@@ -141,6 +140,9 @@ struct MeshState final : EngineState {
     // would cool on the lists), so that sand at rest is found at the same
     // tick whichever way a tick runs.
     std::int64_t pending_until = 0;
+    // With a static angle, per owned cell: a face of it carried sand since
+    // all its faces last fired together (mesh_engine.cpp, note_moving_cells).
+    std::vector<std::uint8_t> carried_in_cycle;
 };
 
 MeshState &mesh_state(Grid &grid);

@@ -118,17 +118,6 @@ void take_part_refusing(Grid &grid) {
     }
 }
 
-// Local time steps (DPSM_RELAX_LOCAL_STEPS) take a mesh without a static
-// angle in this version; on a grid, whose cells share one size, they are
-// the time-accurate sub-steps.
-void require_local_steps_apply(Grid &grid) {
-    const char *what = grid.hysteresis() ? "a static angle (dpsm_set_static_angle)" : nullptr;
-    if (!what || !grid.geometry().is_mesh()) return;
-    take_part_refusing(grid);
-    fail(DPSM_ERR_NOT_APPLICABLE, "dpsm_step", "local time steps (DPSM_RELAX_LOCAL_STEPS) do not take ", what,
-         " in this version; step with DPSM_RELAX_AUTO");
-}
-
 }  // namespace
 
 void step(Grid &grid, double dt) {
@@ -137,7 +126,6 @@ void step(Grid &grid, double dt) {
         if (!std::isfinite(dt)) fail(DPSM_ERR_INVALID_VALUE, "dpsm_step", "dt = ", dt, " is not finite");
         fail(DPSM_ERR_INVALID_VALUE, "dpsm_step", "dt = ", dt, " must be positive");
     }
-    if (grid.relaxation() == kLocalSteps) require_local_steps_apply(grid);
     // The default advances the model's time by dt, as the time-accurate
     // steps do; relaxing straight to rest is a host's explicit choice.
     if (grid.relaxation() != kToRest) {

@@ -1965,6 +1965,7 @@ typedef struct {
     double *levels;     /* per face */
     double *source;     /* per cell; NULL: none */
     int record;         /* face fluxes recorded */
+    int hold;           /* a static angle above the angle of repose */
     int64_t max_substeps;
     double mass_scale;
     prng_t *p;
@@ -2149,9 +2150,10 @@ static void mesh_step(mesh_state_t *ms, reader_t *r) {
     const int sourced = mesh_source_active(ms);
     double held_lo = 0.0, held_hi = 0.0;
     const int held = mesh_held_range(ms, before.h, &held_lo, &held_hi);
-    /* A source drives only where it keeps a face steep to the end of the step (sources in closed form). */
+    /* A source drives only where it keeps a face steep to the end of the step (sources in closed form; not with
+     * a static angle, under which a source always drives). */
     const int held_apart = held && held_lo != held_hi;
-    const int limited = held_apart || (sourced && mesh_source_surely_steep(ms, before.h, dt));
+    const int limited = held_apart || (sourced && (ms->hold || mesh_source_surely_steep(ms, before.h, dt)));
     const double needed = ceil(dt / before.stable_dt), limit = (double)ms->max_substeps;
     int want = limited && needed > limit ? DPSM_ERR_WORK_LIMIT : DPSM_OK;
     const int either = (limited && fabs(needed - limit) <= 1.0) || (sourced && !limited && needed > limit - 1.0);
@@ -2459,9 +2461,16 @@ static void mesh_operation(mesh_state_t *ms, reader_t *r) {
             }
             break;
         }
-        case 8: { /* b < 0x80: dpsm_set_max_substeps; else dpsm_set_relaxation, b & 1: local time steps, or the default */
+        case 8: { /* b < 0x80: dpsm_set_max_substeps; else b & 2: dpsm_set_static_angle, b & 4: 37 degrees, or
+                     * 17 (the angle of repose then); else dpsm_set_relaxation, b & 1: local time steps, or the default */
             static const int64_t values[] = {1, 3, 50, MESH_MAX_SUBSTEPS};
             const unsigned b = u8(r);
+            if ((b & 0x82) == 0x82) {
+                const double angle = (b & 4 ? 37.0 : 17.0) * 3.14159265358979323846 / 180.0;
+                MESH_CALL(ms, DPSM_OK, "dpsm_set_static_angle", dpsm_set_static_angle(ms->g, angle));
+                ms->hold = angle > DPSM_DEFAULT_REPOSE_ANGLE;
+                break;
+            }
             if (b & 0x80) {
                 const int relaxation = b & 1 ? DPSM_RELAX_LOCAL_STEPS : DPSM_RELAX_AUTO;
                 MESH_CALL(ms, DPSM_OK, "dpsm_set_relaxation", dpsm_set_relaxation(ms->g, relaxation));

@@ -276,7 +276,8 @@ static void check_restart(made_t *m, double dt, double *h, double *hs) {
 /* The scene on a grid made: heights (and a source, an open edge) from the
  * input, steps, a restart; then both grids are destroyed.
  * Bytes: mode, v, w, edge, source, steps, then one dt factor per step; on a
- * mesh, bit 0 of edge / 12 steps both with DPSM_RELAX_LOCAL_STEPS. */
+ * mesh, bit 0 of edge / 12 steps both with DPSM_RELAX_LOCAL_STEPS and bit 1
+ * gives both a static angle of 37 degrees. */
 static void run_scene(made_t *m, reader_t *r) {
     int64_t sx = 0, sy = 0;
     g_op = "dpsm_get_shape";
@@ -311,6 +312,12 @@ static void run_scene(made_t *m, reader_t *r) {
         if (dpsm_set_relaxation(m->g, DPSM_RELAX_LOCAL_STEPS) != DPSM_OK ||
             dpsm_set_relaxation(m->serial, DPSM_RELAX_LOCAL_STEPS) != DPSM_OK)
             die("dpsm_set_relaxation(local steps) failed: %s", dpsm_last_error(m->g));
+    }
+    if (m->edge == DPSM_MESH_EDGE && edge / 24 % 2 == 1) {
+        g_op = "dpsm_set_static_angle";
+        const double angle = 37.0 * 3.14159265358979323846 / 180.0;
+        if (dpsm_set_static_angle(m->g, angle) != DPSM_OK || dpsm_set_static_angle(m->serial, angle) != DPSM_OK)
+            die("dpsm_set_static_angle failed: %s", dpsm_last_error(m->g));
     }
     if (source % 4 == 1) {
         g_op = "dpsm_set_source";

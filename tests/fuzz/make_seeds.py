@@ -322,6 +322,10 @@ def m_relaxation(local):  # DPSM_RELAX_LOCAL_STEPS, or back to DPSM_RELAX_AUTO
     return [8, 0x81 if local else 0x80]
 
 
+def m_static_angle(on):  # 37 degrees over the angle of repose (30), or 17 (none beyond the angle of repose)
+    return [8, 0x86 if on else 0x82]
+
+
 def m_step(k, restart=False):  # dt = 1e-3 * 10^(4 k / 127): k = 127 is 10, 95 about 1, 64 about 0.1
     return [9, k | (0x80 if restart else 0)]
 
@@ -367,6 +371,16 @@ seed("mesh_local_steps",
      mesh("dual", "triangles", 7, 6, jitter=4, seed=6, ops=[
          m_relaxation(True), m_heights(1, 3.0, 0.0), m_kinds(1), m_fluxes(1), m_step(127, True), m_source(3, 1e-9),
          m_step(127), m_levels(1, 1.0), m_boundary(0), m_step(95)]))
+# Local time steps with a static angle: piles that hold between the two
+# angles, a source (which then drives), restarts, and the static angle off.
+seed("mesh_local_steps_static_angle",
+     mesh("polygons", "mixed", 8, 8, dx=0.5, dy=2.0, jitter=4, seed=303, ops=[
+         m_relaxation(True), m_static_angle(True), m_heights(1, 10.0, 0.0), m_fluxes(1), m_step(95),
+         m_step(127, True), m_kinds(2), m_step(127), m_source(2, 1e-3, 0.1), m_step(64, True), m_static_angle(False),
+         m_step(95), m_static_angle(True), m_step(127, True)]),
+     mesh("dual", "triangles", 7, 6, jitter=4, seed=8, ops=[
+         m_static_angle(True), m_relaxation(True), m_heights(2, 0.0, 30.0), m_boundary(0), m_fluxes(1),
+         m_step(127), m_relaxation(False), m_step(95, True), m_relaxation(True), m_step(127, True)]))
 seed("mesh_bad_polygons", *[mesh("polygons", ("quads", "triangles", "mixed")[k % 3], 3 + k % 4, 2 + k % 3,
                                   seed=k + 1, defect=k) for k in range(11)],
      mesh("polygons", "quads", 3, 3, ops=[m_heights(0, 1.0, plant=0), m_absent(2)]))

@@ -22,12 +22,13 @@ def defect(k):
 
 # kHeights indices: 0 0.0, 1 1.0, 2 -1.0, 3 0.25, 4 3.0, 5 10.0, 6 100.0, 7 1e3, 9 -3.0, 11 30.0, 13 0.5
 # kDtFactors indices: 0 1e-6, 1 0.1, 2 0.5, 3 1.0, 4 2.0, 5 4.0, 6 10.0, 7 50.0
-def scene(mode=3 + 5 * 2, v=6, w=0, open_side=None, source=None, dts=(3, 6, 7), local_steps=False):
+def scene(mode=3 + 5 * 2, v=6, w=0, open_side=None, source=None, dts=(3, 6, 7), local_steps=False,
+          static_angle=False):
     """Heights (mode % 5: 0 v, 1 alternating, 2 a ramp, 3 a spike of v at cell
     mode / 5 on w, 4 one table index per cell), an open side or mesh edge,
     a source pattern, then one dt factor index per step (1 to 4 steps); on a
-    mesh, local time steps (DPSM_RELAX_LOCAL_STEPS)."""
-    edge = (0 if open_side is None else 1 + 3 * open_side) + (12 if local_steps else 0)
+    mesh, local time steps (DPSM_RELAX_LOCAL_STEPS) and a static angle."""
+    edge = (0 if open_side is None else 1 + 3 * open_side) + (12 if local_steps else 0) + (24 if static_angle else 0)
     src = 0 if source is None else 1 + 4 * source
     return [mode, v, w, edge, src, len(dts) - 1] + list(dts)
 
@@ -66,6 +67,10 @@ def seeds():
                                                       local_steps=True))
     s["graph_local_steps_source"] = mesh(GRAPH, how=FORTRAN, nx=4, ny=4, seed=5,
                                          then=scene(mode=2, v=1, w=3, source=2, dts=(5, 7), local_steps=True))
+    s["mesh_triangles_local_steps_static_angle"] = mesh(POLYGONS, how=WORLD, nx=5, ny=4, triangles=1, seed=22,
+                                                        then=scene(mode=3 + 5 * 9, v=7, w=0, open_side=0,
+                                                                   source=2, dts=(7, 6, 7), local_steps=True,
+                                                                   static_angle=True))
     s["mesh_one_triangle_pair"] = mesh(POLYGONS, nx=1, ny=1, triangles=1, then=scene(mode=1, v=5, w=0))
     for kind, name in ((GRAPH, "graph"), (POLYGONS, "mesh")):
         s[name + "_defects"] = sum((mesh(kind, how=k % 4, bad=defect(k), seed=k, pick=k) for k in range(15)), [])

@@ -324,7 +324,7 @@ static const char *const scene_names[] = {"column collapse, open edge", "sources
                                           "bed, erosion, angle field, static angle, edge levels",
                                           "relaxation to rest"};
 
-/* The scenes stepped with local time steps (no static angle: they refuse it). */
+/* The scenes stepped with local time steps. */
 static int local_steps_;
 
 static double column(const mesh_t *m, int64_t c) {
@@ -380,7 +380,7 @@ static void set_scene(const mesh_t *m, int scene, run_t *r) {
         OK(r->g, dpsm_set_bedrock(r->g, v));
         FILL(4, 0.2)
         OK(r->g, dpsm_set_repose_angle_field(r->g, v));
-        if (!local_steps_) OK(r->g, dpsm_set_static_angle(r->g, 36.0 * M_PI / 180.0));
+        OK(r->g, dpsm_set_static_angle(r->g, 36.0 * M_PI / 180.0));
     }
     FILL(1, DPSM_CELL_WALL)
     for (int64_t k = 0; k < r->ncells; ++k) kinds[k] = (uint8_t)v[k];
@@ -790,33 +790,6 @@ static int create_part(const part_t *p, dpsm_grid **g) {
                                 p->global_id, p->owner, g);
 }
 
-/* Local time steps (DPSM_RELAX_LOCAL_STEPS) with a static angle are refused
- * on a distributed mesh as on a serial one, on every rank, the heights
- * unchanged; the default steps again. */
-static void local_steps_refused(void) {
-    mesh_t m = lattice(12, 1);
-    int *owner = xcalloc((size_t)m.ncells, sizeof(int));
-    partition(&m, PART_STRIPS, owner);
-    part_t p = part_of(&m, owner, 2);
-    dpsm_grid *g = NULL;
-    OK(NULL, create_part(&p, &g));
-    double *h = xcalloc((size_t)p.ncells, sizeof(double)), *after = xcalloc((size_t)p.ncells, sizeof(double));
-    for (int64_t k = 0; k < p.ncells; ++k) h[k] = column(&m, p.global[k]);
-    OK(g, dpsm_set_heights(g, h));
-    OK(g, dpsm_set_relaxation(g, DPSM_RELAX_LOCAL_STEPS));
-    OK(g, dpsm_set_static_angle(g, 36.0 * M_PI / 180.0));
-    require_failed_alike(g, dpsm_step(g, 0.01), "static angle", "local time steps with a static angle");
-    OK(g, dpsm_get_heights(g, after));
-    require(memcmp(h, after, sizeof(double) * (size_t)p.ncells) == 0, "a refused step changed the heights");
-    OK(g, dpsm_set_relaxation(g, DPSM_RELAX_AUTO));
-    OK(g, dpsm_step(g, 0.01));
-    dpsm_destroy(g);
-    free(h), free(after);
-    free_part(&p);
-    free(owner);
-    free_mesh(&m);
-}
-
 static void inconsistent_partitions(void) {
     if (size_ < 2) return;
     mesh_t m = lattice(12, 1);
@@ -971,7 +944,7 @@ int main(int argc, char **argv) {
     }
     {
         /* Local time steps on graded lattices: three scenes (the third
-         * without its static angle), each partition, polygons and graphs,
+         * with its static angle), each partition, polygons and graphs,
          * one layer of ghosts and a deep one, bit for bit with the serial
          * mesh's local time steps. With a deep layer of ghosts on a graded
          * lattice some ghosts on the layer's rim hold as many faces as their
@@ -1007,10 +980,9 @@ int main(int argc, char **argv) {
             long mine = failures_ - before, total = 0;
             MPI_Allreduce(&mine, &total, 1, MPI_LONG, MPI_SUM, MPI_COMM_WORLD);
             if (rank_ == 0)
-                printf("  graded %s, %s, %s%s: %s, %s partition, %d layers of ghosts: %s\n",
+                printf("  graded %s, %s, %s: %s, %s partition, %d layers of ghosts: %s\n",
                        runs[k].triangles ? "triangles" : "quads", runs[k].local ? "local time steps" : "the default",
                        scene_names[runs[k].scene],
-                       runs[k].local && runs[k].scene == SCENE_PHYSICS ? " (but the static angle)" : "",
                        runs[k].graph ? "graph" : "polygons", partition_names[runs[k].kind], runs[k].layers,
                        total == 0 ? "heights bit for bit" : "FAILED, see above");
         }
@@ -1033,7 +1005,6 @@ int main(int argc, char **argv) {
                                                    "idle" : "FAILED, see above");
         free_mesh(&shapes[0]), free_mesh(&shapes[1]);
     }
-    local_steps_refused();
     inconsistent_partitions();
     long total = 0, all_checks = 0;
     MPI_Allreduce(&failures_, &total, 1, MPI_LONG, MPI_SUM, MPI_COMM_WORLD);

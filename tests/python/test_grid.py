@@ -829,7 +829,8 @@ class TestMesh(LedgerMixin, unittest.TestCase):
 
     def test_local_steps(self):
         """RELAX_LOCAL_STEPS on a graded strip of squares (1, 2, 4, 8 wide): mass kept, the large cells' ticks
-        passed over (INFO_SUBSTEPS_EVALUATED below INFO_SUBSTEPS), and a static angle refused."""
+        passed over (INFO_SUBSTEPS_EVALUATED below INFO_SUBSTEPS); a static angle holds a slope between it and the
+        angle of repose, which slides without it."""
         xs = [0.0]
         for width in (1.0,) * 4 + (2.0,) * 4 + (4.0,) * 4 + (8.0,) * 4:
             xs.append(xs[-1] + width)
@@ -845,8 +846,16 @@ class TestMesh(LedgerMixin, unittest.TestCase):
             self.assertLess(g.get_step_info(dpsm.INFO_SUBSTEPS_EVALUATED), g.get_step_info(dpsm.INFO_SUBSTEPS))
             self.assertAlmostEqual(g.get_mass(dpsm.MASS_TOTAL), total, delta=1e-12 * total)
             self.assertLedger(g)
-            g.set_static_angle(0.7)
-            self.assertFails(dpsm.ERR_NOT_APPLICABLE, g.step, 1.0)
+            ramp = [math.tan(math.radians(35.0)) * 0.5 * (xs[i] + xs[i + 1]) for i in range(n - 1)]
+            g.set_heights(ramp)
+            g.set_static_angle(math.radians(40.0))
+            g.step(10.0)
+            self.assertEqual(g.get_step_info(dpsm.INFO_AT_REST), 1.0)
+            self.assertEqual(as_list(g.get_heights()), ramp)
+            g.set_static_angle(0.3)  # below the angle of repose: none
+            g.step(10.0)
+            self.assertNotEqual(as_list(g.get_heights()), ramp)
+            self.assertLedger(g)
 
     def test_aliases_and_flat_input(self):
         flat_xy = [v for xy in self.node_xy for v in xy]
