@@ -15,7 +15,10 @@
  * the threshold) against the plain face loop below (one pass over faces
  * computing the gradient and flux, one over cells updating, in the host's
  * order); the sparse scene (slip faces on ~1 % of cells) and a mesh at rest,
- * each against a fully active sub-step.
+ * each against a fully active sub-step. Beside the fully active rates: the
+ * bytes a sub-step moves per cell update, counted from the engine's layout
+ * (mesh_bytes.cpp), a triad's bandwidth in the same run, and the bound the
+ * two set (triad / bytes) with the share of it the engine reaches.
  *
  * mesh-wind: the dune field of `wind` with a source on every cell. */
 #include <math.h>
@@ -409,6 +412,30 @@ static void visited_and_changed(dpsm_grid *g, int64_t cells, int substeps, doubl
     free(before), free(after);
 }
 
+/* bench/mesh_bytes.cpp: the bytes a fully active sub-step moves per cell update, from the engine's layout. */
+double bench_mesh_bytes_per_update(const dpsm_grid *g, FILE *log);
+
+/* A STREAM-like triad a = b + s c over arrays of 256 MB on `threads`
+ * threads, best of five: bytes read and written (24 a point) per second. */
+static double triad_bytes_per_second(int threads) {
+    const int64_t n = 32 * 1024 * 1024;
+    double *a = xcalloc((size_t)n, sizeof(double)), *b = xcalloc((size_t)n, sizeof(double)),
+           *c = xcalloc((size_t)n, sizeof(double));
+    (void)threads;
+#pragma omp parallel for num_threads(threads) schedule(static)
+    for (int64_t i = 0; i < n; ++i) a[i] = 0.0, b[i] = 1.0, c[i] = 2.0;
+    double best = 1e300;
+    for (int run = 0; run < 5; ++run) {
+        const double t0 = now_seconds();
+#pragma omp parallel for num_threads(threads) schedule(static)
+        for (int64_t i = 0; i < n; ++i) a[i] = b[i] + 3.0 * c[i];
+        best = fmin(best, now_seconds() - t0);
+    }
+    if (a[n / 2] != 7.0) fprintf(stderr, "triad: a wrong sum\n");
+    free(a), free(b), free(c);
+    return 24.0 * (double)n / best;
+}
+
 static double seconds_per_substep(dpsm_grid *g, int substeps, double *updates) {
     double dt = 0.0;
     CHECK(g, dpsm_stable_dt(g, &dt));
@@ -437,7 +464,9 @@ int cmd_mesh(int argc, char **argv) {
     double dt = 0.0;
     CHECK(g, dpsm_stable_dt(g, &dt));
     plain_mesh p = plain_from(&s);
-    printf("scene,threads,seconds_per_substep,mcells_per_s,reference_mcells_per_s,ratio,cells_visited_per_substep\n");
+    const double bytes = bench_mesh_bytes_per_update(g, stderr);
+    printf("scene,threads,seconds_per_substep,mcells_per_s,reference_mcells_per_s,ratio,cells_visited_per_substep,"
+           "bytes_per_update,triad_gb_per_s,bound_mcells_per_s,share_of_bound\n");
     const int substeps = 20;
     double plain_best = 1e300;
     for (int run = 0; run < runs; ++run) {
@@ -454,8 +483,11 @@ int cmd_mesh(int argc, char **argv) {
             CHECK(g, dpsm_set_heights(g, h));
             active_best[threads] = fmin(active_best[threads], seconds_per_substep(g, substeps, &updates));
         }
-        printf("fully_active,%d,%.6f,%.1f,%.1f,%.2f,%.0f\n", threads, active_best[threads], s.cells / active_best[threads] / 1e6,
-               s.cells / plain_best / 1e6, plain_best / active_best[threads], updates);
+        /* The triad in the same run, beside it: the bound the layout's bytes set on this machine. */
+        const double triad = triad_bytes_per_second(threads), rate = s.cells / active_best[threads];
+        printf("fully_active,%d,%.6f,%.1f,%.1f,%.2f,%.0f,%.0f,%.1f,%.1f,%.3f\n", threads, active_best[threads],
+               rate / 1e6, s.cells / plain_best / 1e6, plain_best / active_best[threads], updates, bytes, triad / 1e9,
+               triad / bytes / 1e6, rate / (triad / bytes));
         fflush(stdout);
     }
     /* Sparse: flat ground with ridges on about 1 % of the cells. */

@@ -100,8 +100,7 @@ struct FaceLaw {
     Heights h;
     const std::uint8_t *kind;
     const double *gx, *gy;
-    const std::uint8_t *edge_open;  // per face; null: every edge as open_edges says
-    bool open_edges;
+    const std::uint8_t *carrying;   // per face: whether it may carry sand at all (carrying_faces)
     const double *edge_level;       // per face; null: 0
     const double *tan_field;        // null: uniform
     const std::uint8_t *moving;     // hysteresis: null when off
@@ -109,15 +108,7 @@ struct FaceLaw {
     double nu, tan_theta, tolerance, tan_static, p, dt;
     bool isotropic;
 
-    // Whether face f may carry sand at all: no wall on it, a sand cell on
-    // it, and on the domain edge an open edge.
-    bool carries(std::int64_t f) const {
-        const std::int64_t a = m.face_a[f], b = m.face_b[f];
-        const std::uint8_t ka = kind[a];
-        if (b < 0) return ka == kSand && (edge_open ? edge_open[f] != 0 : open_edges);
-        const std::uint8_t kb = kind[b];
-        return ka != kWall && kb != kWall && (ka == kSand || kb == kSand);
-    }
+    bool carries(std::int64_t f) const { return carrying[f] != 0; }
 
     // Face f's slope and what it gives the sub-step's fluxes.
     //
@@ -298,12 +289,13 @@ inline void limits_of(const Mesh &m, const FaceLaw &law, const double *low, cons
         limit_in[c] = limit_out[c] = 0.0;
         return;
     }
-    bool ignored = false;
     const double h = law.h[c];
-    const double monotone = h + law.dt * net_rate(m, low, c, ignored);
-    double highest = h, lowest = h, entering = 0.0, leaving = 0.0;
+    // The monotone update's rate, summed over every face in the cell's face
+    // order as net_rate does (the faces that carry nothing add 0).
+    double rate = 0.0, highest = h, lowest = h, entering = 0.0, leaving = 0.0;
     for (std::int64_t k = m.cell_face_start[c]; k < m.cell_face_start[c + 1]; ++k) {
         const std::int64_t f = m.cell_faces[k];
+        rate += m.into[k] * low[f];
         if (!law.carries(f)) continue;
         const std::int64_t o = m.other[k];
         const double v = o >= 0 ? law.h[o] : (law.edge_level ? law.edge_level[f] : 0.0);
@@ -315,6 +307,7 @@ inline void limits_of(const Mesh &m, const FaceLaw &law, const double *low, cons
         else
             leaving -= enters;
     }
+    const double monotone = h + law.dt * (rate / m.area[c]);
     if (bed) lowest = std::max(lowest, bed[c]);
     // A hair short of the bounds, so that the update's rounding does not cross them.
     const double room = kLimiterRoom * m.area[c] / law.dt;
@@ -359,6 +352,7 @@ public:
             s.excess.assign(nf, 0.0);
             s.steep.assign(nf, 0);
             s.steep_faces.clear();
+            s.steep_faces_listed = true;
         }
         if (s.pull_x.size() != n) {
             s.pull_x.assign(n, 0.0), s.pull_y.assign(n, 0.0);
@@ -375,6 +369,7 @@ public:
         if (!grid.bed().empty()) s.available.resize(n, 0.0);
         if (s.lists_current) return;
         s.lists_current = true;
+        carrying_faces(grid, m, s.carrying);
         // Faces onto a sink: the outflow is summed over them alone, in one
         // order. On a distributed mesh the rank that owns the cell the sand
         // leaves books it.
@@ -392,6 +387,26 @@ public:
         for (std::int64_t c = 0; c < static_cast<std::int64_t>(q.size()); ++c)
             if (kind[c] == kSand && q[c] != 0.0) (c < m.owned ? s.source_cells : s.ghost_source_cells).push_back(c);
         list_source_faces(m, q, s);
+    }
+
+    // Per face, whether it may carry sand at all: no wall on it, a sand cell
+    // on it, and on the domain edge an open edge. It follows the kinds and
+    // the edges, so it is found with the lists that follow them.
+    static void carrying_faces(const Grid &grid, const Mesh &m, std::vector<std::uint8_t> &carrying) {
+        const std::uint8_t *kind = grid.kinds().data();
+        const std::uint8_t *edge_open = grid.edge_open_flags().empty() ? nullptr : grid.edge_open_flags().data();
+        const bool open_edges = grid.side_open(0);
+        carrying.resize(static_cast<std::size_t>(m.faces));
+        for (std::int64_t f = 0; f < m.faces; ++f) {
+            const std::int64_t a = m.face_a[f], b = m.face_b[f];
+            const std::uint8_t ka = kind[a];
+            if (b < 0) {
+                carrying[f] = ka == kSand && (edge_open ? edge_open[f] != 0 : open_edges);
+            } else {
+                const std::uint8_t kb = kind[b];
+                carrying[f] = ka != kWall && kb != kWall && (ka == kSand || kb == kSand);
+            }
+        }
     }
 
     // Not with a bed (erosion stops at it, so a source's part depends on the
@@ -628,8 +643,7 @@ private:
             }
             s.flux_clean = false;
             s.steep_faces.clear();
-            for (std::int64_t f = 0; f < m.live_faces; ++f)
-                if (steep[f]) s.steep_faces.push_back(f);
+            s.steep_faces_listed = false;  // listed where a sparse pass reads them (list_steep_faces)
             std::uint8_t *changed = s.carried.data();
             std::int64_t changed_cells = 0;
 #pragma omp parallel for num_threads(threads) if (parallel) schedule(static) reduction(+ : changed_cells)
@@ -707,6 +721,7 @@ private:
                 }
             }
             // The steep faces: those looked at again as they are now, the others as they were.
+            list_steep_faces(m, s);
             std::vector<std::int64_t> &steep_faces = s.steep_faces;
             std::vector<std::uint8_t> &became_steep = s.became_steep;
             became_steep.resize(s.faces.size());
@@ -785,6 +800,17 @@ private:
         return did;
     }
 
+
+    // The steep faces in face order, where a dense sub-step left them to
+    // its flags: the sparse passes read them as a list, and a dense sub-step
+    // followed by another has no use for one.
+    static void list_steep_faces(const Mesh &m, MeshState &s) {
+        if (s.steep_faces_listed) return;
+        s.steep_faces.clear();
+        for (std::int64_t f = 0; f < m.live_faces; ++f)
+            if (s.steep[f]) s.steep_faces.push_back(f);
+        s.steep_faces_listed = true;
+    }
 
     // The faces of cell c that touch an owned cell (with classes given,
     // those of a class at most `level`), each once a sub-step (`stamp`), into
@@ -1255,6 +1281,7 @@ private:
         for (const std::int64_t c : act.hot_list) s.hot_by_level[s.classes->finest[c]].push_back(c);
         act.hot_list.clear();
         s.steep_by_level.resize(s.hot_by_level.size());
+        list_steep_faces(m, s);
         for (const std::int64_t f : s.steep_faces) s.steep_by_level[s.classes->face_class[f]].push_back(f);
         s.steep_faces.clear();
     }
@@ -1513,8 +1540,7 @@ private:
                        grid.kinds().data(),
                        gx,
                        gy,
-                       grid.edge_open_flags().empty() ? nullptr : grid.edge_open_flags().data(),
-                       grid.side_open(0),
+                       mesh_state(grid).carrying.data(),
                        grid.side_levels(0).empty() ? nullptr : grid.side_levels(0).data(),
                        grid.tan_field().empty() ? nullptr : grid.tan_field().data(),
                        grid.hysteresis() ? grid.moving().data() : nullptr,

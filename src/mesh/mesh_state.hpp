@@ -78,6 +78,7 @@ struct MeshState final : EngineState {
     // list that may hold faces no longer steep, dropped as it is read).
     std::vector<std::uint8_t> steep;
     std::vector<std::int64_t> steep_faces;
+    bool steep_faces_listed = true;  // false: a dense sub-step left them to `steep` alone
     std::vector<std::uint8_t> became_steep;  // per face looked at, in the sub-step's list: it turned steep
     std::vector<std::int64_t> pull_cells, limit_cells;
     std::vector<std::int64_t> pulling_ghosts;  // a part's ghosts whose pulls are not 0
@@ -125,6 +126,7 @@ struct MeshState final : EngineState {
     std::vector<std::int64_t> source_faces, source_face_cells;
     std::vector<std::int64_t> ghost_source_cells;  // a part's ghosts with a source, stepped where they are in reach
     std::vector<std::int64_t> sink_faces;          // faces onto open edges or open cells
+    std::vector<std::uint8_t> carrying;            // per face: it may carry sand (no wall, a sand cell, an open edge)
     bool lists_current = false;
 
     // Local time steps (DPSM_RELAX_LOCAL_STEPS, mesh/step_classes.hpp): the
