@@ -108,13 +108,20 @@ static void free_graded(graded_mesh *m) {
     free(m->cx), free(m->cy), free(m->area);
 }
 
-/* A column of height `top` and radius r about (x, y). */
-static void pour(graded_mesh *m, double x, double y, double r, double top) {
+/* A column of height `top` and radius r about (x, y) on a plane rising at
+ * `slope` into the coarse corner from the diagonal x + y = from (the floor
+ * flat before it). */
+static void pour_on_a_slope(graded_mesh *m, double slope, double from, double x, double y, double r, double top) {
     double *h = calloc((size_t)m->cells, sizeof(double));
-    for (int64_t c = 0; c < m->cells; ++c) h[c] = hypot(m->cx[c] - x, m->cy[c] - y) < r ? top : 0.0;
+    for (int64_t c = 0; c < m->cells; ++c)
+        h[c] = fmax(tan(slope) * (m->cx[c] + m->cy[c] - from) / sqrt(2.0), 0.0) +
+               (hypot(m->cx[c] - x, m->cy[c] - y) < r ? top : 0.0);
     CHECK_OK(m->g, dpsm_set_heights(m->g, h));
     free(h);
 }
+
+/* A column of height `top` and radius r about (x, y) on a flat floor. */
+static void pour(graded_mesh *m, double x, double y, double r, double top) { pour_on_a_slope(m, 0.0, 0.0, x, y, r, top); }
 
 /* The three columns, on a mesh of n cells a side whose cells span `ratio`
  * from corner to corner (the domain is about (n + 1) ratio / 2 wide in
@@ -402,18 +409,6 @@ static void test_negligible_source(void **state) {
     REQUIRE(step_info_of(m.g, DPSM_INFO_TIME_INTEGRATED) == 1e12, "time %g", step_info_of(m.g, DPSM_INFO_TIME_INTEGRATED));
     free(q);
     free_graded(&m);
-}
-
-/* A column of height `top` and radius r about (x, y) on a plane rising at
- * `slope` into the coarse corner from the diagonal x + y = from (the floor
- * flat before it). */
-static void pour_on_a_slope(graded_mesh *m, double slope, double from, double x, double y, double r, double top) {
-    double *h = calloc((size_t)m->cells, sizeof(double));
-    for (int64_t c = 0; c < m->cells; ++c)
-        h[c] = fmax(tan(slope) * (m->cx[c] + m->cy[c] - from) / sqrt(2.0), 0.0) +
-               (hypot(m->cx[c] - x, m->cy[c] - y) < r ? top : 0.0);
-    CHECK_OK(m->g, dpsm_set_heights(m->g, h));
-    free(h);
 }
 
 /* The straddling column on a slope of 32 degrees from the diagonal x + y =
