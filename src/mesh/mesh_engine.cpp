@@ -473,7 +473,8 @@ public:
             }
             if (parts) {
                 // Every rank takes the same sub-steps and stops at the same one.
-                std::vector<SubstepSummary> agreed{did};
+                std::vector<SubstepSummary> &agreed = s.agreed;
+                agreed.assign(1, did);
                 parts->agree_on_substeps(agreed);
                 did = agreed[0];
             }

@@ -14,11 +14,13 @@ namespace {
 // that steps its ghosts: the next update adds to it) and the sub-step its
 // height is current after (lazy sources: what its source added since is
 // read, not stored), in that place.
-std::vector<GhostField> height_fields(Grid &grid) {
+const std::vector<GhostField> &height_fields(Grid &grid) {
     GhostField moving, residual;
     if (grid.hysteresis()) moving.u8 = grid.moving_for_stepping().data();
     if (steps_ghosts(grid)) residual.f32 = grid.residuals_for_stepping().data();
-    return {GhostField{grid.heights_for_stepping().data()}, moving, residual, GhostField{mesh_state(grid).since.data()}};
+    MeshState &s = mesh_state(grid);
+    s.ghost_fields.assign({GhostField{grid.heights_for_stepping().data()}, moving, residual, GhostField{s.since.data()}});
+    return s.ghost_fields;
 }
 
 }  // namespace
@@ -30,7 +32,8 @@ bool steps_ghosts(const Grid &grid) { return grid.geometry().mesh->substeps_per_
 // its own and leaves the others absent.
 namespace {
 void exchange_face_fields(MeshState &s, int first, double *x, double *y, std::vector<std::int64_t> &changed_ghosts) {
-    std::vector<GhostField> fields(6);
+    std::vector<GhostField> &fields = s.ghost_fields;
+    fields.assign(6, GhostField{});
     fields[static_cast<std::size_t>(first)].f64 = x;
     fields[static_cast<std::size_t>(first) + 1].f64 = y;
     s.exchange->send_changed(GhostExchange::kFaceGhosts, fields, nullptr, changed_ghosts);

@@ -8,13 +8,14 @@
 #include <memory>
 #include <vector>
 
+#include "mesh/ghost_exchange.hpp"
 #include "mesh/step_classes.hpp"
+#include "model/engine.hpp"
 #include "model/grid.hpp"
 #include "model/switches.hpp"
 
 namespace dpsm {
 
-class GhostExchange;
 
 // Which cells the next sub-step must look at, kept between steps: a face
 // can start to carry sand only where a cell within one face of its cells
@@ -86,6 +87,10 @@ struct MeshState final : EngineState {
     std::uint32_t stamp = 0;
     std::vector<std::int64_t> faces, gradient_cells, update_cells;
     std::vector<std::int64_t> changed_ghosts;  // a part's ghosts whose owners sent new values
+    // A part's exchanges in every sub-step, kept so that they allocate nothing
+    // once warm: the fields sent, the sub-step's summary the ranks agree on.
+    std::vector<GhostField> ghost_fields;
+    std::vector<SubstepSummary> agreed;
     std::vector<double> available;         // bed: the sand (a volume) a cell's faces may take
     std::vector<std::uint8_t> carried;     // dense: per cell, a face of it carried sand
     bool flux_clean = true;

@@ -106,7 +106,8 @@ std::vector<double> CollectiveDistribution::agree_on_step(const Grid &grid, doub
 }
 
 void CollectiveDistribution::agree_on_substeps(std::vector<SubstepSummary> &levels) const {
-    std::vector<double> v;
+    std::vector<double> &v = substep_values_;
+    v.clear();
     for (const SubstepSummary &level : levels) {
         v.push_back(level.moved ? 1.0 : 0.0);
         v.push_back(level.max_excess_slope);

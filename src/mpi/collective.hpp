@@ -69,6 +69,9 @@ protected:
 
 private:
     Communicator ranks_;
+    // agree_on_substeps' values, kept between sub-steps: it runs in every
+    // one, and an allocation each time is what a sanitizer's run pays most for.
+    mutable std::vector<double> substep_values_;
 };
 
 }  // namespace dpsm

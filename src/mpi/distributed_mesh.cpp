@@ -400,7 +400,8 @@ public:
         const CellLists &send = ghosts == kEveryGhost ? links_.send_heights : links_.send_gradients;
         const CellLists &receive = ghosts == kEveryGhost ? links_.receive_heights : links_.receive_gradients;
         std::vector<std::vector<double>> &sent = sent_[ghosts];
-        std::vector<std::size_t> present;
+        std::vector<std::size_t> &present = present_;
+        present.clear();
         for (std::size_t k = 0; k < fields.size(); ++k)
             if (fields[k].present()) present.push_back(k);
         if (sent.size() < fields.size()) sent.resize(fields.size());
@@ -435,7 +436,8 @@ public:
     void send_all(Ghosts ghosts, const std::vector<GhostField> &fields, bool remember) override {
         const CellLists &send = ghosts == kEveryGhost ? links_.send_heights : links_.send_gradients;
         const CellLists &receive = ghosts == kEveryGhost ? links_.receive_heights : links_.receive_gradients;
-        std::vector<std::size_t> present;
+        std::vector<std::size_t> &present = present_;
+        present.clear();
         for (std::size_t k = 0; k < fields.size(); ++k)
             if (fields[k].present()) present.push_back(k);
         exchange(send, receive, static_cast<int>(present.size()),
@@ -665,6 +667,8 @@ private:
     std::vector<std::vector<double>> sent_[2];
     std::vector<std::vector<double>> outgoing_;
     std::vector<double> incoming_, whole_;
+    // The places of the fields a call sends (GhostField::present).
+    std::vector<std::size_t> present_;
     std::vector<MPI_Request> sends_;
     std::vector<double> send_buffer_, receive_buffer_;
     std::vector<int> send_counts_, send_offsets_, receive_counts_, receive_offsets_;
