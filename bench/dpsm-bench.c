@@ -269,8 +269,9 @@ static const command kCommands[] = {
      " static angle; 1 and 2 threads, best of runs (3); cost against the plain scene (DPSM_SCALAR_PHYSICS=1: the scalar"
      " kernel); a scene named: that one alone"},
     {"mesh", cmd_mesh,
-     "[n [runs]]  2 n^2 (n = 708: 1,002,528) jittered triangles: a fully active sub-step on 1 and 2 threads against the"
-     " plain face loop; ridges on ~1 % of cells and a mesh at rest against a fully active sub-step"},
+     "[n [runs [kind]]]  about a million cells (n = 0: 708 for 1,002,528 jittered_triangles, 936 hexagons, 1000"
+     " median_dual): a fully active sub-step on 1 and 2 threads against the plain face loop on the same cells; ridges"
+     " on ~1 % of cells and a mesh at rest against a fully active sub-step"},
     {"mesh-wind", cmd_mesh_wind,
      "[n [threads [runs]]]  the wind scene on 2 n^2 (n = 708: 1,002,528) jittered triangles: ~1 % of cells on slip faces"
      " and a source on every cell; a call of 64 stable sub-steps against 64 fully active sub-steps and the plain face"

@@ -298,33 +298,67 @@ static int edge_order(const void *l, const void *r) {
     return a->cell < b->cell ? -1 : a->cell > b->cell;
 }
 
+/* Face f of the plain loop: cells a and b (-1: the edge), its length, and
+ * the line from a's centre to b's (on the edge: to a's mirror image across
+ * the face's midpoint (mx, my)). */
+static void plain_face(plain_mesh *p, const mesh_scene *s, int64_t *degree, int64_t a, int64_t b, double len, double mx,
+                       double my) {
+    const int64_t f = p->faces++;
+    const double ex = b >= 0 ? s->cx[b] - s->cx[a] : 2.0 * (mx - s->cx[a]);
+    const double ey = b >= 0 ? s->cy[b] - s->cy[a] : 2.0 * (my - s->cy[a]);
+    p->fa[f] = a, p->fb[f] = b, p->d[f] = hypot(ex, ey), p->ortho[f] = len / p->d[f];
+    p->tx[f] = -ey / p->d[f], p->ty[f] = ex / p->d[f];
+    if (b >= 0) ++degree[a], ++degree[b];
+}
+
+/* The plain loop's faces from the scene's polygons: each shared edge a face
+ * between its two polygons, each other edge a face on the domain edge. On
+ * the median dual (whose cells are the triangles' nodes) each triangle edge
+ * is a face between its two nodes, running from one triangle's centroid to
+ * the edge's midpoint to the other's, and each half of an edge on the
+ * domain edge a face of its node there. */
 static plain_mesh plain_from(const mesh_scene *s) {
     plain_mesh p;
     memset(&p, 0, sizeof p);
     p.cells = s->cells;
-    const int64_t uses = s->cell_start[s->cells];
+    const int dual = s->kind == SCENE_DUAL;
+    const int64_t polygons = dual ? s->npolygons : s->cells;
+    const int64_t uses = dual ? 3 * s->npolygons : s->cell_start[s->cells];
     edge_use *e = xcalloc((size_t)uses, sizeof *e);
-    for (int64_t c = 0; c < s->cells; ++c)
-        for (int64_t k = s->cell_start[c]; k < s->cell_start[c + 1]; ++k) {
-            const int64_t u = s->cell_nodes[k], v = s->cell_nodes[k + 1 < s->cell_start[c + 1] ? k + 1 : s->cell_start[c]];
+    for (int64_t c = 0; c < polygons; ++c) {
+        const int64_t first = dual ? 3 * c : s->cell_start[c], end = dual ? 3 * c + 3 : s->cell_start[c + 1];
+        for (int64_t k = first; k < end; ++k) {
+            const int64_t u = s->cell_nodes[k], v = s->cell_nodes[k + 1 < end ? k + 1 : first];
             e[k].lo = u < v ? u : v, e[k].hi = u < v ? v : u, e[k].cell = c;
         }
+    }
     qsort(e, (size_t)uses, sizeof *e, edge_order);
-    p.fa = xcalloc((size_t)uses, sizeof(int64_t)), p.fb = xcalloc((size_t)uses, sizeof(int64_t));
-    p.d = xcalloc((size_t)uses, sizeof(double)), p.ortho = xcalloc((size_t)uses, sizeof(double));
-    p.tx = xcalloc((size_t)uses, sizeof(double)), p.ty = xcalloc((size_t)uses, sizeof(double));
+    const size_t most = 2 * (size_t)uses; /* the dual's edge on the domain edge gives two faces */
+    p.fa = xcalloc(most, sizeof(int64_t)), p.fb = xcalloc(most, sizeof(int64_t));
+    p.d = xcalloc(most, sizeof(double)), p.ortho = xcalloc(most, sizeof(double));
+    p.tx = xcalloc(most, sizeof(double)), p.ty = xcalloc(most, sizeof(double));
     int64_t *degree = xcalloc((size_t)s->cells + 1, sizeof(int64_t));
+    const double *xy = s->node_xy;
     for (int64_t k = 0; k < uses;) {
         const int shared = k + 1 < uses && e[k + 1].lo == e[k].lo && e[k + 1].hi == e[k].hi;
-        const int64_t a = e[k].cell, b = shared ? e[k + 1].cell : -1, f = p.faces++;
-        const double *xy = s->node_xy;
-        const double len = hypot(xy[2 * e[k].hi] - xy[2 * e[k].lo], xy[2 * e[k].hi + 1] - xy[2 * e[k].lo + 1]);
-        const double mx = 0.5 * (xy[2 * e[k].hi] + xy[2 * e[k].lo]), my = 0.5 * (xy[2 * e[k].hi + 1] + xy[2 * e[k].lo + 1]);
-        const double ex = b >= 0 ? s->cx[b] - s->cx[a] : 2.0 * (mx - s->cx[a]);
-        const double ey = b >= 0 ? s->cy[b] - s->cy[a] : 2.0 * (my - s->cy[a]);
-        p.fa[f] = a, p.fb[f] = b, p.d[f] = hypot(ex, ey), p.ortho[f] = len / p.d[f];
-        p.tx[f] = -ey / p.d[f], p.ty[f] = ex / p.d[f];
-        if (b >= 0) ++degree[a], ++degree[b];
+        const int64_t lo = e[k].lo, hi = e[k].hi;
+        const double len = hypot(xy[2 * hi] - xy[2 * lo], xy[2 * hi + 1] - xy[2 * lo + 1]);
+        const double mx = 0.5 * (xy[2 * hi] + xy[2 * lo]), my = 0.5 * (xy[2 * hi + 1] + xy[2 * lo + 1]);
+        if (!dual) {
+            plain_face(&p, s, degree, e[k].cell, shared ? e[k + 1].cell : -1, len, mx, my);
+        } else if (shared) {
+            double dual_len = 0.0;
+            for (int side = 0; side < 2; ++side) {
+                const int64_t *t = s->cell_nodes + 3 * e[k + side].cell;
+                const double gx = (xy[2 * t[0]] + xy[2 * t[1]] + xy[2 * t[2]]) / 3.0;
+                const double gy = (xy[2 * t[0] + 1] + xy[2 * t[1] + 1] + xy[2 * t[2] + 1]) / 3.0;
+                dual_len += hypot(gx - mx, gy - my);
+            }
+            plain_face(&p, s, degree, lo, hi, dual_len, mx, my);
+        } else {
+            plain_face(&p, s, degree, lo, -1, 0.5 * len, 0.5 * (mx + xy[2 * lo]), 0.5 * (my + xy[2 * lo + 1]));
+            plain_face(&p, s, degree, hi, -1, 0.5 * len, 0.5 * (mx + xy[2 * hi]), 0.5 * (my + xy[2 * hi + 1]));
+        }
         k += shared ? 2 : 1;
     }
     free(e);
@@ -450,12 +484,26 @@ static double seconds_per_substep(dpsm_grid *g, int substeps, double *updates) {
 }
 
 int cmd_mesh(int argc, char **argv) {
-    const int n = argc > 0 ? atoi(argv[0]) : 708; /* 2 n^2 triangles: 1,002,528 */
+    /* The kinds of mesh, each with the n that makes about a million cells. */
+    static const struct {
+        scene_kind kind;
+        int n;
+    } kinds[] = {{SCENE_TRIANGLES, 708}, {SCENE_HEXAGONS, 936}, {SCENE_DUAL, 1000}};
+    size_t which = 0;
+    if (argc > 2) {
+        while (which < sizeof kinds / sizeof *kinds && strcmp(argv[2], scene_name(kinds[which].kind)) != 0) ++which;
+        if (which == sizeof kinds / sizeof *kinds) {
+            fprintf(stderr, "mesh: no mesh kind '%s' (jittered_triangles, hexagons or median_dual)\n", argv[2]);
+            return 2;
+        }
+    }
+    const int n = argc > 0 && atoi(argv[0]) > 0 ? atoi(argv[0]) : kinds[which].n; /* 0: about a million cells */
     const int runs = argc > 1 ? atoi(argv[1]) : 3;
     const double tan_theta = tan(30.0 * kPi / 180.0);
-    mesh_scene s = scene_make(SCENE_TRIANGLES, n, 1.0, 4242u);
-    fprintf(stderr, "mesh: %lld jittered triangles; fully active (a plane of slope 10 draining over open edges),"
-                    " sparse (ridges on ~1 %% of cells), idle; best of %d\n", (long long)s.cells, runs);
+    const char *mesh = scene_name(kinds[which].kind);
+    mesh_scene s = scene_make(kinds[which].kind, n, 1.0, 4242u);
+    fprintf(stderr, "mesh: %lld cells of %s; fully active (a plane of slope 10 draining over open edges),"
+                    " sparse (ridges on ~1 %% of cells), idle; best of %d\n", (long long)s.cells, mesh, runs);
     double *h = xcalloc((size_t)s.cells, sizeof(double)), *plain_h = xcalloc((size_t)s.cells, sizeof(double));
     for (int64_t c = 0; c < s.cells; ++c) h[c] = 30.0 + 10.0 * (s.cx[c] + 0.3 * s.cy[c]);
     dpsm_grid *g = NULL;
@@ -465,7 +513,7 @@ int cmd_mesh(int argc, char **argv) {
     CHECK(g, dpsm_stable_dt(g, &dt));
     plain_mesh p = plain_from(&s);
     const double bytes = bench_mesh_bytes_per_update(g, stderr);
-    printf("scene,threads,seconds_per_substep,mcells_per_s,reference_mcells_per_s,ratio,cells_visited_per_substep,"
+    printf("mesh,scene,threads,seconds_per_substep,mcells_per_s,reference_mcells_per_s,ratio,cells_visited_per_substep,"
            "bytes_per_update,triad_gb_per_s,bound_mcells_per_s,share_of_bound\n");
     const int substeps = 20;
     double plain_best = 1e300;
@@ -485,7 +533,7 @@ int cmd_mesh(int argc, char **argv) {
         }
         /* The triad in the same run, beside it: the bound the layout's bytes set on this machine. */
         const double triad = triad_bytes_per_second(threads), rate = s.cells / active_best[threads];
-        printf("fully_active,%d,%.6f,%.1f,%.1f,%.2f,%.0f,%.0f,%.1f,%.1f,%.3f\n", threads, active_best[threads],
+        printf("%s,fully_active,%d,%.6f,%.1f,%.1f,%.2f,%.0f,%.0f,%.1f,%.1f,%.3f\n", mesh, threads, active_best[threads],
                rate / 1e6, s.cells / plain_best / 1e6, plain_best / active_best[threads], updates, bytes, triad / 1e9,
                triad / bytes / 1e6, rate / (triad / bytes));
         fflush(stdout);
@@ -507,8 +555,8 @@ int cmd_mesh(int argc, char **argv) {
         CHECK(g, dpsm_set_heights(g, h));
         CHECK(g, dpsm_step(g, dt));
         visited_and_changed(g, s.cells, substeps, &visited, &changed);
-        printf("sparse,%d,%.6f,,,%.4f of fully active,%.0f (%.2f %% of cells; %.0f changed a sub-step: visited %.2f times)\n",
-               threads, best, best / active_best[threads], updates, 100.0 * updates / s.cells, changed,
+        printf("%s,sparse,%d,%.6f,,,%.4f of fully active,%.0f (%.2f %% of cells; %.0f changed a sub-step: visited %.2f times)\n",
+               mesh, threads, best, best / active_best[threads], updates, 100.0 * updates / s.cells, changed,
                visited / changed);
         fflush(stdout);
     }
@@ -524,7 +572,7 @@ int cmd_mesh(int argc, char **argv) {
         CHECK(g, dpsm_step(g, dt));
         best = fmin(best, now_seconds() - t0);
     }
-    printf("idle,2,%.9f,,,%.6f of fully active,0\n", best, best / active_best[2]);
+    printf("%s,idle,2,%.9f,,,%.6f of fully active,0\n", mesh, best, best / active_best[2]);
     plain_free(&p);
     dpsm_destroy(g);
     free(h), free(plain_h);

@@ -38,8 +38,12 @@ mkdir -p "$data" "$figures"
 echo ">> dpsm-bench mesh-accuracy"
 DPSM_DISK_GEO=$root/bench/data/disk.geo "$bench" mesh-accuracy 1 3 > "$data/mesh_accuracy.csv" 2> "$data/mesh_accuracy.log"
 cat "$data/mesh_accuracy.csv"
-echo ">> dpsm-bench mesh"
-"$bench" mesh > "$data/mesh_speed.csv" 2> "$data/mesh_speed.log"
+echo ">> dpsm-bench mesh, each kind of mesh three times"
+{
+  for kind in jittered_triangles hexagons median_dual; do
+    for run in 1 2 3; do "$bench" mesh 0 3 "$kind"; done
+  done
+} 2> "$data/mesh_speed.log" | awk 'NR == 1 || !/^mesh,/' > "$data/mesh_speed.csv"
 cat "$data/mesh_speed.csv"
 echo ">> dpsm-bench mesh-wind, 1 and 2 threads, three runs each"
 {
