@@ -16,7 +16,6 @@
 
 namespace dpsm {
 
-
 // Which cells the next sub-step must look at, kept between steps: a face
 // can start to carry sand only where a cell within one face of its cells
 // changed (its slope reads its cells' least-squares gradients).
