@@ -771,6 +771,56 @@ static void test_plane_at_the_angle_of_repose_rests(void **state) {
     }
 }
 
+/* A slope that runs along a wall drains as it does away from one: a ridge
+ * across a mesh of squares walled on every side (and across a row of wall
+ * cells through its middle) collapses the same in every row, the rows
+ * beside the walls included. A face between a sand cell and a wall carries
+ * nothing, but the slope along it counts in the faces' energy; without it
+ * the rows beside a wall lag (by 6e-3 of the ridge's height here) and rest
+ * last. */
+static void test_slope_along_a_wall_drains_as_away_from_it(void **state) {
+    (void)state;
+    const int n = 24;
+    mesh_scene s = scene_make(SCENE_QUADS, n, 1.0, 3u);
+    for (int wall_row = 0; wall_row < 2; ++wall_row) {
+        dpsm_grid *g = NULL;
+        CHECK_OK(NULL, scene_create(&s, &g));
+        CHECK_OK(g, dpsm_set_repose_angle(g, 30.0 * kDeg));
+        CHECK_OK(g, dpsm_set_boundary(g, DPSM_MESH_EDGE, DPSM_WALL));
+        double *h = calloc((size_t)s.cells, sizeof(double)), *after = calloc((size_t)s.cells, sizeof(double));
+        uint8_t *kinds = calloc((size_t)s.cells, 1);
+        /* The row of wall cells: those whose centres lie in the band |y| < spacing / 2 (no
+         * centre lies on y = 0 for even n, so the band takes the row just above it). */
+        const double spacing = 2.0 / n;
+        for (int64_t c = 0; c < s.cells; ++c) {
+            h[c] = fabs(s.cx[c]) < 0.3 ? 1.0 : 0.0;
+            if (wall_row && s.cy[c] > 0.0 && s.cy[c] < spacing) kinds[c] = DPSM_CELL_WALL;
+        }
+        CHECK_OK(g, dpsm_set_cell_kinds(g, kinds));
+        CHECK_OK(g, dpsm_set_heights(g, h));
+        for (int call = 0; call < 10; ++call) CHECK_OK(g, dpsm_step(g, 0.05));
+        CHECK_OK(g, dpsm_get_heights(g, after));
+        /* Every sand cell against the sand cell of its column nearest y = -0.5 (a row with sand on both sides). */
+        double largest = 0.0, moved = 0.0;
+        for (int64_t c = 0; c < s.cells; ++c) {
+            if (kinds[c] == DPSM_CELL_WALL) continue;
+            int64_t reference = -1;
+            for (int64_t o = 0; o < s.cells; ++o)
+                if (fabs(s.cx[o] - s.cx[c]) < 1e-9 &&
+                    (reference < 0 || fabs(s.cy[o] + 0.5) < fabs(s.cy[reference] + 0.5)))
+                    reference = o;
+            largest = fmax(largest, fabs(after[c] - after[reference]));
+            moved = fmax(moved, fabs(after[c] - h[c]));
+        }
+        REQUIRE(moved > 0.1, "the ridge did not collapse (largest change %g)", moved);
+        REQUIRE(largest <= 1e-12, "%s: the rows differ by up to %.3g after the same collapse",
+                wall_row ? "walled edges and a row of wall cells" : "walled edges", largest);
+        free(h), free(after), free(kinds);
+        dpsm_destroy(g);
+    }
+    scene_free(&s);
+}
+
 /* The column on a copy of the mesh turned by 30 degrees about the column's
  * axis is the same scene: the heights agree cell by cell to round-off on
  * every kind of mesh (the library orders the turned mesh's cells otherwise,
@@ -1264,6 +1314,7 @@ int main(void) {
         cmocka_unit_test(test_no_new_extremum_on_rough_surfaces),
         cmocka_unit_test(test_exact_states),
         cmocka_unit_test(test_plane_at_the_angle_of_repose_rests),
+        cmocka_unit_test(test_slope_along_a_wall_drains_as_away_from_it),
         cmocka_unit_test(test_turned_mesh_same_deposit),
         cmocka_unit_test(test_error_falls_with_the_cells),
         cmocka_unit_test(test_host_order),

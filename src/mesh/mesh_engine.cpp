@@ -71,6 +71,12 @@ constexpr std::uint8_t kWatched = 1, kNearMoves = 2;
 // What counts as the round-off of a sum, relative to its terms' magnitudes.
 constexpr double kRoundOff = 64.0 * std::numeric_limits<double>::epsilon();
 
+// What a face does in a sub-step (carrying_faces): carries sand between its
+// cells or over an open edge, lies between a sand cell and a wall (it
+// carries none, but the slope along it counts in the faces' energy), or
+// nothing (no sand on it).
+enum FaceRole : std::uint8_t { kCarriesNothing = 0, kCarries = 1, kAlongWall = 2 };
+
 // The heights a sub-step reads. With lazy sources a sand cell's stored
 // height is current after sub-step since[c] of the step, and what its source
 // added since is read, the same bits wherever it is read ("Sources in closed
@@ -100,7 +106,7 @@ struct FaceLaw {
     Heights h;
     const std::uint8_t *kind;
     const double *gx, *gy;
-    const std::uint8_t *carrying;   // per face: whether it may carry sand at all (carrying_faces)
+    const std::uint8_t *carrying;   // per face: a FaceRole (carrying_faces)
     const double *edge_level;       // per face; null: 0
     const double *tan_field;        // null: uniform
     const std::uint8_t *moving;     // hysteresis: null when off
@@ -108,7 +114,8 @@ struct FaceLaw {
     double nu, tan_theta, tolerance, tan_static, p, dt;
     bool isotropic;
 
-    bool carries(std::int64_t f) const { return carrying[f] != 0; }
+    bool carries(std::int64_t f) const { return carrying[f] == kCarries; }
+    bool along_wall(std::int64_t f) const { return carrying[f] == kAlongWall; }
 
     // Face f's slope and what it gives the sub-step's fluxes.
     //
@@ -127,6 +134,7 @@ struct FaceLaw {
     };
     Slope slope(std::int64_t f) const {
         const std::int64_t a = m.face_a[f], b = m.face_b[f];
+        if (along_wall(f)) return slope_along_wall(f, b >= 0 && kind[b] == kSand ? b : a);
         const std::uint8_t ka = kind[a];
         Slope out;
         out.ha = h[a];
@@ -152,11 +160,27 @@ struct FaceLaw {
         return out;
     }
 
+    // A face between sand cell c and a wall (a closed edge or a wall cell):
+    // nothing crosses it, so its slope is the one along it, read from c's
+    // gradient. Its diamond's half in c counts in E like any other, so that
+    // a slope running along a wall drains as it does away from one.
+    Slope slope_along_wall(std::int64_t f, std::int64_t c) const {
+        Slope out;
+        out.ha = out.hb = h[c];
+        out.normal = 0.0;
+        out.tangential = isotropic ? gx[c] * m.tangent_x[f] + gy[c] * m.tangent_y[f] : 0.0;
+        out.tan_face = tan_field ? tan_field[c] : tan_theta;
+        out.threshold = out.tan_face * (1.0 + tolerance);
+        if (moving) out.threshold = law::threshold(out.threshold, !moving[c], tan_static);
+        out.s = std::fabs(out.tangential);
+        return out;
+    }
+
     // Whether face f may be steep, where the rounding of its heights and
     // gradients could decide it: its slope within a band of rounding below
     // its threshold counts.
     bool may_be_steep(std::int64_t f) const {
-        if (!carries(f)) return false;
+        if (!carries(f) && !along_wall(f)) return false;
         const Slope sl = slope(f);
         const double band = 1e-9 * sl.threshold + kRoundOff * (std::fabs(sl.ha) + std::fabs(sl.hb)) / m.distance[f];
         return sl.s > sl.threshold - band;
@@ -164,6 +188,7 @@ struct FaceLaw {
 
     FaceTerms terms(std::int64_t f) const {
         FaceTerms out;
+        if (along_wall(f)) return terms_along_wall(f);
         if (!carries(f)) return out;
         const std::int64_t a = m.face_a[f], b = m.face_b[f];
         const Slope sl = slope(f);
@@ -193,6 +218,23 @@ struct FaceLaw {
         if (!(across > tolerance * tan_face)) return out;
         out.low = capped(g * factor * normal, a, b);
         if (on_bed) out.two_point = out.low;
+        return out;
+    }
+
+    // A face along a wall carries nothing itself: its part of E's derivative
+    // is its pull on its sand cell's gradient (the whole of it: its slope
+    // reads that gradient alone), which the cell's stencil carries.
+    FaceTerms terms_along_wall(std::int64_t f) const {
+        FaceTerms out;
+        const std::int64_t a = m.face_a[f], b = m.face_b[f];
+        const std::int64_t c = b >= 0 && kind[b] == kSand ? b : a;
+        const Slope sl = slope_along_wall(f, c);
+        if (!(sl.s > sl.threshold)) return out;
+        out.steep = true;
+        out.excess = sl.s - sl.tan_face;
+        if (available && bare(c)) return out;  // as a face on a bare cell: no pull
+        const double diamond = 0.25 * m.orthogonal[f] * m.distance[f];
+        out.pull = diamond * slide_flux(nu, sl.tan_face, sl.s, p) / sl.s * sl.tangential;
         return out;
     }
 
@@ -389,9 +431,10 @@ public:
         list_source_faces(m, q, s);
     }
 
-    // Per face, whether it may carry sand at all: no wall on it, a sand cell
-    // on it, and on the domain edge an open edge. It follows the kinds and
-    // the edges, so it is found with the lists that follow them.
+    // Per face, its FaceRole: it carries sand where no wall is on it and a
+    // sand cell is (on the domain edge, an open edge); between a sand cell
+    // and a wall cell or a closed edge it lies along a wall. It follows the
+    // kinds and the edges, so it is found with the lists that follow them.
     static void carrying_faces(const Grid &grid, const Mesh &m, std::vector<std::uint8_t> &carrying) {
         const std::uint8_t *kind = grid.kinds().data();
         const std::uint8_t *edge_open = grid.edge_open_flags().empty() ? nullptr : grid.edge_open_flags().data();
@@ -401,10 +444,14 @@ public:
             const std::int64_t a = m.face_a[f], b = m.face_b[f];
             const std::uint8_t ka = kind[a];
             if (b < 0) {
-                carrying[f] = ka == kSand && (edge_open ? edge_open[f] != 0 : open_edges);
+                const bool open = edge_open ? edge_open[f] != 0 : open_edges;
+                carrying[f] = ka != kSand ? kCarriesNothing : open ? kCarries : kAlongWall;
             } else {
                 const std::uint8_t kb = kind[b];
-                carrying[f] = ka != kWall && kb != kWall && (ka == kSand || kb == kSand);
+                if (ka != kWall && kb != kWall)
+                    carrying[f] = ka == kSand || kb == kSand ? kCarries : kCarriesNothing;
+                else
+                    carrying[f] = ka == kSand || kb == kSand ? kAlongWall : kCarriesNothing;
             }
         }
     }
