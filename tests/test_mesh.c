@@ -821,6 +821,46 @@ static void test_slope_along_a_wall_drains_as_away_from_it(void **state) {
     scene_free(&s);
 }
 
+/* The same on hexagons, whose cells meet a straight wall at an angle:
+ * there the slope on a cell's side of a wall face is the cell's whole
+ * gradient, not its part along the face. A ridge across 24 x 24 hexagons
+ * walled all round drains as on the grid engine's 24 x 24 cells: after 4
+ * time units its largest excess slope is 0.91 times the grid's (with the
+ * slope along the wall faces alone, 4.4 times: the cells beside the walls
+ * lag). */
+static void test_ridge_between_walls_drains_as_on_the_grid(void **state) {
+    (void)state;
+    const int n = 24;
+    const double half = 2.5, spacing = 2.0 * half / n;
+    double excess[2] = {0.0, 0.0};
+    mesh_scene s = scene_make(SCENE_HEXAGONS, n, half, 3u);
+    for (int on_grid = 0; on_grid < 2; ++on_grid) {
+        dpsm_grid *g = NULL;
+        const int64_t cells = on_grid ? (int64_t)n * n : s.cells;
+        double *h = calloc((size_t)cells, sizeof(double));
+        if (on_grid) {
+            CHECK_OK(NULL, dpsm_create_2d(n, n, spacing, spacing, &g));
+            for (int side = DPSM_XMIN; side <= DPSM_YMAX; ++side) CHECK_OK(g, dpsm_set_boundary(g, side, DPSM_WALL));
+            for (int64_t c = 0; c < cells; ++c) h[c] = fabs(-half + (c % n + 0.5) * spacing) < 0.6 ? 2.0 : 0.0;
+        } else {
+            CHECK_OK(NULL, scene_create(&s, &g));
+            CHECK_OK(g, dpsm_set_boundary(g, DPSM_MESH_EDGE, DPSM_WALL));
+            for (int64_t c = 0; c < cells; ++c) h[c] = fabs(s.cx[c]) < 0.6 ? 2.0 : 0.0;
+        }
+        CHECK_OK(g, dpsm_set_repose_angle(g, 30.0 * kDeg));
+        CHECK_OK(g, dpsm_set_heights(g, h));
+        for (int call = 0; call < 40; ++call) CHECK_OK(g, dpsm_step(g, 0.1));
+        excess[on_grid] = step_info_of(g, DPSM_INFO_MAX_EXCESS_SLOPE);
+        free(h);
+        dpsm_destroy(g);
+    }
+    scene_free(&s);
+    print_message("ridge between walls at t = 4: largest excess slope %.3g on hexagons, %.3g on the grid\n", excess[0], excess[1]);
+    REQUIRE(excess[1] > 0.0, "the grid's ridge rested before t = 4: the scene tests nothing");
+    REQUIRE(excess[0] <= 1.5 * excess[1], "hexagons: the largest excess slope at t = 4 is %.3g, %.2f times the grid's %.3g",
+            excess[0], excess[0] / excess[1], excess[1]);
+}
+
 /* The column on a copy of the mesh turned by 30 degrees about the column's
  * axis is the same scene: the heights agree cell by cell to round-off on
  * every kind of mesh (the library orders the turned mesh's cells otherwise,
@@ -1315,6 +1355,7 @@ int main(void) {
         cmocka_unit_test(test_exact_states),
         cmocka_unit_test(test_plane_at_the_angle_of_repose_rests),
         cmocka_unit_test(test_slope_along_a_wall_drains_as_away_from_it),
+        cmocka_unit_test(test_ridge_between_walls_drains_as_on_the_grid),
         cmocka_unit_test(test_turned_mesh_same_deposit),
         cmocka_unit_test(test_error_falls_with_the_cells),
         cmocka_unit_test(test_host_order),

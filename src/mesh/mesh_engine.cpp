@@ -95,7 +95,7 @@ struct Heights {
 struct FaceTerms {
     double low = 0.0;        // the monotone two-point flux, a to b
     double two_point = 0.0;  // the gradient flow's two-point part, a to b
-    double pull = 0.0;       // V g t: what the face asks of its cells' gradients along t
+    double pull = 0.0;       // V g t: what the face asks of its cells' gradients along t (along a wall: V g)
     double excess = 0.0;     // its slope beyond tan(theta)
     bool steep = false;      // its slope exceeds its threshold
 };
@@ -161,18 +161,19 @@ struct FaceLaw {
     }
 
     // A face between sand cell c and a wall (a closed edge or a wall cell):
-    // nothing crosses it, so its slope is the one along it, read from c's
-    // gradient. Its diamond's half in c counts in E like any other, so that
-    // a slope running along a wall drains as it does away from one.
+    // nothing crosses it, and the surface on c's side of it, its diamond's
+    // half in c, has c's gradient for its slope. That half counts in E like
+    // any other diamond, so that a slope running along a wall drains as it
+    // does away from one.
     Slope slope_along_wall(std::int64_t f, std::int64_t c) const {
         Slope out;
         out.ha = out.hb = h[c];
-        out.normal = 0.0;
+        out.normal = isotropic ? gx[c] * m.tangent_y[f] - gy[c] * m.tangent_x[f] : 0.0;
         out.tangential = isotropic ? gx[c] * m.tangent_x[f] + gy[c] * m.tangent_y[f] : 0.0;
         out.tan_face = tan_field ? tan_field[c] : tan_theta;
         out.threshold = out.tan_face * (1.0 + tolerance);
         if (moving) out.threshold = law::threshold(out.threshold, !moving[c], tan_static);
-        out.s = std::fabs(out.tangential);
+        out.s = std::sqrt(out.normal * out.normal + out.tangential * out.tangential);
         return out;
     }
 
@@ -222,8 +223,8 @@ struct FaceLaw {
     }
 
     // A face along a wall carries nothing itself: its part of E's derivative
-    // is its pull on its sand cell's gradient (the whole of it: its slope
-    // reads that gradient alone), which the cell's stencil carries.
+    // is a pull on its sand cell's gradient, V g along that gradient (pull_of
+    // applies it so), which the cell's stencil carries.
     FaceTerms terms_along_wall(std::int64_t f) const {
         FaceTerms out;
         const std::int64_t a = m.face_a[f], b = m.face_b[f];
@@ -234,7 +235,7 @@ struct FaceLaw {
         out.excess = sl.s - sl.tan_face;
         if (available && bare(c)) return out;  // as a face on a bare cell: no pull
         const double diamond = 0.25 * m.orthogonal[f] * m.distance[f];
-        out.pull = diamond * slide_flux(nu, sl.tan_face, sl.s, p) / sl.s * sl.tangential;
+        out.pull = diamond * slide_flux(nu, sl.tan_face, sl.s, p) / sl.s;
         return out;
     }
 
@@ -292,10 +293,18 @@ inline double beyond_round_off(double sum, double scale) {
 
 // Cell c's pull: M_c^-1 P_c, with P_c the sum of its faces' pulls along
 // their tangents, in the cell's face order (0 without a stencil).
-inline void pull_of(const Mesh &m, const double *pull, std::int64_t c, double *pull_x, double *pull_y) {
+inline void pull_of(const Mesh &m, const FaceLaw &law, const double *pull, std::int64_t c, double *pull_x,
+                    double *pull_y) {
     double x = 0.0, y = 0.0;
     for (std::int64_t k = m.cell_face_start[c]; k < m.cell_face_start[c + 1]; ++k) {
         const std::int64_t f = m.cell_faces[k];
+        if (law.along_wall(f)) {
+            // The wall's side has no gradient the face reads.
+            if (pull[f] == 0.0 || law.kind[c] != kSand) continue;
+            x += pull[f] * law.gx[c];
+            y += pull[f] * law.gy[c];
+            continue;
+        }
         x += pull[f] * m.tangent_x[f];
         y += pull[f] * m.tangent_y[f];
     }
@@ -673,7 +682,7 @@ private:
 #pragma omp parallel for num_threads(threads) if (parallel) schedule(static)
             for (std::int64_t f = 0; f < pass_faces; ++f) face_terms(f);
 #pragma omp parallel for num_threads(threads) if (parallel) schedule(static)
-            for (std::int64_t c = 0; c < pass_cells; ++c) pull_of(m, pull, c, pull_x, pull_y);
+            for (std::int64_t c = 0; c < pass_cells; ++c) pull_of(m, law, pull, c, pull_x, pull_y);
             if (parts && !in_batch) take_every_ghosts_pull(m, s);
 #pragma omp parallel for num_threads(threads) if (parallel) schedule(static)
             for (std::int64_t f = 0; f < pass_faces; ++f) high[f] = gradient_flow_flux(m, law, f, high[f], pull_x, pull_y);
@@ -793,7 +802,7 @@ private:
             });
             // Pulls: the owned cells of steep faces.
             owned_cells_of(m, s, steep_faces, s.pull_cells);
-            for_each_item(s.pull_cells, threads, [&](std::int64_t c) { pull_of(m, pull, c, pull_x, pull_y); });
+            for_each_item(s.pull_cells, threads, [&](std::int64_t c) { pull_of(m, law, pull, c, pull_x, pull_y); });
             if (exchanges) list_pulling_ghosts(s);
             // The gradient flow's flux: the steep faces and the faces of the pulling cells.
             const std::uint32_t carrying = next_stamp(s);
@@ -1065,7 +1074,7 @@ private:
                 }
             }
             for_each_item(firing, firing_n, threads, terms_of);
-            for_each_item(reading, reading_n, threads, [&](std::int64_t c) { pull_of(m, pull, c, pull_x, pull_y); });
+            for_each_item(reading, reading_n, threads, [&](std::int64_t c) { pull_of(m, law, pull, c, pull_x, pull_y); });
             if (parts) take_every_ghosts_pull(m, s);
             for_each_item(carrying, carrying_n, threads, flow);
             for_each_item(taking, taking_n, threads, limit);
@@ -1182,7 +1191,7 @@ private:
                 for (const std::int64_t f : s.steep_by_level[static_cast<std::size_t>(l)])
                     if (steep[f]) due.push_back(f);
             owned_cells_of(m, s, due, s.pull_cells);
-            for_each_item(s.pull_cells, threads, [&](std::int64_t c) { pull_of(m, pull, c, pull_x, pull_y); });
+            for_each_item(s.pull_cells, threads, [&](std::int64_t c) { pull_of(m, law, pull, c, pull_x, pull_y); });
             if (parts) list_pulling_ghosts(s);
             const std::uint32_t carrying = next_stamp(s);
             std::vector<std::int64_t> &faces = s.update_cells;  // scratch until the updates' list
