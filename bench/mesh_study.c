@@ -9,7 +9,9 @@
  * grid engine's error and rest time) and, at the two coarsest levels, on the
  * same mesh turned by 30 degrees (the deposits' difference, cell by cell,
  * against the error); and the cone (40 high, slope 1.5, 33 degrees) on
- * jittered triangles, its top against 22.89.
+ * jittered triangles, its top against 22.89. With `ridge` for the mesh: a
+ * ridge across a square walled all round, on every kind against the exact
+ * triangle and the grid's squares (rest times beside each other).
  *
  * mesh: a fully active jittered triangle mesh (steep plane, every face over
  * the threshold) against the plain face loop below (one pass over faces
@@ -135,21 +137,28 @@ static void collapse_on_mesh(const mesh_scene *s, int threads, double *h, mesh_r
     free(poured);
 }
 
+/* The 2D grid of n x n squares over [-half, half]^2, every side `side`
+ * (DPSM_OPEN or DPSM_WALL), at the column's angle, holding h. */
+static dpsm_grid *square_grid(int n, double half, int threads, int side, const double *h) {
+    const double d = 2.0 * half / n;
+    dpsm_grid *g = NULL;
+    CHECK(NULL, dpsm_create_2d(n, n, d, d, &g));
+    CHECK(g, dpsm_set_threads(g, threads));
+    CHECK(g, dpsm_set_repose_angle(g, kColumnTheta));
+    for (int which = DPSM_XMIN; which <= DPSM_YMAX; ++which) CHECK(g, dpsm_set_boundary(g, which, side));
+    CHECK(g, dpsm_set_heights(g, h));
+    return g;
+}
+
 /* The same column on the 2D grid of n x n squares over the same square,
  * every side open: the grid engine's L1 error and rest time. */
 static void collapse_on_grid(int n, int threads, mesh_result *r) {
     mesh_scene squares = scene_make(SCENE_QUADS, n, column_half(), 1u); /* the grid's cells, x fastest */
     double *h = poured_column(&squares);
-    const double d = 2.0 * column_half() / n;
-    dpsm_grid *g = NULL;
-    CHECK(NULL, dpsm_create_2d(n, n, d, d, &g));
-    CHECK(g, dpsm_set_threads(g, threads));
-    CHECK(g, dpsm_set_repose_angle(g, kColumnTheta));
-    for (int side = DPSM_XMIN; side <= DPSM_YMAX; ++side) CHECK(g, dpsm_set_boundary(g, side, DPSM_OPEN));
-    CHECK(g, dpsm_set_heights(g, h));
+    dpsm_grid *g = square_grid(n, column_half(), threads, DPSM_OPEN, h);
     mesh_result grid;
     memset(&grid, 0, sizeof grid);
-    grid.size = d;
+    grid.size = 2.0 * column_half() / n;
     step_to_rest(g, 0.1, 20.0, &grid);
     CHECK(g, dpsm_get_heights(g, h));
     score_column(&squares, h, &grid);
@@ -226,10 +235,107 @@ static mesh_result cone_on(scene_kind kind, int n, int threads) {
     return r;
 }
 
+/* The ridge between walls: a bank 2 high and 1.2 wide across the square
+ * (|x| < 0.6), walled all round, collapses to the exact triangle of slope
+ * tan 30 degrees that holds its volume over the same cells (about 1.18
+ * high, its toes near x = +-2.04); the same on the grid's squares of the mesh's mean size. The
+ * runout: the farthest cell with sand against the exact toe. Along the walls only
+ * a construction that drops the walls' part of the faces' energy would make
+ * the cells beside them lag and rest last. */
+static const double kRidgeHalf = 2.5;
+static double ridge_height(double x) { return fabs(x) < 0.6 ? 2.0 : 0.0; }
+static void score_ridge(const double *cx, const double *area, int64_t cells, const double *h, mesh_result *r) {
+    /* The exact triangle holds the sand the cells were given (the bank's
+     * edges fall inside cells): its height from that volume. */
+    double volume = 0.0, reach = 0.0;
+    for (int64_t c = 0; c < cells; ++c) {
+        volume += ridge_height(cx[c]) * area[c];
+        if (h[c] > 1e-6) reach = fmax(reach, fabs(cx[c]));
+    }
+    /* Its height: the triangle over these cells that holds that volume (by
+     * bisection; the edges of a mesh need not be straight). */
+    const double alpha = tan(kColumnTheta);
+    double low = 0.0, high = 4.0;
+    for (int k = 0; k < 100; ++k) {
+        const double top = 0.5 * (low + high);
+        double held = 0.0;
+        for (int64_t c = 0; c < cells; ++c) held += fmax(0.0, top - alpha * fabs(cx[c])) * area[c];
+        if (held < volume)
+            low = top;
+        else
+            high = top;
+    }
+    const double top = 0.5 * (low + high), toe = top / alpha;
+    double err = 0.0;
+    for (int64_t c = 0; c < cells; ++c) err += fabs(h[c] - fmax(0.0, top - alpha * fabs(cx[c]))) * area[c];
+    r->l1 = err / volume;
+    r->runout_error = fabs(reach - toe);
+}
+
+static mesh_result ridge_on(scene_kind kind, int n, int threads) {
+    mesh_scene s = scene_make(kind, n, kRidgeHalf, 12345u);
+    mesh_result r;
+    memset(&r, 0, sizeof r);
+    r.rotated = NAN;
+    if (s.cells == 0) return r;
+    r.cells = s.cells;
+    r.size = scene_mean_size(&s);
+    double *h = xcalloc((size_t)s.cells, sizeof(double));
+    for (int64_t c = 0; c < s.cells; ++c) h[c] = ridge_height(s.cx[c]);
+    const double t0 = now_seconds();
+    dpsm_grid *g = open_mesh(&s, kColumnTheta, threads, h);
+    CHECK(g, dpsm_set_boundary(g, DPSM_MESH_EDGE, DPSM_WALL));
+    step_to_rest(g, 0.1, 40.0, &r);
+    CHECK(g, dpsm_get_heights(g, h));
+    r.seconds = now_seconds() - t0;
+    score_ridge(s.cx, s.area, s.cells, h, &r);
+    dpsm_destroy(g);
+    free(h);
+    /* The grid of squares of the same mean size. */
+    const int m = (int)lround(2.0 * kRidgeHalf / r.size);
+    mesh_scene squares = scene_make(SCENE_QUADS, m, kRidgeHalf, 1u); /* the grid's cells, x fastest */
+    h = xcalloc((size_t)squares.cells, sizeof(double));
+    for (int64_t c = 0; c < squares.cells; ++c) h[c] = ridge_height(squares.cx[c]);
+    g = square_grid(m, kRidgeHalf, threads, DPSM_WALL, h);
+    mesh_result grid;
+    memset(&grid, 0, sizeof grid);
+    step_to_rest(g, 0.1, 40.0, &grid);
+    CHECK(g, dpsm_get_heights(g, h));
+    score_ridge(squares.cx, squares.area, squares.cells, h, &grid);
+    r.grid_cells = squares.cells;
+    r.grid_l1 = grid.l1;
+    r.grid_rest_time = grid.rest_time;
+    dpsm_destroy(g);
+    free(h);
+    scene_free(&squares);
+    scene_free(&s);
+    return r;
+}
+
+/* The ridge on every kind but the gmsh disk (whose edge is a circle, not
+ * walls a straight ridge can cross), `levels` refinements from 64 cells a side. */
+static void ridge_rows(int threads, int levels) {
+    static const scene_kind kinds[] = {SCENE_QUADS, SCENE_TRIANGLES, SCENE_HEXAGONS, SCENE_DUAL};
+    for (size_t k = 0; k < sizeof kinds / sizeof *kinds; ++k) {
+        double previous = 0.0;
+        for (int level = 0; level < levels; ++level) {
+            const mesh_result r = ridge_on(kinds[k], 64 << level, threads);
+            const double order = level > 0 ? log2(previous / r.l1) : NAN;
+            printf("ridge_between_walls,%s,%lld,%.5f,%.4e,%.2f,%.2f,%d,%.3f,%.4g,%.3f,%lld,%.4e,%.3f,%.3f,\n",
+                   scene_name(kinds[k]), (long long)r.cells, r.size, r.l1, order, r.runout_error / r.size, r.at_rest,
+                   r.rest_time, r.cell_updates, r.seconds, (long long)r.grid_cells, r.grid_l1, r.grid_rest_time,
+                   r.rest_time / r.grid_rest_time);
+            fflush(stdout);
+            previous = r.l1;
+        }
+    }
+}
+
 int cmd_mesh_accuracy(int argc, char **argv) {
     const int threads = argc > 0 ? atoi(argv[0]) : 0;
     const int levels = argc > 1 ? atoi(argv[1]) : 4;
-    /* one mesh kind (its name) or "columns", without the cone; "cone": the cone alone */
+    /* one mesh kind (its name) or "columns", without the cone; "cone": the cone alone; "ridge": the ridge
+     * between walls alone (not run otherwise) */
     const char *only = argc > 2 ? argv[2] : NULL;
     /* about 4,000, 16,000, 65,000 and 262,000 cells on each kind */
     static const struct {
@@ -241,6 +347,10 @@ int cmd_mesh_accuracy(int argc, char **argv) {
     printf("scene,mesh,cells,mean_size,l1_error,order,runout_error_cells,at_rest,rest_time,cell_updates,seconds,"
            "grid_cells,grid_l1_error,grid_rest_time,rest_time_ratio,turned_difference\n");
     fflush(stdout);
+    if (only && strcmp(only, "ridge") == 0) {
+        ridge_rows(threads, levels);
+        return 0;
+    }
     for (size_t k = 0; k < sizeof kinds / sizeof *kinds; ++k) {
         if (only && strcmp(only, "columns") != 0 && strcmp(only, scene_name(kinds[k].kind)) != 0) continue;
         double previous = 0.0;
