@@ -73,8 +73,8 @@ constexpr double kRoundOff = 64.0 * std::numeric_limits<double>::epsilon();
 
 // What a face does in a sub-step (carrying_faces): carries sand between its
 // cells or over an open edge, lies between a sand cell and a wall (it
-// carries none, but the slope along it counts in the faces' energy), or
-// nothing (no sand on it).
+// carries none, but the surface on the sand's side of it counts in the
+// faces' energy), or nothing (no sand on it).
 enum FaceRole : std::uint8_t { kCarriesNothing = 0, kCarries = 1, kAlongWall = 2 };
 
 // The heights a sub-step reads. With lazy sources a sand cell's stored
@@ -292,14 +292,15 @@ inline double beyond_round_off(double sum, double scale) {
 }
 
 // Cell c's pull: M_c^-1 P_c, with P_c the sum of its faces' pulls along
-// their tangents, in the cell's face order (0 without a stencil).
+// their tangents (a face along a wall: along c's gradient), in the cell's
+// face order (0 without a stencil).
 inline void pull_of(const Mesh &m, const FaceLaw &law, const double *pull, std::int64_t c, double *pull_x,
                     double *pull_y) {
     double x = 0.0, y = 0.0;
     for (std::int64_t k = m.cell_face_start[c]; k < m.cell_face_start[c + 1]; ++k) {
         const std::int64_t f = m.cell_faces[k];
         if (law.along_wall(f)) {
-            // The wall's side has no gradient the face reads.
+            // A wall cell has no gradient the face reads.
             if (pull[f] == 0.0 || law.kind[c] != kSand) continue;
             x += pull[f] * law.gx[c];
             y += pull[f] * law.gy[c];
