@@ -107,6 +107,7 @@ struct FaceLaw {
     const std::uint8_t *kind;
     const double *gx, *gy;
     const std::uint8_t *carrying;   // per face: a FaceRole (carrying_faces)
+    const std::uint8_t *beside_wall;  // per cell: whether a face of it lies along a wall; null: none does
     const double *edge_level;       // per face; null: 0
     const double *tan_field;        // null: uniform
     const std::uint8_t *moving;     // hysteresis: null when off
@@ -116,6 +117,11 @@ struct FaceLaw {
 
     bool carries(std::int64_t f) const { return carrying[f] == kCarries; }
     bool along_wall(std::int64_t f) const { return carrying[f] == kAlongWall; }
+    // The sand cell of a face along a wall.
+    std::int64_t sand_side(std::int64_t f) const {
+        const std::int64_t b = m.face_b[f];
+        return b >= 0 && kind[b] == kSand ? b : m.face_a[f];
+    }
 
     // Face f's slope and what it gives the sub-step's fluxes.
     //
@@ -134,7 +140,6 @@ struct FaceLaw {
     };
     Slope slope(std::int64_t f) const {
         const std::int64_t a = m.face_a[f], b = m.face_b[f];
-        if (along_wall(f)) return slope_along_wall(f, b >= 0 && kind[b] == kSand ? b : a);
         const std::uint8_t ka = kind[a];
         Slope out;
         out.ha = h[a];
@@ -181,16 +186,18 @@ struct FaceLaw {
     // gradients could decide it: its slope within a band of rounding below
     // its threshold counts.
     bool may_be_steep(std::int64_t f) const {
-        if (!carries(f) && !along_wall(f)) return false;
-        const Slope sl = slope(f);
+        const std::uint8_t role = carrying[f];
+        if (role == kCarriesNothing) return false;
+        const Slope sl = role == kAlongWall ? slope_along_wall(f, sand_side(f)) : slope(f);
         const double band = 1e-9 * sl.threshold + kRoundOff * (std::fabs(sl.ha) + std::fabs(sl.hb)) / m.distance[f];
         return sl.s > sl.threshold - band;
     }
 
     FaceTerms terms(std::int64_t f) const {
         FaceTerms out;
-        if (along_wall(f)) return terms_along_wall(f);
-        if (!carries(f)) return out;
+        const std::uint8_t role = carrying[f];
+        if (role == kAlongWall) return terms_along_wall(f);
+        if (role != kCarries) return out;
         const std::int64_t a = m.face_a[f], b = m.face_b[f];
         const Slope sl = slope(f);
         const double distance = m.distance[f], normal = sl.normal, tangential = sl.tangential, s = sl.s,
@@ -227,8 +234,7 @@ struct FaceLaw {
     // applies it so), which the cell's stencil carries.
     FaceTerms terms_along_wall(std::int64_t f) const {
         FaceTerms out;
-        const std::int64_t a = m.face_a[f], b = m.face_b[f];
-        const std::int64_t c = b >= 0 && kind[b] == kSand ? b : a;
+        const std::int64_t c = sand_side(f);
         const Slope sl = slope_along_wall(f, c);
         if (!(sl.s > sl.threshold)) return out;
         out.steep = true;
@@ -297,9 +303,11 @@ inline double beyond_round_off(double sum, double scale) {
 inline void pull_of(const Mesh &m, const FaceLaw &law, const double *pull, std::int64_t c, double *pull_x,
                     double *pull_y) {
     double x = 0.0, y = 0.0;
+    // Most cells have no face along a wall: they skip the faces' roles.
+    const bool walls = law.beside_wall && law.beside_wall[c];
     for (std::int64_t k = m.cell_face_start[c]; k < m.cell_face_start[c + 1]; ++k) {
         const std::int64_t f = m.cell_faces[k];
-        if (law.along_wall(f)) {
+        if (walls && law.along_wall(f)) {
             // A wall cell has no gradient the face reads.
             if (pull[f] == 0.0 || law.kind[c] != kSand) continue;
             x += pull[f] * law.gx[c];
@@ -421,7 +429,7 @@ public:
         if (!grid.bed().empty()) s.available.resize(n, 0.0);
         if (s.lists_current) return;
         s.lists_current = true;
-        carrying_faces(grid, m, s.carrying);
+        carrying_faces(grid, m, s.carrying, s.beside_wall);
         // Faces onto a sink: the outflow is summed over them alone, in one
         // order. On a distributed mesh the rank that owns the cell the sand
         // leaves books it.
@@ -443,13 +451,18 @@ public:
 
     // Per face, its FaceRole: it carries sand where no wall is on it and a
     // sand cell is (on the domain edge, an open edge); between a sand cell
-    // and a wall cell or a closed edge it lies along a wall. It follows the
-    // kinds and the edges, so it is found with the lists that follow them.
-    static void carrying_faces(const Grid &grid, const Mesh &m, std::vector<std::uint8_t> &carrying) {
+    // and a wall cell or a closed edge it lies along a wall. Per cell,
+    // whether a face of it lies along a wall (empty when none does). They
+    // follow the kinds and the edges, so they are found with the lists that
+    // follow them.
+    static void carrying_faces(const Grid &grid, const Mesh &m, std::vector<std::uint8_t> &carrying,
+                               std::vector<std::uint8_t> &beside_wall) {
         const std::uint8_t *kind = grid.kinds().data();
         const std::uint8_t *edge_open = grid.edge_open_flags().empty() ? nullptr : grid.edge_open_flags().data();
         const bool open_edges = grid.side_open(0);
         carrying.resize(static_cast<std::size_t>(m.faces));
+        beside_wall.assign(static_cast<std::size_t>(m.cells), 0);
+        bool any = false;
         for (std::int64_t f = 0; f < m.faces; ++f) {
             const std::int64_t a = m.face_a[f], b = m.face_b[f];
             const std::uint8_t ka = kind[a];
@@ -463,7 +476,12 @@ public:
                 else
                     carrying[f] = ka == kSand || kb == kSand ? kAlongWall : kCarriesNothing;
             }
+            if (carrying[f] != kAlongWall) continue;
+            any = true;
+            beside_wall[a] = 1;
+            if (b >= 0) beside_wall[b] = 1;
         }
+        if (!any) beside_wall.clear();
     }
 
     // Not with a bed (erosion stops at it, so a source's part depends on the
@@ -1599,6 +1617,7 @@ private:
                        gx,
                        gy,
                        mesh_state(grid).carrying.data(),
+                       mesh_state(grid).beside_wall.empty() ? nullptr : mesh_state(grid).beside_wall.data(),
                        grid.side_levels(0).empty() ? nullptr : grid.side_levels(0).data(),
                        grid.tan_field().empty() ? nullptr : grid.tan_field().data(),
                        grid.hysteresis() ? grid.moving().data() : nullptr,

@@ -131,6 +131,7 @@ struct MeshState final : EngineState {
     std::vector<std::int64_t> ghost_source_cells;  // a part's ghosts with a source, stepped where they are in reach
     std::vector<std::int64_t> sink_faces;          // faces onto open edges or open cells
     std::vector<std::uint8_t> carrying;            // per face: what it does (FaceRole in mesh_engine.cpp)
+    std::vector<std::uint8_t> beside_wall;         // per cell: a face of it lies along a wall; empty: none does
     bool lists_current = false;
 
     // Local time steps (DPSM_RELAX_LOCAL_STEPS, mesh/step_classes.hpp): the
