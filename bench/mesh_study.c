@@ -11,7 +11,9 @@
  * against the error); and the cone (40 high, slope 1.5, 33 degrees) on
  * jittered triangles, its top against 22.89. With `ridge` for the mesh: a
  * ridge across a square walled all round, on every kind against the exact
- * triangle and the grid's squares (rest times beside each other).
+ * triangle and the grid's squares (rest times beside each other); with
+ * `slope`, the same walls holding a triangle 1 % steeper than the angle of
+ * repose: the rest tail alone.
  *
  * mesh: a fully active jittered triangle mesh (steep plane, every face over
  * the threshold) against the plain face loop below (one pass over faces
@@ -244,14 +246,17 @@ static mesh_result cone_on(scene_kind kind, int n, int threads) {
  * the cells beside them lag and rest last. */
 static const double kRidgeHalf = 2.5;
 static double ridge_height(double x) { return fabs(x) < 0.6 ? 2.0 : 0.0; }
-static void score_ridge(const double *cx, const double *area, int64_t cells, const double *h, mesh_result *r) {
-    /* The exact triangle holds the sand the cells were given (the bank's
-     * edges fall inside cells): its height from that volume. */
-    double volume = 0.0, reach = 0.0;
-    for (int64_t c = 0; c < cells; ++c) {
-        volume += ridge_height(cx[c]) * area[c];
+/* The slope: the same walls, but the sand starts as a triangle 1 % steeper
+ * than the angle of repose (toes at x = +-1.5), so the flow is the tail
+ * alone: no front sweeps over the cells, and every face starts at the same
+ * small excess. */
+static double steep_slope_height(double x) { return fmax(0.0, tan(kColumnTheta) * 1.01 * (1.5 - fabs(x))); }
+/* `volume`: the sand the cells were given (the bank's edges fall inside cells). */
+static void score_ridge(const double *cx, const double *area, int64_t cells, const double *h, double volume,
+                        mesh_result *r) {
+    double reach = 0.0;
+    for (int64_t c = 0; c < cells; ++c)
         if (h[c] > 1e-6) reach = fmax(reach, fabs(cx[c]));
-    }
     /* Its height: the triangle over these cells that holds that volume (by
      * bisection; the edges of a mesh need not be straight). */
     const double alpha = tan(kColumnTheta);
@@ -272,7 +277,17 @@ static void score_ridge(const double *cx, const double *area, int64_t cells, con
     r->runout_error = fabs(reach - toe);
 }
 
-static mesh_result ridge_on(scene_kind kind, int n, int threads) {
+/* The sand of `height` on cells cx with areas `area`, into h; its volume. */
+static double poured_ridge(double (*height)(double), const double *cx, const double *area, int64_t cells, double *h) {
+    double volume = 0.0;
+    for (int64_t c = 0; c < cells; ++c) {
+        h[c] = height(cx[c]);
+        volume += h[c] * area[c];
+    }
+    return volume;
+}
+
+static mesh_result ridge_on(scene_kind kind, int n, int threads, double (*height)(double)) {
     mesh_scene s = scene_make(kind, n, kRidgeHalf, 12345u);
     mesh_result r;
     memset(&r, 0, sizeof r);
@@ -281,27 +296,27 @@ static mesh_result ridge_on(scene_kind kind, int n, int threads) {
     r.cells = s.cells;
     r.size = scene_mean_size(&s);
     double *h = xcalloc((size_t)s.cells, sizeof(double));
-    for (int64_t c = 0; c < s.cells; ++c) h[c] = ridge_height(s.cx[c]);
+    double volume = poured_ridge(height, s.cx, s.area, s.cells, h);
     const double t0 = now_seconds();
     dpsm_grid *g = open_mesh(&s, kColumnTheta, threads, h);
     CHECK(g, dpsm_set_boundary(g, DPSM_MESH_EDGE, DPSM_WALL));
     step_to_rest(g, 0.1, 40.0, &r);
     CHECK(g, dpsm_get_heights(g, h));
     r.seconds = now_seconds() - t0;
-    score_ridge(s.cx, s.area, s.cells, h, &r);
+    score_ridge(s.cx, s.area, s.cells, h, volume, &r);
     dpsm_destroy(g);
     free(h);
     /* The grid of squares of the same mean size. */
     const int m = (int)lround(2.0 * kRidgeHalf / r.size);
     mesh_scene squares = scene_make(SCENE_QUADS, m, kRidgeHalf, 1u); /* the grid's cells, x fastest */
     h = xcalloc((size_t)squares.cells, sizeof(double));
-    for (int64_t c = 0; c < squares.cells; ++c) h[c] = ridge_height(squares.cx[c]);
+    volume = poured_ridge(height, squares.cx, squares.area, squares.cells, h);
     g = square_grid(m, kRidgeHalf, threads, DPSM_WALL, h);
     mesh_result grid;
     memset(&grid, 0, sizeof grid);
     step_to_rest(g, 0.1, 40.0, &grid);
     CHECK(g, dpsm_get_heights(g, h));
-    score_ridge(squares.cx, squares.area, squares.cells, h, &grid);
+    score_ridge(squares.cx, squares.area, squares.cells, h, volume, &grid);
     r.grid_cells = squares.cells;
     r.grid_l1 = grid.l1;
     r.grid_rest_time = grid.rest_time;
@@ -312,16 +327,17 @@ static mesh_result ridge_on(scene_kind kind, int n, int threads) {
     return r;
 }
 
-/* The ridge on every kind but the gmsh disk (whose edge is a circle, not
- * walls a straight ridge can cross), `levels` refinements from 64 cells a side. */
-static void ridge_rows(int threads, int levels) {
+/* The ridge (or the slope) on every kind but the gmsh disk (whose edge is a
+ * circle, not walls a straight ridge can cross), `levels` refinements from
+ * 64 cells a side. */
+static void ridge_rows(int threads, int levels, const char *scene, double (*height)(double)) {
     static const scene_kind kinds[] = {SCENE_QUADS, SCENE_TRIANGLES, SCENE_HEXAGONS, SCENE_DUAL};
     for (size_t k = 0; k < sizeof kinds / sizeof *kinds; ++k) {
         double previous = 0.0;
         for (int level = 0; level < levels; ++level) {
-            const mesh_result r = ridge_on(kinds[k], 64 << level, threads);
+            const mesh_result r = ridge_on(kinds[k], 64 << level, threads, height);
             const double order = level > 0 ? log2(previous / r.l1) : NAN;
-            printf("ridge_between_walls,%s,%lld,%.5f,%.4e,%.2f,%.2f,%d,%.3f,%.4g,%.3f,%lld,%.4e,%.3f,%.3f,\n",
+            printf("%s,%s,%lld,%.5f,%.4e,%.2f,%.2f,%d,%.3f,%.4g,%.3f,%lld,%.4e,%.3f,%.3f,\n", scene,
                    scene_name(kinds[k]), (long long)r.cells, r.size, r.l1, order, r.runout_error / r.size, r.at_rest,
                    r.rest_time, r.cell_updates, r.seconds, (long long)r.grid_cells, r.grid_l1, r.grid_rest_time,
                    r.rest_time / r.grid_rest_time);
@@ -335,7 +351,7 @@ int cmd_mesh_accuracy(int argc, char **argv) {
     const int threads = argc > 0 ? atoi(argv[0]) : 0;
     const int levels = argc > 1 ? atoi(argv[1]) : 4;
     /* one mesh kind (its name) or "columns", without the cone; "cone": the cone alone; "ridge": the ridge
-     * between walls alone (not run otherwise) */
+     * between walls alone, "slope": the slope 1 % steeper than repose between them (neither run otherwise) */
     const char *only = argc > 2 ? argv[2] : NULL;
     /* about 4,000, 16,000, 65,000 and 262,000 cells on each kind */
     static const struct {
@@ -348,7 +364,11 @@ int cmd_mesh_accuracy(int argc, char **argv) {
            "grid_cells,grid_l1_error,grid_rest_time,rest_time_ratio,turned_difference\n");
     fflush(stdout);
     if (only && strcmp(only, "ridge") == 0) {
-        ridge_rows(threads, levels);
+        ridge_rows(threads, levels, "ridge_between_walls", ridge_height);
+        return 0;
+    }
+    if (only && strcmp(only, "slope") == 0) {
+        ridge_rows(threads, levels, "slope_between_walls", steep_slope_height);
         return 0;
     }
     for (size_t k = 0; k < sizeof kinds / sizeof *kinds; ++k) {
