@@ -1092,6 +1092,117 @@ static void test_active_set_same_bits(void **state) {
     run_with_and_without("DPSM_VISIT_ALL_CELLS", 60, 5u, "every cell visited", same_bits_and_ledger);
 }
 
+/* The dense sub-step's face passes in vector lanes (mesh/face_lanes.hpp)
+ * against the scalar functions alone (DPSM_SCALAR_MESH=1): the same heights,
+ * face fluxes and ledger bit for bit, on every mesh kind, in every scene the
+ * lanes take (open edge faces held at levels, closed ones, wall and open
+ * cells, flux exponent 2) and in those they leave in part to scalar code (an
+ * angle field, a bed), on one thread and, on a mesh large enough for them,
+ * on two. A steep plane keeps every cell moving, so every sub-step is dense. */
+typedef struct {
+    int edge;      /* DPSM_OPEN: levels beyond the edge; DPSM_WALL: closed */
+    int cells;     /* wall and open cells in the plane */
+    double power;  /* flux exponent */
+    int field;     /* an angle field */
+    int bed;       /* a bed under the plane */
+    int threads;
+} lanes_scene;
+
+static void plane_in_lanes(const mesh_scene *s, const lanes_scene *scene, int scalar, double *h_out,
+                           double *fluxes_out, double *ledger_out) {
+    if (scalar) setenv("DPSM_SCALAR_MESH", "1", 1);
+    dpsm_grid *g = NULL;
+    CHECK_OK(NULL, scene_create(s, &g));
+    CHECK_OK(g, dpsm_set_repose_angle(g, 30.0 * kDeg));
+    CHECK_OK(g, dpsm_set_threads(g, scene->threads));
+    CHECK_OK(g, dpsm_set_flux_exponent(g, scene->power));
+    CHECK_OK(g, dpsm_set_face_flux_recording(g, 1));
+    int64_t nfaces = 0;
+    CHECK_OK(g, dpsm_get_face_count(g, &nfaces));
+    double *levels = calloc((size_t)nfaces, sizeof(double));
+    for (int64_t f = 0; f < nfaces; ++f) levels[f] = 0.25 * (double)(f % 5);
+    CHECK_OK(g, dpsm_set_side_levels(g, DPSM_MESH_EDGE, levels));
+    CHECK_OK(g, dpsm_set_boundary(g, DPSM_MESH_EDGE, scene->edge));
+    double *h = calloc((size_t)s->cells, sizeof(double)), *angle = calloc((size_t)s->cells, sizeof(double));
+    uint8_t *kinds = calloc((size_t)s->cells, 1);
+    for (int64_t c = 0; c < s->cells; ++c) {
+        h[c] = 3.0 + 1.5 * s->cx[c] + 0.8 * s->cy[c] + 0.3 * sin(7.0 * s->cx[c] * s->cy[c]);
+        angle[c] = (28.0 + 4.0 * (double)(c % 3)) * kDeg;
+        if (scene->cells && hypot(s->cx[c] - 0.3, s->cy[c] + 0.2) < 0.25) kinds[c] = DPSM_CELL_WALL;
+        if (scene->cells && hypot(s->cx[c] + 0.6, s->cy[c] - 0.5) < 0.15) kinds[c] = DPSM_CELL_OPEN;
+    }
+    CHECK_OK(g, dpsm_set_cell_kinds(g, kinds));
+    if (scene->field) CHECK_OK(g, dpsm_set_repose_angle_field(g, angle));
+    CHECK_OK(g, dpsm_set_heights(g, h));
+    if (scene->bed) {
+        double *bed = calloc((size_t)s->cells, sizeof(double));
+        for (int64_t c = 0; c < s->cells; ++c) bed[c] = h[c] - (s->cx[c] > 0.2 ? 0.02 : 0.5);
+        CHECK_OK(g, dpsm_set_bedrock(g, bed));
+        free(bed);
+    }
+    double dt = 0.0;
+    CHECK_OK(g, dpsm_stable_dt(g, &dt));
+    for (int call = 0; call < 3; ++call) CHECK_OK(g, dpsm_step(g, 4.0 * dt));
+    CHECK_OK(g, dpsm_get_heights(g, h_out));
+    CHECK_OK(g, dpsm_get_face_fluxes(g, fluxes_out, NULL));
+    ledger_out[0] = mass_of(g, DPSM_MASS_TOTAL);
+    ledger_out[1] = mass_of(g, DPSM_MASS_OUTFLOW);
+    free(h), free(angle), free(kinds), free(levels);
+    dpsm_destroy(g);
+    unsetenv("DPSM_SCALAR_MESH");
+}
+
+static void test_face_pass_in_lanes_same_bits(void **state) {
+    (void)state;
+    const scene_kind kinds[4] = {SCENE_QUADS, SCENE_TRIANGLES, SCENE_HEXAGONS, SCENE_DUAL};
+    const lanes_scene scenes[6] = {{DPSM_OPEN, 0, 1.0, 0, 0, 1}, {DPSM_WALL, 1, 1.0, 0, 0, 1},
+                                   {DPSM_OPEN, 1, 2.0, 0, 0, 1}, {DPSM_OPEN, 1, 1.0, 1, 0, 1},
+                                   {DPSM_OPEN, 1, 1.0, 0, 1, 1}, {DPSM_OPEN, 1, 1.0, 0, 0, 2}};
+    const char *names[6] = {"open edge at levels",
+                            "closed edge, wall and open cells",
+                            "flux exponent 2",
+                            "angle field (faces in scalar code)",
+                            "bed (faces and limited fluxes in scalar code)",
+                            "two threads"};
+    for (int k = 0; k < 4; ++k)
+        for (int n = 0; n < 6; ++n) {
+            /* Two threads share a pass from 32,768 cells (kCellsForThreads): one mesh that large. */
+            if (scenes[n].threads > 1 && kinds[k] != SCENE_TRIANGLES) continue;
+            mesh_scene s = scene_make(kinds[k], scenes[n].threads > 1 ? 130 : 20, 1.0, 9u);
+            int64_t nfaces = 0;
+            {
+                dpsm_grid *g = NULL;
+                CHECK_OK(NULL, scene_create(&s, &g));
+                CHECK_OK(g, dpsm_get_face_count(g, &nfaces));
+                dpsm_destroy(g);
+            }
+            double *h[2], *flux[2], ledger[2][2];
+            for (int scalar = 0; scalar < 2; ++scalar) {
+                h[scalar] = calloc((size_t)s.cells, sizeof(double));
+                flux[scalar] = calloc((size_t)nfaces, sizeof(double));
+                plane_in_lanes(&s, &scenes[n], scalar, h[scalar], flux[scalar], ledger[scalar]);
+            }
+            const char *kind = scene_name(kinds[k]);
+            for (int64_t c = 0; c < s.cells; ++c)
+                REQUIRE(memcmp(&h[0][c], &h[1][c], sizeof(double)) == 0,
+                        "%s, %s: cell %lld: %.17g in lanes, %.17g in scalar code", kind, names[n], (long long)c,
+                        h[0][c], h[1][c]);
+            for (int64_t f = 0; f < nfaces; ++f)
+                REQUIRE(memcmp(&flux[0][f], &flux[1][f], sizeof(double)) == 0,
+                        "%s, %s: face %lld carried %.17g in lanes, %.17g in scalar code", kind, names[n],
+                        (long long)f, flux[0][f], flux[1][f]);
+            REQUIRE(memcmp(ledger[0], ledger[1], sizeof ledger[0]) == 0, "%s, %s: the ledger differs", kind,
+                    names[n]);
+            /* The scene moved sand everywhere: a comparison of planes at rest would prove nothing. */
+            double moved = 0.0;
+            for (int64_t f = 0; f < nfaces; ++f) moved += flux[0][f] != 0.0;
+            REQUIRE(moved > 0.5 * (double)nfaces, "%s, %s: %.0f of %lld faces carried sand", kind, names[n], moved,
+                    (long long)nfaces);
+            for (int scalar = 0; scalar < 2; ++scalar) free(h[scalar]), free(flux[scalar]);
+            scene_free(&s);
+        }
+}
+
 /* The sparse step's passes over its lists run on the threads where the
  * lists are long (mesh/mesh_engine.cpp, for_each_item). Ridges on a mesh of
  * about 80,000 cells collapse in sub-steps that each change a few thousand
@@ -1361,6 +1472,7 @@ int main(void) {
         cmocka_unit_test(test_host_order),
         cmocka_unit_test(test_graph_steps_as_polygons),
         cmocka_unit_test(test_active_set_same_bits),
+        cmocka_unit_test(test_face_pass_in_lanes_same_bits),
         cmocka_unit_test(test_sparse_step_on_threads),
         cmocka_unit_test(test_sums_ordered_by_host_numbers),
         cmocka_unit_test(test_fluxes_match_height_changes),

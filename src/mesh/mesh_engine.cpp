@@ -5,6 +5,7 @@
 #include <limits>
 #include <vector>
 
+#include "mesh/face_lanes.hpp"
 #include "mesh/ghost_exchange.hpp"
 #include "mesh/mesh_parts.hpp"
 #include "mesh/mesh_state.hpp"
@@ -68,14 +69,6 @@ constexpr double kLimiterRoom = 1.0 - 1e-9;
 // MeshState::source_reach and MeshState::watch (lazy sources).
 constexpr std::uint8_t kSourceReach = 1, kSourceNear = 2;
 constexpr std::uint8_t kWatched = 1, kNearMoves = 2;
-// What counts as the round-off of a sum, relative to its terms' magnitudes.
-constexpr double kRoundOff = 64.0 * std::numeric_limits<double>::epsilon();
-
-// What a face does in a sub-step (carrying_faces): carries sand between its
-// cells or over an open edge, lies between a sand cell and a wall (it
-// carries none, but the surface on the sand's side of it counts in the
-// faces' energy), or nothing (no sand on it).
-enum FaceRole : std::uint8_t { kCarriesNothing = 0, kCarries = 1, kAlongWall = 2 };
 
 // The heights a sub-step reads. With lazy sources a sand cell's stored
 // height is current after sub-step since[c] of the step, and what its source
@@ -430,6 +423,9 @@ public:
         if (s.lists_current) return;
         s.lists_current = true;
         carrying_faces(grid, m, s.carrying, s.beside_wall);
+        s.faces_off_lanes.clear();
+        for (std::int64_t f = 0; f < m.faces; ++f)
+            if (s.carrying[f] != kCarries || m.face_b[f] < 0) s.faces_off_lanes.push_back(f);
         // Faces onto a sink: the outflow is summed over them alone, in one
         // order. On a distributed mesh the rank that owns the cell the sand
         // leaves books it.
@@ -688,6 +684,10 @@ private:
             const std::int64_t n = m.owned;
             const std::int64_t pass_cells = in_batch ? m.cells : n, pass_faces = in_batch ? m.faces : m.live_faces;
             const bool parallel = threads_in_use(threads, n) > 1;
+            const int ranges = parallel ? threads : 1;  // the face passes in lanes: a range of faces a thread
+            const auto range_of = [&](int r) {
+                return std::make_pair(pass_faces * r / ranges, pass_faces * (r + 1) / ranges);
+            };
             const std::int64_t *extra_cells = reach.ghosts();
             const std::int64_t extra_count = reach.ghost_count();
             if (law.isotropic) {
@@ -698,23 +698,61 @@ private:
                     watch_near_moves(m, s, changed_ghosts);
                 }
             }
+            if (in_lanes(law, s)) {
+                const FaceLanes lanes{m.face_a.data(),     m.face_b.data(),      m.tangent_x.data(),
+                                      m.tangent_y.data(),  m.distance.data(),    m.orthogonal.data(),
+                                      m.skew.data(),       m.conductance.data(), law.h.h,
+                                      law.gx,              law.gy,               law.nu,
+                                      law.tan_theta,       law.tolerance,        law.p == 2.0,
+                                      low,                 high,                 pull,
+                                      excess,              steep};
+                const std::vector<std::int64_t> &off = s.faces_off_lanes;
 #pragma omp parallel for num_threads(threads) if (parallel) schedule(static)
-            for (std::int64_t f = 0; f < pass_faces; ++f) face_terms(f);
+                for (int r = 0; r < ranges; ++r) {
+                    const auto [begin, end] = range_of(r);
+                    face_terms_in_lanes(lanes, begin, end);
+                    for (auto k = std::lower_bound(off.begin(), off.end(), begin); k != off.end() && *k < end; ++k)
+                        face_terms(*k);
+                }
+            } else {
+#pragma omp parallel for num_threads(threads) if (parallel) schedule(static)
+                for (std::int64_t f = 0; f < pass_faces; ++f) face_terms(f);
+            }
 #pragma omp parallel for num_threads(threads) if (parallel) schedule(static)
             for (std::int64_t c = 0; c < pass_cells; ++c) pull_of(m, law, pull, c, pull_x, pull_y);
             if (parts && !in_batch) take_every_ghosts_pull(m, s);
+            if (!s.switches.scalar_mesh) {
+                const FlowLanes lanes{m.face_a.data(),  m.face_b.data(),  law.carrying, m.pair_ax.data(),
+                                      m.pair_ay.data(), m.pair_bx.data(), m.pair_by.data(), pull_x,
+                                      pull_y,           high};
 #pragma omp parallel for num_threads(threads) if (parallel) schedule(static)
-            for (std::int64_t f = 0; f < pass_faces; ++f) high[f] = gradient_flow_flux(m, law, f, high[f], pull_x, pull_y);
+                for (int r = 0; r < ranges; ++r) flow_fluxes_in_lanes(lanes, range_of(r).first, range_of(r).second);
+            } else {
+#pragma omp parallel for num_threads(threads) if (parallel) schedule(static)
+                for (std::int64_t f = 0; f < pass_faces; ++f)
+                    high[f] = gradient_flow_flux(m, law, f, high[f], pull_x, pull_y);
+            }
 #pragma omp parallel for num_threads(threads) if (parallel) schedule(static)
             for (std::int64_t c = 0; c < pass_cells; ++c) limits_of(m, law, low, high, bed, c, limit_in, limit_out);
             if (parts && !in_batch) exchange_ghost_limits(s);
+            if (!s.switches.scalar_mesh && !law.available) {
+                const LimitLanes lanes{m.face_a.data(), m.face_b.data(), low, high, excess, limit_in, limit_out, flux};
+                double largest = -1.0;
+#pragma omp parallel for num_threads(threads) if (parallel) schedule(static) reduction(max : largest)
+                for (int r = 0; r < ranges; ++r)
+                    largest = std::max(largest,
+                                       limited_fluxes_in_lanes(lanes, range_of(r).first, range_of(r).second, m.live_faces));
+                moved = largest >= 0.0;
+                max_excess = std::max(max_excess, largest);
+            } else {
 #pragma omp parallel for num_threads(threads) if (parallel) schedule(static) reduction(max : max_excess) reduction(|| : moved)
-            for (std::int64_t f = 0; f < pass_faces; ++f) {
-                const double v = limited_flux(m, law, f, low[f], high[f], limit_in, limit_out);
-                flux[f] = v;
-                if (v != 0.0 && f < m.live_faces) {
-                    moved = true;
-                    max_excess = std::max(max_excess, excess[f]);
+                for (std::int64_t f = 0; f < pass_faces; ++f) {
+                    const double v = limited_flux(m, law, f, low[f], high[f], limit_in, limit_out);
+                    flux[f] = v;
+                    if (v != 0.0 && f < m.live_faces) {
+                        moved = true;
+                        max_excess = std::max(max_excess, excess[f]);
+                    }
                 }
             }
             s.flux_clean = false;
@@ -1606,6 +1644,13 @@ private:
         forget_watches(s);
         s.lazy = false;
         return changed;
+    }
+
+    // Whether the dense face pass runs in lanes (mesh/face_lanes.hpp): on a
+    // plain scene, unless a test asks for FaceLaw::terms alone.
+    static bool in_lanes(const FaceLaw &law, const MeshState &s) {
+        return !s.switches.scalar_mesh && law.isotropic && !law.tan_field && !law.moving && !law.available &&
+               !law.h.q && (law.p == 1.0 || law.p == 2.0);
     }
 
     // One sub-step's law over the grid, reading heights `hv` and gradients gx, gy.

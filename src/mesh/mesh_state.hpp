@@ -132,6 +132,10 @@ struct MeshState final : EngineState {
     std::vector<std::int64_t> sink_faces;          // faces onto open edges or open cells
     std::vector<std::uint8_t> carrying;            // per face: what it does (FaceRole in mesh_engine.cpp)
     std::vector<std::uint8_t> beside_wall;         // per cell: a face of it lies along a wall; empty: none does
+    // The faces the dense face pass leaves to FaceLaw::terms when it runs in
+    // lanes (mesh/face_lanes.hpp): on the domain edge, along a wall or
+    // carrying nothing, in face order.
+    std::vector<std::int64_t> faces_off_lanes;
     bool lists_current = false;
 
     // Local time steps (DPSM_RELAX_LOCAL_STEPS, mesh/step_classes.hpp): the

@@ -20,6 +20,7 @@ Switches read_switches() {
     s.copy_tiles = flag("DPSM_COPY_TILES");
     s.scalar_physics = flag("DPSM_SCALAR_PHYSICS");
     s.visit_all_cells = flag("DPSM_VISIT_ALL_CELLS");
+    s.scalar_mesh = flag("DPSM_SCALAR_MESH");
     s.mesh_host_order = flag("DPSM_MESH_HOST_ORDER");
     if (const char *limit = std::getenv("DPSM_MPI_SUBSTEPS_PER_EXCHANGE"))
         if (*limit) s.mpi_substeps_per_exchange = std::max(0, std::atoi(limit));

@@ -17,6 +17,7 @@ struct Switches {
     bool copy_tiles = false;       // DPSM_COPY_TILES: every tile through a buffer (none in place)
     bool scalar_physics = false;   // DPSM_SCALAR_PHYSICS: the scalar reference kernel for scenes with physics
     bool visit_all_cells = false;  // DPSM_VISIT_ALL_CELLS: a mesh's active set off (every cell)
+    bool scalar_mesh = false;      // DPSM_SCALAR_MESH: a mesh's dense face pass in FaceLaw::terms alone (no lanes)
     // When a mesh is built.
     bool mesh_host_order = false;  // DPSM_MESH_HOST_ORDER: the host's cell order, not the Hilbert curve's
     // When a part of a distributed mesh is made: at most this many sub-steps

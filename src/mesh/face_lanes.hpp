@@ -1,0 +1,65 @@
+// The dense sub-step's three face passes in vector lanes: what
+// FaceLaw::terms, gradient_flow_flux and limited_flux (mesh/mesh_engine.cpp)
+// give, bit for bit, branch-free so that the compiler runs several faces at
+// once (docs/performance.md, "The face passes in lanes"). The scalar
+// functions stay the reference: they take the faces and scenes the lanes do
+// not, and DPSM_SCALAR_MESH runs them alone, as the tests compare.
+#pragma once
+
+#include <cstdint>
+#include <limits>
+
+namespace dpsm {
+
+// What counts as the round-off of a sum, relative to its terms' magnitudes.
+constexpr double kRoundOff = 64.0 * std::numeric_limits<double>::epsilon();
+
+// What a face does in a sub-step (carrying_faces): carries sand between its
+// cells or over an open edge, lies between a sand cell and a wall (it
+// carries none, but the surface on the sand's side of it counts in the
+// faces' energy), or nothing (no sand on it).
+enum FaceRole : std::uint8_t { kCarriesNothing = 0, kCarries = 1, kAlongWall = 2 };
+
+// A plain scene: isotropic gradients, one angle of repose, no static angle,
+// no bed, no lazy source behind the heights, flux exponent 1 or 2.
+struct FaceLanes {
+    // The mesh (model/mesh.hpp).
+    const std::int64_t *face_a, *face_b;
+    const double *tangent_x, *tangent_y, *distance, *orthogonal, *skew, *conductance;
+    // The sub-step's heights and the cells' gradients.
+    const double *h, *gx, *gy;
+    double nu, tan_theta, tolerance;
+    bool squared;  // flux exponent 2 (else 1)
+    // What FaceLaw::terms writes, per face.
+    double *low, *high, *pull, *excess;
+    std::uint8_t *steep;
+};
+
+// Faces [begin, end) as if each carried sand between two cells; the caller
+// then passes the others (on the domain edge, along a wall, carrying
+// nothing) to FaceLaw::terms, which overwrites what this wrote for them.
+void face_terms_in_lanes(const FaceLanes &lanes, std::int64_t begin, std::int64_t end);
+
+// The gradient flow's flux over faces [begin, end), any scene: high holds
+// each face's two-point part and takes its flux, as gradient_flow_flux.
+struct FlowLanes {
+    const std::int64_t *face_a, *face_b;
+    const std::uint8_t *carrying;  // per face, its FaceRole
+    const double *pair_ax, *pair_ay, *pair_bx, *pair_by;
+    const double *pull_x, *pull_y;
+    double *high;
+};
+void flow_fluxes_in_lanes(const FlowLanes &lanes, std::int64_t begin, std::int64_t end);
+
+// The limited flux over faces [begin, end), without a bed (limited_flux with
+// no cap), into flux. Returns the largest excess slope of the faces below
+// `live` that carry sand, or -1 where none does.
+struct LimitLanes {
+    const std::int64_t *face_a, *face_b;
+    const double *low, *high, *excess;
+    const double *limit_in, *limit_out;
+    double *flux;
+};
+double limited_fluxes_in_lanes(const LimitLanes &lanes, std::int64_t begin, std::int64_t end, std::int64_t live);
+
+}  // namespace dpsm
