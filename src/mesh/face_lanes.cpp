@@ -8,6 +8,14 @@
 #pragma clang diagnostic ignored "-Wpass-failed"
 #endif
 
+// GCC builds a copy for AVX-512, one for AVX2 and a plain one of each pass,
+// and picks one when the library loads; the copies round alike.
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
+#define LANE_COPIES __attribute__((target_clones("avx512f", "avx2", "default")))
+#else
+#define LANE_COPIES
+#endif
+
 namespace dpsm {
 
 // Every operation is FaceLaw::terms's, in its order, on one face per lane:
@@ -63,11 +71,7 @@ __attribute__((always_inline)) inline void terms_in_lanes(const FaceLanes &lanes
     }
 }
 
-// GCC builds a copy for AVX-512, one for AVX2 and a plain one, and picks one
-// when the library loads; the copies round alike.
-#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
-__attribute__((target_clones("avx512f", "avx2", "default")))
-#endif
+LANE_COPIES
 void face_terms_in_lanes(const FaceLanes &lanes, std::int64_t begin, std::int64_t end) {
     if (lanes.squared)
         terms_in_lanes<true>(lanes, begin, end);
@@ -75,9 +79,7 @@ void face_terms_in_lanes(const FaceLanes &lanes, std::int64_t begin, std::int64_
         terms_in_lanes<false>(lanes, begin, end);
 }
 
-#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
-__attribute__((target_clones("avx512f", "avx2", "default")))
-#endif
+LANE_COPIES
 void flow_fluxes_in_lanes(const FlowLanes &lanes, std::int64_t begin, std::int64_t end) {
     const std::int64_t *__restrict face_a = lanes.face_a, *__restrict face_b = lanes.face_b;
     const std::uint8_t *__restrict carrying = lanes.carrying;
@@ -91,16 +93,13 @@ void flow_fluxes_in_lanes(const FlowLanes &lanes, std::int64_t begin, std::int64
         const double two_point = high[f];
         const double from_b = pair_bx[f] * pull_x[b] + pair_by[f] * pull_y[b];
         const double from_a = pair_ax[f] * pull_x[a] + pair_ay[f] * pull_y[a];
-        const double sum = two_point + (from_b - from_a);
-        const double scale = std::fabs(two_point) + std::fabs(from_b) + std::fabs(from_a);
-        const double flow = std::fabs(sum) > kRoundOff * scale ? sum : 0.0;
+        const double flow =
+            beyond_round_off(two_point + (from_b - from_a), std::fabs(two_point) + std::fabs(from_b) + std::fabs(from_a));
         high[f] = carrying[f] != kCarries ? 0.0 : b_or_edge < 0 ? two_point : flow;
     }
 }
 
-#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
-__attribute__((target_clones("avx512f", "avx2", "default")))
-#endif
+LANE_COPIES
 double limited_fluxes_in_lanes(const LimitLanes &lanes, std::int64_t begin, std::int64_t end, std::int64_t live) {
     const std::int64_t *__restrict face_a = lanes.face_a, *__restrict face_b = lanes.face_b;
     const double *__restrict lows = lanes.low, *__restrict highs = lanes.high, *__restrict excess = lanes.excess;
@@ -119,8 +118,7 @@ double limited_fluxes_in_lanes(const LimitLanes &lanes, std::int64_t begin, std:
         const double share_b = out_of_a ? b_in : b_out;
         const double share = b_or_edge >= 0 && share_b < share_a ? share_b : share_a;
         const double limited = share * beyond;
-        const double sum = low + limited, scale = std::fabs(low) + std::fabs(limited);
-        const double v = beyond == 0.0 ? low : std::fabs(sum) > kRoundOff * scale ? sum : 0.0;
+        const double v = beyond == 0.0 ? low : beyond_round_off(low + limited, std::fabs(low) + std::fabs(limited));
         flux[f] = v;
         const double carried = v != 0.0 && f < live ? excess[f] : -1.0;
         largest = carried > largest ? carried : largest;

@@ -6,6 +6,7 @@
 // not, and DPSM_SCALAR_MESH runs them alone, as the tests compare.
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 #include <limits>
 
@@ -13,6 +14,13 @@ namespace dpsm {
 
 // What counts as the round-off of a sum, relative to its terms' magnitudes.
 constexpr double kRoundOff = 64.0 * std::numeric_limits<double>::epsilon();
+
+// A sum whose terms' magnitudes add up to `scale`, or 0 where it is within
+// their round-off: where the parts of a flux cancel (a state the bed holds
+// still) the rounding must not keep a face carrying sand for ever.
+inline double beyond_round_off(double sum, double scale) {
+    return std::fabs(sum) > kRoundOff * scale ? sum : 0.0;
+}
 
 // What a face does in a sub-step (carrying_faces): carries sand between its
 // cells or over an open edge, lies between a sand cell and a wall (it

@@ -283,13 +283,6 @@ inline double net_rate(const Mesh &m, const double *flux, std::int64_t c, bool &
     return rate / m.area[c];
 }
 
-// A sum whose terms' magnitudes add up to `scale`, or 0 where it is within
-// their round-off: where the parts of a flux cancel (a state the bed holds
-// still) the rounding must not keep a face carrying sand for ever.
-inline double beyond_round_off(double sum, double scale) {
-    return std::fabs(sum) > kRoundOff * scale ? sum : 0.0;
-}
-
 // Cell c's pull: M_c^-1 P_c, with P_c the sum of its faces' pulls along
 // their tangents (a face along a wall: along c's gradient), in the cell's
 // face order (0 without a stencil).
@@ -726,7 +719,10 @@ private:
                                       m.pair_ay.data(), m.pair_bx.data(), m.pair_by.data(), pull_x,
                                       pull_y,           high};
 #pragma omp parallel for num_threads(threads) if (parallel) schedule(static)
-                for (int r = 0; r < ranges; ++r) flow_fluxes_in_lanes(lanes, range_of(r).first, range_of(r).second);
+                for (int r = 0; r < ranges; ++r) {
+                    const auto [begin, end] = range_of(r);
+                    flow_fluxes_in_lanes(lanes, begin, end);
+                }
             } else {
 #pragma omp parallel for num_threads(threads) if (parallel) schedule(static)
                 for (std::int64_t f = 0; f < pass_faces; ++f)
@@ -739,9 +735,10 @@ private:
                 const LimitLanes lanes{m.face_a.data(), m.face_b.data(), low, high, excess, limit_in, limit_out, flux};
                 double largest = -1.0;
 #pragma omp parallel for num_threads(threads) if (parallel) schedule(static) reduction(max : largest)
-                for (int r = 0; r < ranges; ++r)
-                    largest = std::max(largest,
-                                       limited_fluxes_in_lanes(lanes, range_of(r).first, range_of(r).second, m.live_faces));
+                for (int r = 0; r < ranges; ++r) {
+                    const auto [begin, end] = range_of(r);
+                    largest = std::max(largest, limited_fluxes_in_lanes(lanes, begin, end, m.live_faces));
+                }
                 moved = largest >= 0.0;
                 max_excess = std::max(max_excess, largest);
             } else {
