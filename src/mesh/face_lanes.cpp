@@ -24,9 +24,10 @@ namespace dpsm {
 // this file is built without floating-point traps or errno, and without
 // contraction, so each lane rounds as the scalar code). A copy per flux
 // exponent: a select on it would keep the compiler from the lanes.
-template <bool kSquared>
-__attribute__((always_inline)) inline void terms_in_lanes(const FaceLanes &lanes, std::int64_t begin,
-                                                          std::int64_t end) {
+// With kListed, the faces list[begin, end) (each once), else faces [begin, end).
+template <bool kSquared, bool kListed>
+__attribute__((always_inline)) inline void terms_in_lanes(const FaceLanes &lanes, const std::int64_t *list,
+                                                          std::int64_t begin, std::int64_t end) {
     const std::int64_t *__restrict face_a = lanes.face_a, *__restrict face_b = lanes.face_b;
     const double *__restrict tangent_x = lanes.tangent_x, *__restrict tangent_y = lanes.tangent_y;
     const double *__restrict distances = lanes.distance, *__restrict orthogonals = lanes.orthogonal;
@@ -38,7 +39,8 @@ __attribute__((always_inline)) inline void terms_in_lanes(const FaceLanes &lanes
     const double nu = lanes.nu, tan_face = lanes.tan_theta, tolerance = lanes.tolerance;
     const double threshold = tan_face * (1.0 + tolerance), flat = tolerance * tan_face;
 #pragma omp simd
-    for (std::int64_t f = begin; f < end; ++f) {
+    for (std::int64_t i = begin; i < end; ++i) {
+        const std::int64_t f = kListed ? list[i] : i;
         const std::int64_t a = face_a[f], b_or_edge = face_b[f], b = b_or_edge < 0 ? a : b_or_edge;
         const double tangential =
             0.5 * ((gx[a] + gx[b]) * tangent_x[f] + (gy[a] + gy[b]) * tangent_y[f]);
@@ -74,13 +76,22 @@ __attribute__((always_inline)) inline void terms_in_lanes(const FaceLanes &lanes
 LANE_COPIES
 void face_terms_in_lanes(const FaceLanes &lanes, std::int64_t begin, std::int64_t end) {
     if (lanes.squared)
-        terms_in_lanes<true>(lanes, begin, end);
+        terms_in_lanes<true, false>(lanes, nullptr, begin, end);
     else
-        terms_in_lanes<false>(lanes, begin, end);
+        terms_in_lanes<false, false>(lanes, nullptr, begin, end);
 }
 
 LANE_COPIES
-void flow_fluxes_in_lanes(const FlowLanes &lanes, std::int64_t begin, std::int64_t end) {
+void face_terms_in_lanes(const FaceLanes &lanes, const std::int64_t *faces, std::int64_t count) {
+    if (lanes.squared)
+        terms_in_lanes<true, true>(lanes, faces, 0, count);
+    else
+        terms_in_lanes<false, true>(lanes, faces, 0, count);
+}
+
+template <bool kListed>
+__attribute__((always_inline)) inline void flow_in_lanes(const FlowLanes &lanes, const std::int64_t *list,
+                                                         std::int64_t begin, std::int64_t end) {
     const std::int64_t *__restrict face_a = lanes.face_a, *__restrict face_b = lanes.face_b;
     const std::uint8_t *__restrict carrying = lanes.carrying;
     const double *__restrict pair_ax = lanes.pair_ax, *__restrict pair_ay = lanes.pair_ay;
@@ -88,7 +99,8 @@ void flow_fluxes_in_lanes(const FlowLanes &lanes, std::int64_t begin, std::int64
     const double *__restrict pull_x = lanes.pull_x, *__restrict pull_y = lanes.pull_y;
     double *__restrict high = lanes.high;
 #pragma omp simd
-    for (std::int64_t f = begin; f < end; ++f) {
+    for (std::int64_t i = begin; i < end; ++i) {
+        const std::int64_t f = kListed ? list[i] : i;
         const std::int64_t a = face_a[f], b_or_edge = face_b[f], b = b_or_edge < 0 ? a : b_or_edge;
         const double two_point = high[f];
         const double from_b = pair_bx[f] * pull_x[b] + pair_by[f] * pull_y[b];
@@ -100,14 +112,27 @@ void flow_fluxes_in_lanes(const FlowLanes &lanes, std::int64_t begin, std::int64
 }
 
 LANE_COPIES
-double limited_fluxes_in_lanes(const LimitLanes &lanes, std::int64_t begin, std::int64_t end, std::int64_t live) {
+void flow_fluxes_in_lanes(const FlowLanes &lanes, std::int64_t begin, std::int64_t end) {
+    flow_in_lanes<false>(lanes, nullptr, begin, end);
+}
+
+LANE_COPIES
+void flow_fluxes_in_lanes(const FlowLanes &lanes, const std::int64_t *faces, std::int64_t count) {
+    flow_in_lanes<true>(lanes, faces, 0, count);
+}
+
+template <bool kListed>
+__attribute__((always_inline)) inline double limited_in_lanes(const LimitLanes &lanes, const std::int64_t *list,
+                                                              std::int64_t begin, std::int64_t end,
+                                                              std::int64_t live) {
     const std::int64_t *__restrict face_a = lanes.face_a, *__restrict face_b = lanes.face_b;
     const double *__restrict lows = lanes.low, *__restrict highs = lanes.high, *__restrict excess = lanes.excess;
     const double *__restrict limit_in = lanes.limit_in, *__restrict limit_out = lanes.limit_out;
     double *__restrict flux = lanes.flux;
     double largest = -1.0;
 #pragma omp simd reduction(max : largest)
-    for (std::int64_t f = begin; f < end; ++f) {
+    for (std::int64_t i = begin; i < end; ++i) {
+        const std::int64_t f = kListed ? list[i] : i;
         const std::int64_t a = face_a[f], b_or_edge = face_b[f], b = b_or_edge < 0 ? a : b_or_edge;
         const double low = lows[f], beyond = highs[f] - low;
         const bool out_of_a = beyond > 0.0;
@@ -124,6 +149,16 @@ double limited_fluxes_in_lanes(const LimitLanes &lanes, std::int64_t begin, std:
         largest = carried > largest ? carried : largest;
     }
     return largest;
+}
+
+LANE_COPIES
+double limited_fluxes_in_lanes(const LimitLanes &lanes, std::int64_t begin, std::int64_t end, std::int64_t live) {
+    return limited_in_lanes<false>(lanes, nullptr, begin, end, live);
+}
+
+LANE_COPIES
+void limited_fluxes_in_lanes(const LimitLanes &lanes, const std::int64_t *faces, std::int64_t count) {
+    limited_in_lanes<true>(lanes, faces, 0, count, 0);
 }
 
 }  // namespace dpsm

@@ -47,6 +47,8 @@ struct FaceLanes {
 // then passes the others (on the domain edge, along a wall, carrying
 // nothing) to FaceLaw::terms, which overwrites what this wrote for them.
 void face_terms_in_lanes(const FaceLanes &lanes, std::int64_t begin, std::int64_t end);
+// The same for the `count` faces of a list, each listed once (a sparse sub-step's).
+void face_terms_in_lanes(const FaceLanes &lanes, const std::int64_t *faces, std::int64_t count);
 
 // The gradient flow's flux over faces [begin, end), any scene: high holds
 // each face's two-point part and takes its flux, as gradient_flow_flux.
@@ -58,6 +60,7 @@ struct FlowLanes {
     double *high;
 };
 void flow_fluxes_in_lanes(const FlowLanes &lanes, std::int64_t begin, std::int64_t end);
+void flow_fluxes_in_lanes(const FlowLanes &lanes, const std::int64_t *faces, std::int64_t count);
 
 // The limited flux over faces [begin, end), without a bed (limited_flux with
 // no cap), into flux. Returns the largest excess slope of the faces below
@@ -69,5 +72,7 @@ struct LimitLanes {
     double *flux;
 };
 double limited_fluxes_in_lanes(const LimitLanes &lanes, std::int64_t begin, std::int64_t end, std::int64_t live);
+// The same over the `count` faces of a list (each once), the excess not sought.
+void limited_fluxes_in_lanes(const LimitLanes &lanes, const std::int64_t *faces, std::int64_t count);
 
 }  // namespace dpsm

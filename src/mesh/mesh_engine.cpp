@@ -63,6 +63,20 @@ template <class Work>
 void for_each_item(const std::vector<std::int64_t> &list, int threads, const Work &work) {
     for_each_item(list.data(), static_cast<std::int64_t>(list.size()), threads, work);
 }
+// Calls work(items, count) for a share of a list a thread (the whole list
+// on one thread where it is short): the passes in lanes over a list.
+template <class Work>
+void for_each_share(const std::vector<std::int64_t> &list, int threads, const Work &work) {
+    const std::int64_t count = static_cast<std::int64_t>(list.size());
+    const bool parallel = threads > 1 && count >= kListItemsForThreads;
+    const int shares = parallel ? threads : 1;
+#pragma omp parallel for num_threads(threads) if (parallel) schedule(static)
+    for (int r = 0; r < shares; ++r) {
+        const std::int64_t begin = count * r / shares, end = count * (r + 1) / shares;
+        work(list.data() + begin, end - begin);
+    }
+}
+
 // The share of the room to its bounds a cell's limiter lets the gradient
 // flow's excess fill.
 constexpr double kLimiterRoom = 1.0 - 1e-9;
@@ -666,6 +680,15 @@ private:
             steep[f] = t.steep;
             return t;
         };
+        const bool lanes_run = in_lanes(law, s);
+        const FaceLanes term_lanes{m.face_a.data(),    m.face_b.data(),   m.tangent_x.data(), m.tangent_y.data(),
+                                   m.distance.data(),  m.orthogonal.data(), m.skew.data(),    m.conductance.data(),
+                                   law.h.h,            law.gx,            law.gy,             law.nu,
+                                   law.tan_theta,      law.tolerance,     law.p == 2.0,       low,
+                                   high,               pull,              excess,             steep};
+        const FlowLanes flow_lanes{m.face_a.data(),  m.face_b.data(),  law.carrying, m.pair_ax.data(), m.pair_ay.data(),
+                                   m.pair_bx.data(), m.pair_by.data(), pull_x,       pull_y,           high};
+        const LimitLanes limit_lanes{m.face_a.data(), m.face_b.data(), low, high, excess, limit_in, limit_out, flux};
 
         if (dense) {
             // The owned cells and the faces that touch them: all of a serial
@@ -691,19 +714,12 @@ private:
                     watch_near_moves(m, s, changed_ghosts);
                 }
             }
-            if (in_lanes(law, s)) {
-                const FaceLanes lanes{m.face_a.data(),     m.face_b.data(),      m.tangent_x.data(),
-                                      m.tangent_y.data(),  m.distance.data(),    m.orthogonal.data(),
-                                      m.skew.data(),       m.conductance.data(), law.h.h,
-                                      law.gx,              law.gy,               law.nu,
-                                      law.tan_theta,       law.tolerance,        law.p == 2.0,
-                                      low,                 high,                 pull,
-                                      excess,              steep};
+            if (lanes_run) {
                 const std::vector<std::int64_t> &off = s.faces_off_lanes;
 #pragma omp parallel for num_threads(threads) if (parallel) schedule(static)
                 for (int r = 0; r < ranges; ++r) {
                     const auto [begin, end] = range_of(r);
-                    face_terms_in_lanes(lanes, begin, end);
+                    face_terms_in_lanes(term_lanes, begin, end);
                     for (auto k = std::lower_bound(off.begin(), off.end(), begin); k != off.end() && *k < end; ++k)
                         face_terms(*k);
                 }
@@ -715,13 +731,10 @@ private:
             for (std::int64_t c = 0; c < pass_cells; ++c) pull_of(m, law, pull, c, pull_x, pull_y);
             if (parts && !in_batch) take_every_ghosts_pull(m, s);
             if (!s.switches.scalar_mesh) {
-                const FlowLanes lanes{m.face_a.data(),  m.face_b.data(),  law.carrying, m.pair_ax.data(),
-                                      m.pair_ay.data(), m.pair_bx.data(), m.pair_by.data(), pull_x,
-                                      pull_y,           high};
 #pragma omp parallel for num_threads(threads) if (parallel) schedule(static)
                 for (int r = 0; r < ranges; ++r) {
                     const auto [begin, end] = range_of(r);
-                    flow_fluxes_in_lanes(lanes, begin, end);
+                    flow_fluxes_in_lanes(flow_lanes, begin, end);
                 }
             } else {
 #pragma omp parallel for num_threads(threads) if (parallel) schedule(static)
@@ -732,12 +745,11 @@ private:
             for (std::int64_t c = 0; c < pass_cells; ++c) limits_of(m, law, low, high, bed, c, limit_in, limit_out);
             if (parts && !in_batch) exchange_ghost_limits(s);
             if (!s.switches.scalar_mesh && !law.available) {
-                const LimitLanes lanes{m.face_a.data(), m.face_b.data(), low, high, excess, limit_in, limit_out, flux};
                 double largest = -1.0;
 #pragma omp parallel for num_threads(threads) if (parallel) schedule(static) reduction(max : largest)
                 for (int r = 0; r < ranges; ++r) {
                     const auto [begin, end] = range_of(r);
-                    largest = std::max(largest, limited_fluxes_in_lanes(lanes, begin, end, m.live_faces));
+                    largest = std::max(largest, limited_fluxes_in_lanes(limit_lanes, begin, end, m.live_faces));
                 }
                 moved = largest >= 0.0;
                 max_excess = std::max(max_excess, largest);
@@ -836,10 +848,23 @@ private:
             std::vector<std::int64_t> &steep_faces = s.steep_faces;
             std::vector<std::uint8_t> &became_steep = s.became_steep;
             became_steep.resize(s.faces.size());
-            for_each_place(s.faces, threads, [&](std::int64_t k, std::int64_t f) {
-                const bool was = steep[f] != 0;
-                became_steep[static_cast<std::size_t>(k)] = face_terms(f).steep && !was;
-            });
+            if (lanes_run) {
+                // Whether each face was steep, before the lanes write its flag.
+                for (std::size_t k = 0; k < s.faces.size(); ++k) became_steep[k] = steep[s.faces[k]];
+                for_each_share(s.faces, threads, [&](const std::int64_t *faces, std::int64_t count) {
+                    face_terms_in_lanes(term_lanes, faces, count);
+                    // The faces the lanes do not take: on the domain edge, along a wall, carrying nothing.
+                    for (std::int64_t k = 0; k < count; ++k)
+                        if (!law.carries(faces[k]) || m.face_b[faces[k]] < 0) face_terms(faces[k]);
+                });
+                for (std::size_t k = 0; k < s.faces.size(); ++k)
+                    became_steep[k] = steep[s.faces[k]] && !became_steep[k];
+            } else {
+                for_each_place(s.faces, threads, [&](std::int64_t k, std::int64_t f) {
+                    const bool was = steep[f] != 0;
+                    became_steep[static_cast<std::size_t>(k)] = face_terms(f).steep && !was;
+                });
+            }
             for (std::size_t k = 0; k < s.faces.size(); ++k)
                 if (became_steep[k]) steep_faces.push_back(s.faces[k]);
             // Each steep face once (a face that turned flat in a sub-step
@@ -872,15 +897,26 @@ private:
             for (const std::int64_t f : steep_faces) carry(f);
             for (const std::int64_t c : s.pull_cells) carry_faces_of(c);
             for (const std::int64_t c : s.pulling_ghosts) carry_faces_of(c);
-            for_each_item(s.faces, threads,
-                          [&](std::int64_t f) { high[f] = gradient_flow_flux(m, law, f, high[f], pull_x, pull_y); });
+            if (!s.switches.scalar_mesh)
+                for_each_share(s.faces, threads, [&](const std::int64_t *faces, std::int64_t count) {
+                    flow_fluxes_in_lanes(flow_lanes, faces, count);
+                });
+            else
+                for_each_item(s.faces, threads,
+                              [&](std::int64_t f) { high[f] = gradient_flow_flux(m, law, f, high[f], pull_x, pull_y); });
             // Limiters: the owned cells of those faces.
             owned_cells_of(m, s, s.faces, s.limit_cells);
             for_each_item(s.limit_cells, threads,
                           [&](std::int64_t c) { limits_of(m, law, low, high, bed, c, limit_in, limit_out); });
             if (exchanges) exchange_ghost_limits(s);
-            for_each_item(s.faces, threads,
-                          [&](std::int64_t f) { flux[f] = limited_flux(m, law, f, low[f], high[f], limit_in, limit_out); });
+            if (!s.switches.scalar_mesh && !law.available)
+                for_each_share(s.faces, threads, [&](const std::int64_t *faces, std::int64_t count) {
+                    limited_fluxes_in_lanes(limit_lanes, faces, count);
+                });
+            else
+                for_each_item(s.faces, threads, [&](std::int64_t f) {
+                    flux[f] = limited_flux(m, law, f, low[f], high[f], limit_in, limit_out);
+                });
             list_updates(m, s, moved, max_excess);
             for_each_item(s.update_cells, threads, [&](std::int64_t c) { update_cell(c); });
             visited = cells_visited(s);
