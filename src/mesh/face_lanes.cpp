@@ -145,8 +145,10 @@ __attribute__((always_inline)) inline double limited_in_lanes(const LimitLanes &
         const double limited = share * beyond;
         const double v = beyond == 0.0 ? low : beyond_round_off(low + limited, std::fabs(low) + std::fabs(limited));
         flux[f] = v;
-        const double carried = v != 0.0 && f < live ? excess[f] : -1.0;
-        largest = carried > largest ? carried : largest;
+        if (!kListed) {
+            const double carried = v != 0.0 && f < live ? excess[f] : -1.0;
+            largest = carried > largest ? carried : largest;
+        }
     }
     return largest;
 }
@@ -158,7 +160,7 @@ double limited_fluxes_in_lanes(const LimitLanes &lanes, std::int64_t begin, std:
 
 LANE_COPIES
 void limited_fluxes_in_lanes(const LimitLanes &lanes, const std::int64_t *faces, std::int64_t count) {
-    limited_in_lanes<true>(lanes, faces, 0, count, 0);
+    limited_in_lanes<true>(lanes, faces, 0, count, 0);  // the excess: list_updates
 }
 
 }  // namespace dpsm

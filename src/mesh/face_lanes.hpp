@@ -1,4 +1,5 @@
-// The dense sub-step's three face passes in vector lanes: what
+// The sub-step's three face passes in vector lanes, over a range of faces
+// (a dense sub-step) or a list (a sparse one): what
 // FaceLaw::terms, gradient_flow_flux and limited_flux (mesh/mesh_engine.cpp)
 // give, bit for bit, branch-free so that the compiler runs several faces at
 // once (docs/performance.md, "The face passes in lanes"). The scalar

@@ -432,7 +432,7 @@ public:
         carrying_faces(grid, m, s.carrying, s.beside_wall);
         s.faces_off_lanes.clear();
         for (std::int64_t f = 0; f < m.faces; ++f)
-            if (s.carrying[f] != kCarries || m.face_b[f] < 0) s.faces_off_lanes.push_back(f);
+            if (off_lanes(m, s.carrying.data(), f)) s.faces_off_lanes.push_back(f);
         // Faces onto a sink: the outflow is summed over them alone, in one
         // order. On a distributed mesh the rank that owns the cell the sand
         // leaves books it.
@@ -853,9 +853,8 @@ private:
                 for (std::size_t k = 0; k < s.faces.size(); ++k) became_steep[k] = steep[s.faces[k]];
                 for_each_share(s.faces, threads, [&](const std::int64_t *faces, std::int64_t count) {
                     face_terms_in_lanes(term_lanes, faces, count);
-                    // The faces the lanes do not take: on the domain edge, along a wall, carrying nothing.
                     for (std::int64_t k = 0; k < count; ++k)
-                        if (!law.carries(faces[k]) || m.face_b[faces[k]] < 0) face_terms(faces[k]);
+                        if (off_lanes(m, law.carrying, faces[k])) face_terms(faces[k]);
                 });
                 for (std::size_t k = 0; k < s.faces.size(); ++k)
                     became_steep[k] = steep[s.faces[k]] && !became_steep[k];
@@ -1679,11 +1678,18 @@ private:
         return changed;
     }
 
-    // Whether the dense face pass runs in lanes (mesh/face_lanes.hpp): on a
-    // plain scene, unless a test asks for FaceLaw::terms alone.
+    // Whether the faces' terms run in lanes (mesh/face_lanes.hpp), over every
+    // face or over a sparse sub-step's list: on a plain scene, unless a test
+    // asks for FaceLaw::terms alone.
     static bool in_lanes(const FaceLaw &law, const MeshState &s) {
         return !s.switches.scalar_mesh && law.isotropic && !law.tan_field && !law.moving && !law.available &&
                !law.h.q && (law.p == 1.0 || law.p == 2.0);
+    }
+
+    // A face whose terms the lanes do not take (FaceLaw::terms does): on the
+    // domain edge, along a wall, carrying nothing.
+    static bool off_lanes(const Mesh &m, const std::uint8_t *carrying, std::int64_t f) {
+        return carrying[f] != kCarries || m.face_b[f] < 0;
     }
 
     // One sub-step's law over the grid, reading heights `hv` and gradients gx, gy.
