@@ -1100,7 +1100,9 @@ static void test_active_set_same_bits(void **state) {
  * angle field, a bed), on one thread and, on a mesh large enough for them,
  * on two. A steep plane keeps every cell moving, so every sub-step is dense;
  * a steep bump on a flat table moves a few cells, so sub-steps are sparse
- * (the lanes over a list of faces). */
+ * (the lanes over a list of faces). With sources the heights a face reads
+ * are the stored ones plus what the source added since (sources in closed
+ * form), in lanes too. */
 typedef struct {
     int edge;      /* DPSM_OPEN: levels beyond the edge; DPSM_WALL: closed */
     int cells;     /* wall and open cells in the plane */
@@ -1109,6 +1111,7 @@ typedef struct {
     int bed;       /* a bed under the plane */
     int threads;
     int bump;      /* a steep bump on a flat table instead of the plane: sparse sub-steps */
+    int source;    /* a source on every cell: the heights read lag behind the stored ones */
 } lanes_scene;
 
 static void plane_in_lanes(const mesh_scene *s, const lanes_scene *scene, int scalar, double *h_out,
@@ -1134,6 +1137,8 @@ static void plane_in_lanes(const mesh_scene *s, const lanes_scene *scene, int sc
         /* on two threads, wide enough that the lists are shared (kListItemsForThreads) */
         if (scene->bump)
             h[c] = 3.0 + fmax(0.0, (scene->threads > 1 ? 0.45 : 0.2) - 1.5 * hypot(s->cx[c] - 0.5, s->cy[c] + 0.1));
+        /* with a source, a pile just below the angle of repose */
+        if (scene->bump && scene->source) h[c] = 3.0 + fmax(0.0, 0.2 - 0.55 * hypot(s->cx[c] - 0.5, s->cy[c] + 0.1));
         angle[c] = (28.0 + 4.0 * (double)(c % 3)) * kDeg;
         if (scene->cells && hypot(s->cx[c] - 0.3, s->cy[c] + 0.2) < 0.25) kinds[c] = DPSM_CELL_WALL;
         if (scene->cells && hypot(s->cx[c] + 0.6, s->cy[c] - 0.5) < 0.15) kinds[c] = DPSM_CELL_OPEN;
@@ -1141,6 +1146,18 @@ static void plane_in_lanes(const mesh_scene *s, const lanes_scene *scene, int sc
     CHECK_OK(g, dpsm_set_cell_kinds(g, kinds));
     if (scene->field) CHECK_OK(g, dpsm_set_repose_angle_field(g, angle));
     CHECK_OK(g, dpsm_set_heights(g, h));
+    if (scene->source) {
+        /* On the pile, one on its top: the top's faces turn steep one by
+         * one, each reading heights its cells' sources moved since they
+         * last took a sub-step. */
+        double *q = calloc((size_t)s->cells, sizeof(double));
+        for (int64_t c = 0; c < s->cells; ++c)
+            q[c] = !scene->bump                                     ? 0.5 + 0.3 * sin(5.0 * s->cx[c])
+                   : hypot(s->cx[c] - 0.5, s->cy[c] + 0.1) < 0.12 ? 1.7
+                                                                   : 0.0;
+        CHECK_OK(g, dpsm_set_source(g, q));
+        free(q);
+    }
     if (scene->bed) {
         double *bed = calloc((size_t)s->cells, sizeof(double));
         for (int64_t c = 0; c < s->cells; ++c) bed[c] = h[c] - (s->cx[c] > 0.2 ? 0.02 : 0.5);
@@ -1170,11 +1187,12 @@ static void plane_in_lanes(const mesh_scene *s, const lanes_scene *scene, int sc
 static void test_face_pass_in_lanes_same_bits(void **state) {
     (void)state;
     const scene_kind kinds[4] = {SCENE_QUADS, SCENE_TRIANGLES, SCENE_HEXAGONS, SCENE_DUAL};
-    enum { kScenes = 9 };
+    enum { kScenes = 11 };
     const lanes_scene scenes[kScenes] = {
         {DPSM_OPEN, 0, 1.0, 0, 0, 1, 0}, {DPSM_WALL, 1, 1.0, 0, 0, 1, 0}, {DPSM_OPEN, 1, 2.0, 0, 0, 1, 0},
         {DPSM_OPEN, 1, 1.0, 1, 0, 1, 0}, {DPSM_OPEN, 1, 1.0, 0, 1, 1, 0}, {DPSM_OPEN, 1, 1.0, 0, 0, 2, 0},
-        {DPSM_OPEN, 0, 1.0, 0, 0, 1, 1}, {DPSM_WALL, 1, 2.0, 0, 0, 1, 1}, {DPSM_OPEN, 0, 1.0, 0, 0, 2, 1}};
+        {DPSM_OPEN, 0, 1.0, 0, 0, 1, 1}, {DPSM_WALL, 1, 2.0, 0, 0, 1, 1}, {DPSM_OPEN, 0, 1.0, 0, 0, 2, 1},
+        {DPSM_OPEN, 1, 1.0, 0, 0, 1, 0, 1}, {DPSM_OPEN, 0, 1.0, 0, 0, 1, 1, 1}};
     const char *names[kScenes] = {"open edge at levels",
                                   "closed edge, wall and open cells",
                                   "flux exponent 2",
@@ -1183,7 +1201,9 @@ static void test_face_pass_in_lanes_same_bits(void **state) {
                                   "two threads",
                                   "a bump, sparse",
                                   "a bump, sparse, walls, exponent 2",
-                                  "a bump, sparse, two threads"};
+                                  "a bump, sparse, two threads",
+                                  "sources",
+                                  "a bump, sparse, sources lagging"};
     for (int k = 0; k < 4; ++k)
         for (int n = 0; n < kScenes; ++n) {
             /* Two threads share a pass from 32,768 cells (kCellsForThreads): one mesh that large. */

@@ -24,8 +24,9 @@ namespace dpsm {
 // this file is built without floating-point traps or errno, and without
 // contraction, so each lane rounds as the scalar code). A copy per flux
 // exponent: a select on it would keep the compiler from the lanes.
-// With kListed, the faces list[begin, end) (each once), else faces [begin, end).
-template <bool kSquared, bool kListed>
+// With kListed, the faces list[begin, end) (each once), else faces [begin, end);
+// with kLagged, each cell's height with what its lazy source added since.
+template <bool kSquared, bool kListed, bool kLagged>
 __attribute__((always_inline)) inline void terms_in_lanes(const FaceLanes &lanes, const std::int64_t *list,
                                                           std::int64_t begin, std::int64_t end) {
     const std::int64_t *__restrict face_a = lanes.face_a, *__restrict face_b = lanes.face_b;
@@ -33,6 +34,8 @@ __attribute__((always_inline)) inline void terms_in_lanes(const FaceLanes &lanes
     const double *__restrict distances = lanes.distance, *__restrict orthogonals = lanes.orthogonal;
     const double *__restrict skews = lanes.skew, *__restrict conductances = lanes.conductance;
     const double *__restrict h = lanes.h, *__restrict gx = lanes.gx, *__restrict gy = lanes.gy;
+    const double *__restrict q = lanes.q, *__restrict since = lanes.since;
+    const double dt = lanes.dt, now = lanes.now;
     double *__restrict low = lanes.low, *__restrict high = lanes.high, *__restrict pull = lanes.pull;
     double *__restrict excess = lanes.excess;
     std::uint8_t *__restrict steep = lanes.steep;
@@ -45,7 +48,10 @@ __attribute__((always_inline)) inline void terms_in_lanes(const FaceLanes &lanes
         const double tangential =
             0.5 * ((gx[a] + gx[b]) * tangent_x[f] + (gy[a] + gy[b]) * tangent_y[f]);
         const double distance = distances[f];
-        const double normal = (h[a] - h[b]) / distance;
+        // source_lag (model/ledger.hpp), as Heights reads it.
+        const double ha = kLagged ? h[a] + (q[a] * dt) * (now - since[a]) : h[a];
+        const double hb = kLagged ? h[b] + (q[b] * dt) * (now - since[b]) : h[b];
+        const double normal = (ha - hb) / distance;
         const double s = std::sqrt(normal * normal + tangential * tangential);
         const bool is_steep = s > threshold;
         // slide_flux (model/face_law.hpp) over s.
@@ -73,20 +79,31 @@ __attribute__((always_inline)) inline void terms_in_lanes(const FaceLanes &lanes
     }
 }
 
+// One copy for each exponent and whether sources lag.
+template <bool kListed>
+__attribute__((always_inline)) inline void terms_for_scene(const FaceLanes &lanes, const std::int64_t *list,
+                                                           std::int64_t begin, std::int64_t end) {
+    if (lanes.squared) {
+        if (lanes.q)
+            terms_in_lanes<true, kListed, true>(lanes, list, begin, end);
+        else
+            terms_in_lanes<true, kListed, false>(lanes, list, begin, end);
+    } else {
+        if (lanes.q)
+            terms_in_lanes<false, kListed, true>(lanes, list, begin, end);
+        else
+            terms_in_lanes<false, kListed, false>(lanes, list, begin, end);
+    }
+}
+
 LANE_COPIES
 void face_terms_in_lanes(const FaceLanes &lanes, std::int64_t begin, std::int64_t end) {
-    if (lanes.squared)
-        terms_in_lanes<true, false>(lanes, nullptr, begin, end);
-    else
-        terms_in_lanes<false, false>(lanes, nullptr, begin, end);
+    terms_for_scene<false>(lanes, nullptr, begin, end);
 }
 
 LANE_COPIES
 void face_terms_in_lanes(const FaceLanes &lanes, const std::int64_t *faces, std::int64_t count) {
-    if (lanes.squared)
-        terms_in_lanes<true, true>(lanes, faces, 0, count);
-    else
-        terms_in_lanes<false, true>(lanes, faces, 0, count);
+    terms_for_scene<true>(lanes, faces, 0, count);
 }
 
 template <bool kListed>

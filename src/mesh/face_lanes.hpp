@@ -30,13 +30,17 @@ inline double beyond_round_off(double sum, double scale) {
 enum FaceRole : std::uint8_t { kCarriesNothing = 0, kCarries = 1, kAlongWall = 2 };
 
 // A plain scene: isotropic gradients, one angle of repose, no static angle,
-// no bed, no lazy source behind the heights, flux exponent 1 or 2.
+// no bed, flux exponent 1 or 2.
 struct FaceLanes {
     // The mesh (model/mesh.hpp).
     const std::int64_t *face_a, *face_b;
     const double *tangent_x, *tangent_y, *distance, *orthogonal, *skew, *conductance;
-    // The sub-step's heights and the cells' gradients.
+    // The sub-step's stored heights and the cells' gradients.
     const double *h, *gx, *gy;
+    // Lazy sources behind the stored heights (Heights in mesh/mesh_engine.cpp):
+    // a cell reads h + source_lag(q, dt, now - since). q null: none lags.
+    const double *q, *since;
+    double dt, now;
     double nu, tan_theta, tolerance;
     bool squared;  // flux exponent 2 (else 1)
     // What FaceLaw::terms writes, per face.

@@ -681,11 +681,12 @@ private:
             return t;
         };
         const bool lanes_run = in_lanes(law, s);
-        const FaceLanes term_lanes{m.face_a.data(),    m.face_b.data(),   m.tangent_x.data(), m.tangent_y.data(),
-                                   m.distance.data(),  m.orthogonal.data(), m.skew.data(),    m.conductance.data(),
-                                   law.h.h,            law.gx,            law.gy,             law.nu,
-                                   law.tan_theta,      law.tolerance,     law.p == 2.0,       low,
-                                   high,               pull,              excess,             steep};
+        const FaceLanes term_lanes{m.face_a.data(),   m.face_b.data(),     m.tangent_x.data(), m.tangent_y.data(),
+                                   m.distance.data(), m.orthogonal.data(), m.skew.data(),      m.conductance.data(),
+                                   law.h.h,           law.gx,              law.gy,             law.h.q,
+                                   law.h.since,       law.h.dt,            law.h.now,          law.nu,
+                                   law.tan_theta,     law.tolerance,       law.p == 2.0,       low,
+                                   high,              pull,                excess,             steep};
         const FlowLanes flow_lanes{m.face_a.data(),  m.face_b.data(),  law.carrying, m.pair_ax.data(), m.pair_ay.data(),
                                    m.pair_bx.data(), m.pair_by.data(), pull_x,       pull_y,           high};
         const LimitLanes limit_lanes{m.face_a.data(), m.face_b.data(), low, high, excess, limit_in, limit_out, flux};
@@ -1683,7 +1684,7 @@ private:
     // asks for FaceLaw::terms alone.
     static bool in_lanes(const FaceLaw &law, const MeshState &s) {
         return !s.switches.scalar_mesh && law.isotropic && !law.tan_field && !law.moving && !law.available &&
-               !law.h.q && (law.p == 1.0 || law.p == 2.0);
+               (law.p == 1.0 || law.p == 2.0);
     }
 
     // A face whose terms the lanes do not take (FaceLaw::terms does): on the
