@@ -1137,8 +1137,11 @@ static void plane_in_lanes(const mesh_scene *s, const lanes_scene *scene, int sc
         /* on two threads, wide enough that the lists are shared (kListItemsForThreads) */
         if (scene->bump)
             h[c] = 3.0 + fmax(0.0, (scene->threads > 1 ? 0.45 : 0.2) - 1.5 * hypot(s->cx[c] - 0.5, s->cy[c] + 0.1));
-        /* with a source, a pile just below the angle of repose */
+        /* with a source, a pile just below the angle of repose; or a flat
+         * shelf beside the plane, whose cells take no sub-step while the
+         * plane's keep the sub-steps dense */
         if (scene->bump && scene->source) h[c] = 3.0 + fmax(0.0, 0.2 - 0.55 * hypot(s->cx[c] - 0.5, s->cy[c] + 0.1));
+        if (!scene->bump && scene->source && s->cx[c] > 0.4) h[c] = 5.0;
         angle[c] = (28.0 + 4.0 * (double)(c % 3)) * kDeg;
         if (scene->cells && hypot(s->cx[c] - 0.3, s->cy[c] + 0.2) < 0.25) kinds[c] = DPSM_CELL_WALL;
         if (scene->cells && hypot(s->cx[c] + 0.6, s->cy[c] - 0.5) < 0.15) kinds[c] = DPSM_CELL_OPEN;
@@ -1202,7 +1205,7 @@ static void test_face_pass_in_lanes_same_bits(void **state) {
                                   "a bump, sparse",
                                   "a bump, sparse, walls, exponent 2",
                                   "a bump, sparse, two threads",
-                                  "sources",
+                                  "sources, a shelf lagging",
                                   "a bump, sparse, sources lagging"};
     for (int k = 0; k < 4; ++k)
         for (int n = 0; n < kScenes; ++n) {

@@ -660,6 +660,12 @@ private:
         SubstepSummary did;
 
         FaceLaw law = law_of(grid, heights_read(grid, s, dt, now), s.gx.data(), s.gy.data(), dt);
+        // Behind lazy sources a dense sub-step reads every cell's height,
+        // most of them many times (a gradient's stencil, a limiter's
+        // neighbours): it finds them once. The scalar reference reads them
+        // through the clocks.
+        const Heights lagging = law.h;
+        if (dense && lagging.q && !s.switches.scalar_mesh) law.h = heights_found_once(m, s, lagging, threads);
         if (!grid.bed().empty()) {
             prepare_bed(grid, m, s, dt, did);
             law.available = s.available.data();
@@ -668,7 +674,7 @@ private:
         double max_excess = 0.0;
         bool moved = false;
         const CellUpdate update_cell{m,        s.flux.data(), kind.data(), q, grid.bed(), h, residual, dt,
-                                     s.lazy ? &law.h : nullptr, s.since.data()};
+                                     s.lazy ? &lagging : nullptr, s.since.data()};
         double *low = s.low.data(), *high = s.high.data(), *pull = s.pull.data(), *flux = s.flux.data();
         double *pull_x = s.pull_x.data(), *pull_y = s.pull_y.data();
         double *limit_in = s.limit_in.data(), *limit_out = s.limit_out.data();
@@ -1481,6 +1487,16 @@ private:
         Heights hv{grid.heights_for_stepping().data()};
         if (s.lazy) hv.q = s.sand_source.data(), hv.since = s.since.data(), hv.dt = dt, hv.now = now;
         return hv;
+    }
+
+    // Every cell's height as `lagging` reads it, into s.heights_read.
+    static Heights heights_found_once(const Mesh &m, MeshState &s, const Heights &lagging, int threads) {
+        s.heights_read.resize(static_cast<std::size_t>(m.cells));
+        double *found = s.heights_read.data();
+        const bool parallel = threads_in_use(threads, m.cells) > 1;
+#pragma omp parallel for num_threads(threads) if (parallel) schedule(static)
+        for (std::int64_t c = 0; c < m.cells; ++c) found[c] = lagging[c];
+        return Heights{found};
     }
 
     // What the sources make of the mesh (after the host changed them, which
