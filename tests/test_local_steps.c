@@ -281,9 +281,10 @@ static void test_converges_to_the_global_sub_step(void **state) {
     }
 }
 
-/* Visiting every cell, and two threads, change no bit, wherever the column
- * (the straddling one also with a static angle), and find rest at the same
- * tick. */
+/* Visiting every cell, two threads, and the face passes in scalar code
+ * alone (DPSM_SCALAR_MESH: the ticks' passes in lanes are theirs bit for
+ * bit) change no bit, wherever the column (the straddling one also with a
+ * static angle), and find rest at the same tick. */
 static void test_same_bits_whatever_the_visits(void **state) {
     (void)state;
 #ifdef DPSM_TESTS_UNDER_ASAN
@@ -294,9 +295,11 @@ static void test_same_bits_whatever_the_visits(void **state) {
     for (int run = 0; run < runs; ++run) {
         const int kind = run % 3, hold = run >= 9;
         const pile *p = &kPiles[hold ? 2 : run / 3];
-        graded_mesh m[3];
+        enum { kRuns = 4 };
+        static const char *const kHow[kRuns] = {"", "visiting every cell", "two threads", "scalar face passes"};
+        graded_mesh m[kRuns];
         const double w = width_of(28, 8.0);
-        for (int k = 0; k < 3; ++k) {
+        for (int k = 0; k < kRuns; ++k) {
             m[k] = make_graded((graded_kind)kind, 28, 8.0);
             pour(&m[k], p->x * w, p->y * w, p->r * w, 0.5 * p->r * w);
             CHECK_OK(m[k].g, dpsm_set_relaxation(m[k].g, DPSM_RELAX_LOCAL_STEPS));
@@ -304,8 +307,8 @@ static void test_same_bits_whatever_the_visits(void **state) {
         }
         CHECK_OK(m[2].g, dpsm_set_threads(m[2].g, 2));
         const size_t n = (size_t)m[0].cells;
-        double *h[3];
-        for (int k = 0; k < 3; ++k) h[k] = malloc(sizeof(double) * n);
+        double *h[kRuns];
+        for (int k = 0; k < kRuns; ++k) h[k] = malloc(sizeof(double) * n);
         int rested = 0;
         double visits[2] = {0.0, 0.0};
         /* Calls in the flow, then one to rest and one after it (which finds
@@ -313,26 +316,30 @@ static void test_same_bits_whatever_the_visits(void **state) {
          * calls more, which start from few moving cells. */
         for (int call = 0; call < (hold ? 16 : 14); ++call) {
             if (call == 14) {
-                for (int k = 0; k < 3; ++k) {
+                for (int k = 0; k < kRuns; ++k) {
                     h[k][n / 2] += 0.2 * w;
                     CHECK_OK(m[k].g, dpsm_set_heights(m[k].g, h[k]));
                 }
             }
-            for (int k = 0; k < 3; ++k) {
+            for (int k = 0; k < kRuns; ++k) {
                 if (k == 1) setenv("DPSM_VISIT_ALL_CELLS", "1", 1);
+                if (k == 3) setenv("DPSM_SCALAR_MESH", "1", 1);
                 CHECK_OK(m[k].g, dpsm_step(m[k].g, call < 12 ? 3.0 : 1e4));
                 unsetenv("DPSM_VISIT_ALL_CELLS");
+                unsetenv("DPSM_SCALAR_MESH");
                 CHECK_OK(m[k].g, dpsm_get_heights(m[k].g, h[k]));
                 if (k < 2) visits[k] += step_info_of(m[k].g, DPSM_INFO_CELL_UPDATES);
             }
-            for (int k = 1; k < 3; ++k) {
-                REQUIRE(memcmp(h[0], h[k], sizeof(double) * n) == 0, "%s, %s column, call %d: %s changed the heights",
-                        kKindNames[kind], p->name, call, k == 1 ? "visiting every cell" : "two threads");
+            for (int k = 1; k < kRuns; ++k) {
+                for (size_t c = 0; c < n; ++c)
+                    REQUIRE(memcmp(&h[0][c], &h[k][c], sizeof(double)) == 0,
+                            "%s, %s column, call %d: %s changed cell %zu: %.17g, not %.17g", kKindNames[kind], p->name,
+                            call, kHow[k], c, h[k][c], h[0][c]);
                 /* Rest is found at the same tick however the ticks run. */
                 for (int item = DPSM_INFO_SUBSTEPS; item <= DPSM_INFO_AT_REST; ++item)
                     REQUIRE(step_info_of(m[0].g, item) == step_info_of(m[k].g, item),
                             "%s, %s column, call %d: %s gave step information %d = %g, not %g", kKindNames[kind],
-                            p->name, call, k == 1 ? "visiting every cell" : "two threads", item,
+                            p->name, call, kHow[k], item,
                             step_info_of(m[k].g, item), step_info_of(m[0].g, item));
             }
             if (call < 14 && step_info_of(m[0].g, DPSM_INFO_AT_REST) > 0.0) ++rested;
@@ -345,7 +352,7 @@ static void test_same_bits_whatever_the_visits(void **state) {
          * a sub-step with one visits every cell.) */
         REQUIRE(hold || visits[0] < visits[1], "%s, %s column: the calls visited %g cells, every cell %g", kKindNames[kind],
                 p->name, visits[0], visits[1]);
-        for (int k = 0; k < 3; ++k) free(h[k]), free_graded(&m[k]);
+        for (int k = 0; k < kRuns; ++k) free(h[k]), free_graded(&m[k]);
     }
 }
 

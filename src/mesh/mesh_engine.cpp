@@ -66,15 +66,18 @@ void for_each_item(const std::vector<std::int64_t> &list, int threads, const Wor
 // Calls work(items, count) for a share of a list a thread (the whole list
 // on one thread where it is short): the passes in lanes over a list.
 template <class Work>
-void for_each_share(const std::vector<std::int64_t> &list, int threads, const Work &work) {
-    const std::int64_t count = static_cast<std::int64_t>(list.size());
+void for_each_share(const std::int64_t *items, std::int64_t count, int threads, const Work &work) {
     const bool parallel = threads > 1 && count >= kListItemsForThreads;
     const int shares = parallel ? threads : 1;
 #pragma omp parallel for num_threads(threads) if (parallel) schedule(static)
     for (int r = 0; r < shares; ++r) {
         const std::int64_t begin = count * r / shares, end = count * (r + 1) / shares;
-        work(list.data() + begin, end - begin);
+        work(items + begin, end - begin);
     }
+}
+template <class Work>
+void for_each_share(const std::vector<std::int64_t> &list, int threads, const Work &work) {
+    for_each_share(list.data(), static_cast<std::int64_t>(list.size()), threads, work);
 }
 
 // The share of the room to its bounds a cell's limiter lets the gradient
@@ -687,15 +690,10 @@ private:
             return t;
         };
         const bool lanes_run = in_lanes(law, s);
-        const FaceLanes term_lanes{m.face_a.data(),   m.face_b.data(),     m.tangent_x.data(), m.tangent_y.data(),
-                                   m.distance.data(), m.orthogonal.data(), m.skew.data(),      m.conductance.data(),
-                                   law.h.h,           law.gx,              law.gy,             law.h.q,
-                                   law.h.since,       law.h.dt,            law.h.now,          law.nu,
-                                   law.tan_theta,     law.tolerance,       law.p == 2.0,       low,
-                                   high,              pull,                excess,             steep};
-        const FlowLanes flow_lanes{m.face_a.data(),  m.face_b.data(),  law.carrying, m.pair_ax.data(), m.pair_ay.data(),
-                                   m.pair_bx.data(), m.pair_by.data(), pull_x,       pull_y,           high};
-        const LimitLanes limit_lanes{m.face_a.data(), m.face_b.data(), low, high, excess, limit_in, limit_out, flux};
+        const PassLanes lanes = lanes_of(m, law, s);
+        const FaceLanes &term_lanes = lanes.terms;
+        const FlowLanes &flow_lanes = lanes.flow;
+        const LimitLanes &limit_lanes = lanes.limit;
 
         if (dense) {
             // The owned cells and the faces that touch them: all of a serial
@@ -1127,17 +1125,54 @@ private:
         double *limit_in = s.limit_in.data(), *limit_out = s.limit_out.data();
         std::uint8_t *steep = s.steep.data();
         // Face f's terms as amounts over its span.
+        const auto span_of = [&](std::int64_t f) {
+            return static_cast<double>(StepClasses::span(sc.face_class[f], j, n)) * sub_dt;
+        };
         const auto terms_of = [&](std::int64_t f) {
             const FaceTerms t = law.terms(f);
-            const double span = static_cast<double>(StepClasses::span(sc.face_class[f], j, n)) * sub_dt;
+            const double span = span_of(f);
             low[f] = t.low * span, high[f] = t.two_point * span, pull[f] = t.pull * span, excess[f] = t.excess;
             steep[f] = t.steep;
-            return t.steep;
         };
         const auto gradient = [&](std::int64_t c) { gradient_of(m, law.h, kind.data(), c, s.gx.data(), s.gy.data()); };
         const auto flow = [&](std::int64_t f) { high[f] = gradient_flow_flux(m, law, f, high[f], pull_x, pull_y); };
         const auto limit = [&](std::int64_t c) { limits_of(m, law, low, high, bed, c, limit_in, limit_out); };
         const auto limited = [&](std::int64_t f) { flux[f] = limited_flux(m, law, f, low[f], high[f], limit_in, limit_out); };
+        // The three face passes over a list of faces (each listed once), in
+        // lanes where a sub-step's would be: the faces' terms on a plain
+        // scene (those the lanes leave to FaceLaw::terms after them), the
+        // flow always, the limited flux without a bed; the terms then
+        // scaled to amounts as terms_of scales them.
+        const PassLanes lanes = lanes_of(m, law, s);
+        const bool terms_run = in_lanes(law, s), flow_run = !s.switches.scalar_mesh, limited_run = flow_run && !bed;
+        const auto terms_over = [&](const std::int64_t *faces, std::int64_t count) {
+            if (!terms_run) return for_each_item(faces, count, threads, terms_of);
+            for_each_share(faces, count, threads, [&](const std::int64_t *share, std::int64_t share_count) {
+                face_terms_in_lanes(lanes.terms, share, share_count);
+                for (std::int64_t k = 0; k < share_count; ++k) {
+                    const std::int64_t f = share[k];
+                    if (off_lanes(m, law.carrying, f)) {
+                        terms_of(f);
+                        continue;
+                    }
+                    const double span = span_of(f);
+                    low[f] = low[f] * span, high[f] = high[f] * span, pull[f] = pull[f] * span;
+                }
+            });
+        };
+        const auto flow_over = [&](const std::int64_t *faces, std::int64_t count) {
+            if (!flow_run) return for_each_item(faces, count, threads, flow);
+            for_each_share(faces, count, threads, [&](const std::int64_t *share, std::int64_t share_count) {
+                flow_fluxes_in_lanes(lanes.flow, share, share_count);
+            });
+        };
+        const auto limited_over = [&](const std::int64_t *faces, std::int64_t count) {
+            if (!limited_run) return for_each_item(faces, count, threads, limited);
+            for_each_share(faces, count, threads, [&](const std::int64_t *share, std::int64_t share_count) {
+                limited_fluxes_in_lanes(lanes.limit, share, share_count);
+            });
+        };
+        const auto count_of = [](const std::vector<std::int64_t> &list) { return static_cast<std::int64_t>(list.size()); };
         const auto carried = [&](std::int64_t f) {
             if (flux[f] == 0.0) return false;
             did.moved = true;
@@ -1169,13 +1204,13 @@ private:
                     watch_near_moves(m, s, changed_ghosts);
                 }
             }
-            for_each_item(firing, firing_n, threads, terms_of);
+            terms_over(firing, firing_n);
             for_each_item(reading, reading_n, threads, [&](std::int64_t c) { pull_of(m, law, pull, c, pull_x, pull_y); });
             if (parts) take_every_ghosts_pull(m, s);
-            for_each_item(carrying, carrying_n, threads, flow);
+            flow_over(carrying, carrying_n);
             for_each_item(taking, taking_n, threads, limit);
             if (parts) exchange_ghost_limits(s);
-            for_each_item(carrying, carrying_n, threads, limited);
+            limited_over(carrying, carrying_n);
             for (std::int64_t k = 0; k < carrying_n; ++k) carried(carrying[k]);
             std::uint8_t *changed = s.carried.data();
             for_each_item(taking, taking_n, threads, [&](std::int64_t c) {
@@ -1260,10 +1295,11 @@ private:
             }
             std::vector<std::uint8_t> &became_steep = s.became_steep;
             became_steep.resize(s.faces.size());
-            for_each_place(s.faces, threads, [&](std::int64_t k, std::int64_t f) {
-                const bool was = steep[f] != 0;
-                became_steep[static_cast<std::size_t>(k)] = terms_of(f) && !was;
-            });
+            // Whether each face was steep, before its terms write its flag.
+            for (std::size_t k = 0; k < s.faces.size(); ++k) became_steep[k] = steep[s.faces[k]];
+            terms_over(s.faces.data(), count_of(s.faces));
+            for (std::size_t k = 0; k < s.faces.size(); ++k)
+                became_steep[k] = steep[s.faces[k]] && !became_steep[k];
             for (std::size_t k = 0; k < s.faces.size(); ++k)
                 if (became_steep[k]) s.steep_by_level[sc.face_class[s.faces[k]]].push_back(s.faces[k]);
             // Each due steep face once; those not looked at fire as they are.
@@ -1280,7 +1316,7 @@ private:
                 listed.resize(kept);
                 for (const std::int64_t f : listed) steep[f] = 1;
             }
-            for_each_item(due, threads, terms_of);
+            terms_over(due.data(), count_of(due));
             // The due steep faces: their cells pull.
             due.clear();
             for (int l = 0; l <= level; ++l)
@@ -1302,11 +1338,11 @@ private:
                 for (const std::int64_t c : *cells)
                     for (std::int64_t k = m.cell_face_start[c]; k < m.cell_face_start[c + 1]; ++k) carry(m.cell_faces[k]);
             s.faces.swap(faces);
-            for_each_item(s.faces, threads, flow);
+            flow_over(s.faces.data(), count_of(s.faces));
             owned_cells_of(m, s, s.faces, s.limit_cells);
             for_each_item(s.limit_cells, threads, limit);
             if (parts) exchange_ghost_limits(s);
-            for_each_item(s.faces, threads, limited);
+            limited_over(s.faces.data(), count_of(s.faces));
             list_updates(m, s, did.moved, did.max_excess_slope);
             for_each_item(s.update_cells, threads, [&](std::int64_t c) { update_cell(c); });
             visited = cells_visited(s);
@@ -1701,6 +1737,26 @@ private:
     static bool in_lanes(const FaceLaw &law, const MeshState &s) {
         return !s.switches.scalar_mesh && law.isotropic && !law.tan_field && !law.moving && !law.available &&
                (law.p == 1.0 || law.p == 2.0);
+    }
+
+    // The three face passes' lanes over sub-step law `law`'s view and the state's values.
+    struct PassLanes {
+        FaceLanes terms;
+        FlowLanes flow;
+        LimitLanes limit;
+    };
+    static PassLanes lanes_of(const Mesh &m, const FaceLaw &law, MeshState &s) {
+        double *low = s.low.data(), *high = s.high.data(), *pull = s.pull.data(), *excess = s.excess.data();
+        double *pull_x = s.pull_x.data(), *pull_y = s.pull_y.data();
+        return PassLanes{
+            FaceLanes{m.face_a.data(), m.face_b.data(), m.tangent_x.data(), m.tangent_y.data(), m.distance.data(),
+                      m.orthogonal.data(), m.skew.data(), m.conductance.data(), law.h.h, law.gx, law.gy, law.h.q,
+                      law.h.since, law.h.dt, law.h.now, law.nu, law.tan_theta, law.tolerance, law.p == 2.0, low,
+                      high, pull, excess, s.steep.data()},
+            FlowLanes{m.face_a.data(), m.face_b.data(), law.carrying, m.pair_ax.data(), m.pair_ay.data(),
+                      m.pair_bx.data(), m.pair_by.data(), pull_x, pull_y, high},
+            LimitLanes{m.face_a.data(), m.face_b.data(), low, high, excess, s.limit_in.data(), s.limit_out.data(),
+                       s.flux.data()}};
     }
 
     // A face whose terms the lanes do not take (FaceLaw::terms does): on the
