@@ -668,7 +668,7 @@ private:
         // neighbours): it finds them once. The scalar reference reads them
         // through the clocks.
         const Heights lagging = law.h;
-        if (dense && lagging.q && !s.switches.scalar_mesh) law.h = heights_found_once(m, s, lagging, threads);
+        if (dense && lagging.q && !s.switches.scalar_mesh) law.h = heights_found_once(m, lagging, threads, s.heights_read);
         if (!grid.bed().empty()) {
             prepare_bed(grid, m, s, dt, did);
             law.available = s.available.data();
@@ -1525,10 +1525,11 @@ private:
         return hv;
     }
 
-    // Every cell's height as `lagging` reads it, into s.heights_read.
-    static Heights heights_found_once(const Mesh &m, MeshState &s, const Heights &lagging, int threads) {
-        s.heights_read.resize(static_cast<std::size_t>(m.cells));
-        double *found = s.heights_read.data();
+    // Every cell's height as `lagging` reads it, into `into`.
+    static Heights heights_found_once(const Mesh &m, const Heights &lagging, int threads, std::vector<double> &into) {
+        if (!lagging.q) return lagging;
+        into.resize(static_cast<std::size_t>(m.cells));
+        double *found = into.data();
         const bool parallel = threads_in_use(threads, m.cells) > 1;
 #pragma omp parallel for num_threads(threads) if (parallel) schedule(static)
         for (std::int64_t c = 0; c < m.cells; ++c) found[c] = lagging[c];
@@ -1588,11 +1589,17 @@ private:
         for (std::vector<double> *v : {&s.look_gx, &s.look_gy, &s.look_gx_later, &s.look_gy_later}) v->resize(n, 0.0);
         s.look_steep.resize(static_cast<std::size_t>(m.faces), 0);
         const std::uint8_t *kind = grid.kinds().data();
-        const FaceLaw at_first = law_of(grid, heights_read(grid, s, dt, first), s.look_gx.data(), s.look_gy.data(), dt);
-        const FaceLaw at_second =
+        FaceLaw at_first = law_of(grid, heights_read(grid, s, dt, first), s.look_gx.data(), s.look_gy.data(), dt);
+        FaceLaw at_second =
             law_of(grid, heights_read(grid, s, dt, second), s.look_gx_later.data(), s.look_gy_later.data(), dt);
         const int threads = grid.step_threads();
         const bool both = first >= 0.0;
+        // The look reads most cells' heights many times (gradients' stencils,
+        // faces): it finds them once at each time, as a dense sub-step does.
+        if (!s.switches.scalar_mesh) {
+            at_second.h = heights_found_once(m, at_second.h, threads, s.heights_read);
+            if (both) at_first.h = heights_found_once(m, at_first.h, threads, s.heights_read_earlier);
+        }
         const auto gradients = [&](std::int64_t c) {
             if (both) gradient_of(m, at_first.h, kind, c, s.look_gx.data(), s.look_gy.data());
             gradient_of(m, at_second.h, kind, c, s.look_gx_later.data(), s.look_gy_later.data());

@@ -109,8 +109,9 @@ struct MeshState final : EngineState {
     double lazy_substeps = 0.0;  // the step's sub-steps, over which the sources act
     std::vector<double> since;
     // A dense sub-step's heights as its passes read them, found once (the
-    // same bits as reading them through the clocks).
-    std::vector<double> heights_read;
+    // same bits as reading them through the clocks); and a look under the
+    // sources' at its two times.
+    std::vector<double> heights_read, heights_read_earlier;
     std::vector<std::uint8_t> watch;
     std::vector<std::int64_t> watched_cells, moved_cells;
     // A sub-step moved sand since the last look at whether a source may
