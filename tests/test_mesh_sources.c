@@ -17,7 +17,8 @@
  *    next, whatever that call's source;
  *  - a source of 1e-300 takes the sub-steps of none, and dt = 1e12 with it
  *    is accepted;
- *  - only a source that makes a face steep is held to dpsm_set_max_substeps.
+ *  - only a source that makes a face steep is held to dpsm_set_max_substeps;
+ *  - two threads give the bits of one.
  * On triangles, hexagons, the median dual and quadrilaterals. */
 #include <math.h>
 #include <setjmp.h>
@@ -378,6 +379,52 @@ static void test_negligible_source_costs_nothing(void **state) {
 
 /* Only a source that makes a face steep within the step can keep sand
  * flowing, so only it is held to dpsm_set_max_substeps(). */
+/* On two threads the sources' catch-up at a step's end is shared between
+ * them (from 32,768 source cells): the same heights, ledger and cell
+ * updates bit for bit as on one, a call after a call, while a bump slides
+ * under a source on every cell. */
+static void test_two_threads_the_same_bits(void **state) {
+    (void)state;
+    mesh_scene s = scene_make(SCENE_TRIANGLES, 130, 2.5, 11u);
+    double *h = calloc((size_t)s.cells, sizeof(double)), *q = calloc((size_t)s.cells, sizeof(double));
+    for (int64_t c = 0; c < s.cells; ++c) {
+        h[c] = 3.0 + fmax(0.0, 0.4 - 1.5 * hypot(s.cx[c] - 0.5, s.cy[c] + 0.1));
+        q[c] = 0.01 + 0.003 * sin(3.0 * s.cx[c]) * cos(2.0 * s.cy[c]);
+    }
+    dpsm_grid *g[2] = {NULL, NULL};
+    double *out[2];
+    for (int t = 0; t < 2; ++t) {
+        CHECK_OK(NULL, scene_create(&s, &g[t]));
+        CHECK_OK(g[t], dpsm_set_repose_angle(g[t], 30.0 * kDeg));
+        CHECK_OK(g[t], dpsm_set_threads(g[t], t + 1));
+        CHECK_OK(g[t], dpsm_set_heights(g[t], h));
+        CHECK_OK(g[t], dpsm_set_source(g[t], q));
+        out[t] = calloc((size_t)s.cells, sizeof(double));
+    }
+    double dt = 0.0;
+    CHECK_OK(g[0], dpsm_stable_dt(g[0], &dt));
+    for (int call = 0; call < 4; ++call) {
+        double updates[2];
+        for (int t = 0; t < 2; ++t) {
+            CHECK_OK(g[t], dpsm_step(g[t], 6.0 * dt));
+            CHECK_OK(g[t], dpsm_get_heights(g[t], out[t]));
+            CHECK_OK(g[t], dpsm_get_step_info(g[t], DPSM_INFO_CELL_UPDATES, &updates[t]));
+        }
+        for (int64_t c = 0; c < s.cells; ++c)
+            REQUIRE(memcmp(&out[0][c], &out[1][c], sizeof(double)) == 0,
+                    "call %d, cell %lld: %.17g on one thread, %.17g on two", call, (long long)c, out[0][c], out[1][c]);
+        REQUIRE(updates[0] == updates[1], "call %d: %g cell updates on one thread, %g on two", call, updates[0],
+                updates[1]);
+        REQUIRE(updates[0] >= (double)s.cells, "call %d: %g cell updates, fewer than the %lld source cells", call,
+                updates[0], (long long)s.cells);
+        const double total[2] = {mass_of(g[0], DPSM_MASS_TOTAL), mass_of(g[1], DPSM_MASS_TOTAL)};
+        REQUIRE(memcmp(&total[0], &total[1], sizeof(double)) == 0, "call %d: the ledgers differ", call);
+    }
+    for (int t = 0; t < 2; ++t) dpsm_destroy(g[t]), free(out[t]);
+    free(h), free(q);
+    scene_free(&s);
+}
+
 static void test_work_limit_only_for_a_driving_source(void **state) {
     (void)state;
     mesh_scene s = scene_make(SCENE_TRIANGLES, 16, 2.5, 2u);
@@ -419,6 +466,7 @@ int main(void) {
         cmocka_unit_test(test_steep_at_a_call_end_slides_in_the_next),
         cmocka_unit_test(test_negligible_source_costs_nothing),
         cmocka_unit_test(test_work_limit_only_for_a_driving_source),
+        cmocka_unit_test(test_two_threads_the_same_bits),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

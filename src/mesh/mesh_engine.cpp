@@ -1715,17 +1715,25 @@ private:
         std::vector<double> &h = grid.heights_for_stepping();
         std::vector<float> &residual = grid.residuals_for_stepping();
         const bool ghosts_here = s.exchange && steps_ghosts(grid);
-        double changed = 0.0;
+        const int threads = grid.step_threads();
+        std::int64_t changed = 0;
         for (const std::vector<std::int64_t> *list : {&s.source_cells, &s.ghost_source_cells}) {
             if (list == &s.ghost_source_cells && !ghosts_here) break;
-            for (const std::int64_t c : *list) {
+            const std::int64_t count = static_cast<std::int64_t>(list->size()), *cells = list->data();
+            const bool owned = list == &s.source_cells;
+            std::int64_t taken = 0;
+            // Each cell its own: the same bits on any number of threads.
+#pragma omp parallel for num_threads(threads) if (threads_in_use(threads, count) > 1) schedule(static) reduction(+ : taken)
+            for (std::int64_t k = 0; k < count; ++k) {
+                const std::int64_t c = cells[k];
                 const double lag = source_lag(s.sand_source[c], dt, s.lazy_substeps - s.since[c]);
                 if (lag != 0.0) {
                     add_with_residual(h[c], residual[c], lag);
-                    if (list == &s.source_cells) changed += 1.0;
+                    ++taken;
                 }
                 s.since[c] = 0.0;
             }
+            if (owned) changed += taken;
         }
         if (s.exchange && !ghosts_here) {
             std::vector<std::int64_t> &changed_ghosts = s.changed_ghosts;
@@ -1735,7 +1743,7 @@ private:
         }
         forget_watches(s);
         s.lazy = false;
-        return changed;
+        return static_cast<double>(changed);
     }
 
     // Whether the faces' terms run in lanes (mesh/face_lanes.hpp), over every
