@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include "model/ledger.hpp"
+
 // Clang builds the plain copy alone, for the baseline instructions, where
 // the gathers have no lanes: the pragmas are hints there, not demands.
 #if defined(__clang__)
@@ -48,9 +50,9 @@ __attribute__((always_inline)) inline void terms_in_lanes(const FaceLanes &lanes
         const double tangential =
             0.5 * ((gx[a] + gx[b]) * tangent_x[f] + (gy[a] + gy[b]) * tangent_y[f]);
         const double distance = distances[f];
-        // source_lag (model/ledger.hpp), as Heights reads it.
-        const double ha = kLagged ? h[a] + (q[a] * dt) * (now - since[a]) : h[a];
-        const double hb = kLagged ? h[b] + (q[b] * dt) * (now - since[b]) : h[b];
+        // As Heights reads them.
+        const double ha = kLagged ? h[a] + source_lag(q[a], dt, now - since[a]) : h[a];
+        const double hb = kLagged ? h[b] + source_lag(q[b], dt, now - since[b]) : h[b];
         const double normal = (ha - hb) / distance;
         const double s = std::sqrt(normal * normal + tangential * tangential);
         const bool is_steep = s > threshold;

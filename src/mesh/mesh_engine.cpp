@@ -1594,9 +1594,13 @@ private:
             law_of(grid, heights_read(grid, s, dt, second), s.look_gx_later.data(), s.look_gy_later.data(), dt);
         const int threads = grid.step_threads();
         const bool both = first >= 0.0;
-        // The look reads most cells' heights many times (gradients' stencils,
-        // faces): it finds them once at each time, as a dense sub-step does.
-        if (!s.switches.scalar_mesh) {
+        // Where the look reads most cells' heights, many times each
+        // (gradients' stencils, faces), it finds them once at each time, as a
+        // dense sub-step does; a few source cells are not worth a pass over all.
+        const bool every_owned_cell = s.exchange && !steps_ghosts(grid);
+        const bool most_cells = every_owned_cell || static_cast<double>(s.source_face_cells.size()) >
+                                                        dense_share(threads, m.owned) * static_cast<double>(m.owned);
+        if (most_cells && !s.switches.scalar_mesh) {
             at_second.h = heights_found_once(m, at_second.h, threads, s.heights_read);
             if (both) at_first.h = heights_found_once(m, at_first.h, threads, s.heights_read_earlier);
         }
@@ -1605,7 +1609,7 @@ private:
             gradient_of(m, at_second.h, kind, c, s.look_gx_later.data(), s.look_gy_later.data());
         };
         if (at_first.isotropic) {
-            if (s.exchange && !steps_ghosts(grid)) {
+            if (every_owned_cell) {
                 // Every owned cell: a ghost's owner reads the gradient of the cell across their face.
                 const std::int64_t owned = m.owned;
 #pragma omp parallel for num_threads(threads) if (threads_in_use(threads, owned) > 1) schedule(static)
