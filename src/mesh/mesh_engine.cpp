@@ -25,8 +25,9 @@ constexpr std::int64_t kCellsForThreads = 32768;
 // thread, runs the plain passes over every cell: the lists would cost more
 // than they save. A cell on the lists costs about three cells of the plain
 // passes (measured on the column collapse: 2.5 times at 16k cells, 3.5 at
-// 65k), and the lists run on one thread while the plain passes share the
-// threads, so with more threads the share falls in proportion.
+// 65k), and the lists are read out on one thread (mesh/index_set.hpp) while
+// the plain passes share the threads, so with more threads the share falls
+// in proportion.
 constexpr double kDenseShareOnOneThread = 0.25;
 
 // The threads a pass over every cell of `cells` runs on.
@@ -834,7 +835,7 @@ private:
             s.faces.clear();
             s.gradient_cells.clear();
             const auto look_at_faces_of = [&](std::int64_t c) { look_at_faces(m, s, c, stamp, nullptr, 0); };
-            for (const std::int64_t c : act.hot_list) look_at_faces_of(c);
+            look_at_faces_of_hot(m, s, stamp, exchanges, threads);
             clear_passes(m, s);
             if (law.isotropic) {
                 for_each_item(s.gradient_cells, threads,
@@ -851,56 +852,43 @@ private:
             // The steep faces: those looked at again as they are now, the others as they were.
             list_steep_faces(m, s);
             std::vector<std::int64_t> &steep_faces = s.steep_faces;
-            std::vector<std::uint8_t> &became_steep = s.became_steep;
-            became_steep.resize(s.faces.size());
-            if (lanes_run) {
-                // Whether each face was steep, before the lanes write its flag.
-                for (std::size_t k = 0; k < s.faces.size(); ++k) became_steep[k] = steep[s.faces[k]];
+            if (lanes_run)
                 for_each_share(s.faces, threads, [&](const std::int64_t *faces, std::int64_t count) {
                     face_terms_in_lanes(term_lanes, faces, count);
                     for (std::int64_t k = 0; k < count; ++k)
                         if (off_lanes(m, law.carrying, faces[k])) face_terms(faces[k]);
                 });
-                for (std::size_t k = 0; k < s.faces.size(); ++k)
-                    became_steep[k] = steep[s.faces[k]] && !became_steep[k];
-            } else {
-                for_each_place(s.faces, threads, [&](std::int64_t k, std::int64_t f) {
-                    const bool was = steep[f] != 0;
-                    became_steep[static_cast<std::size_t>(k)] = face_terms(f).steep && !was;
+            else
+                for_each_item(s.faces, threads, face_terms);
+            // Each steep face once, in face order: those of the list still
+            // steep (a face looked at may have turned flat) and those looked
+            // at that are.
+            s.face_set.reserve(m.faces);
+            for (const std::vector<std::int64_t> *list : {&steep_faces, &s.faces})
+                for_each_item(*list, threads, [&](std::int64_t f) {
+                    if (steep[f]) s.face_set.add(f);
                 });
-            }
-            for (std::size_t k = 0; k < s.faces.size(); ++k)
-                if (became_steep[k]) steep_faces.push_back(s.faces[k]);
-            // Each steep face once (a face that turned flat in a sub-step
-            // that did not look at it may be listed twice): kept faces are
-            // marked 2 while the list is read.
-            std::size_t kept = 0;
-            for (const std::int64_t f : steep_faces)
-                if (steep[f] == 1) steep[f] = 2, steep_faces[kept++] = f;
-            steep_faces.resize(kept);
-            for (const std::int64_t f : steep_faces) steep[f] = 1;
+            steep_faces.clear();
+            s.face_set.take(steep_faces);
             // The steep faces not looked at again: as they were, with this sub-step's terms.
             for_each_item(steep_faces, threads, [&](std::int64_t f) {
                 if (s.face_seen[f] != stamp) face_terms(f);
             });
             // Pulls: the owned cells of steep faces.
-            owned_cells_of(m, s, steep_faces, s.pull_cells);
+            owned_cells_of(m, s, steep_faces, s.pull_cells, threads);
             for_each_item(s.pull_cells, threads, [&](std::int64_t c) { pull_of(m, law, pull, c, pull_x, pull_y); });
             if (exchanges) list_pulling_ghosts(s);
             // The gradient flow's flux: the steep faces and the faces of the pulling cells.
-            const std::uint32_t carrying = next_stamp(s);
             s.faces.clear();
-            const auto carry = [&](std::int64_t f) {
-                if (f >= m.live_faces || s.face_seen[f] == carrying) return;
-                s.face_seen[f] = carrying;
-                s.faces.push_back(f);
-            };
+            s.face_set.reserve(m.faces);
             const auto carry_faces_of = [&](std::int64_t c) {
-                for (std::int64_t k = m.cell_face_start[c]; k < m.cell_face_start[c + 1]; ++k) carry(m.cell_faces[k]);
+                for (std::int64_t k = m.cell_face_start[c]; k < m.cell_face_start[c + 1]; ++k)
+                    if (m.cell_faces[k] < m.live_faces) s.face_set.add(m.cell_faces[k]);
             };
-            for (const std::int64_t f : steep_faces) carry(f);
-            for (const std::int64_t c : s.pull_cells) carry_faces_of(c);
+            for_each_item(steep_faces, threads, [&](std::int64_t f) { s.face_set.add(f); });
+            for_each_item(s.pull_cells, threads, carry_faces_of);
             for (const std::int64_t c : s.pulling_ghosts) carry_faces_of(c);
+            s.face_set.take(s.faces);
             if (!s.switches.scalar_mesh)
                 for_each_share(s.faces, threads, [&](const std::int64_t *faces, std::int64_t count) {
                     flow_fluxes_in_lanes(flow_lanes, faces, count);
@@ -909,7 +897,7 @@ private:
                 for_each_item(s.faces, threads,
                               [&](std::int64_t f) { high[f] = gradient_flow_flux(m, law, f, high[f], pull_x, pull_y); });
             // Limiters: the owned cells of those faces.
-            owned_cells_of(m, s, s.faces, s.limit_cells);
+            owned_cells_of(m, s, s.faces, s.limit_cells, threads);
             for_each_item(s.limit_cells, threads,
                           [&](std::int64_t c) { limits_of(m, law, low, high, bed, c, limit_in, limit_out); });
             if (exchanges) exchange_ghost_limits(s);
@@ -921,16 +909,24 @@ private:
                 for_each_item(s.faces, threads, [&](std::int64_t f) {
                     flux[f] = limited_flux(m, law, f, low[f], high[f], limit_in, limit_out);
                 });
-            list_updates(m, s, moved, max_excess);
+            list_updates(m, s, moved, max_excess, threads);
             for_each_item(s.update_cells, threads, [&](std::int64_t c) { update_cell(c); });
-            visited = cells_visited(s);
+            visited = cells_visited(m, s, threads);
             if (exchanges) exchange_ghost_heights(grid, s, &s.update_cells, changed_ghosts);
             watch_near_moves(m, s, s.update_cells);
             watch_near_moves(m, s, changed_ghosts);
+            // The next sub-step's hot cells (MeshActivity::wake_around), woken on the threads.
             act.cool_all();
-            for (const std::int64_t c : s.update_cells) act.wake_around(m, c);
-            for (const std::int64_t c : changed_ghosts) act.wake_around(m, c);
-            if (s.lazy) wake_what_sources_keep_hot(m, s, false);  // else the sources' cells are among those updated
+            s.cell_set.reserve(m.cells);
+            const auto wake_around = [&](std::int64_t c) {
+                s.cell_set.add(c);
+                for (std::int64_t k = m.grad_start[c]; k < m.grad_start[c + 1]; ++k) s.cell_set.add(m.grad_cells[k]);
+            };
+            for_each_item(s.update_cells, threads, wake_around);
+            for (const std::int64_t c : changed_ghosts) wake_around(c);
+            if (s.lazy)  // else the sources' cells are among those updated
+                for_each_item(s.watched_cells, threads, [&](std::int64_t c) { s.cell_set.add(c); });
+            act.wake_set(s.cell_set);
             for (const std::int64_t c : s.pull_cells) pull_x[c] = pull_y[c] = 0.0;
             for (const std::int64_t c : s.limit_cells) limit_in[c] = limit_out[c] = 1.0;
         }
@@ -982,6 +978,27 @@ private:
         }
     }
 
+    // look_at_faces for every hot cell: the faces in face order, their cells
+    // in cell order; the cells marked with the stamp too where more will be
+    // looked at (a part's ghosts).
+    static void look_at_faces_of_hot(const Mesh &m, MeshState &s, std::uint32_t stamp, bool more, int threads) {
+        s.face_set.reserve(m.faces);
+        s.cell_set.reserve(m.cells);
+        for_each_item(s.activity.hot_list, threads, [&](std::int64_t c) {
+            for (std::int64_t k = m.cell_face_start[c]; k < m.cell_face_start[c + 1]; ++k)
+                if (m.cell_faces[k] < m.live_faces) s.face_set.add(m.cell_faces[k]);
+        });
+        s.face_set.take(s.faces);
+        for_each_item(s.faces, threads, [&](std::int64_t f) {
+            s.face_seen[f] = stamp;
+            for (const std::int64_t e : {m.face_a[f], m.face_b[f]})
+                if (e >= 0 && e < m.owned) s.cell_set.add(e);
+        });
+        s.cell_set.take(s.gradient_cells);
+        if (more)
+            for (const std::int64_t c : s.gradient_cells) s.cell_seen[c] = stamp;
+    }
+
     // On a part, after every owned cell's pull: the ghosts' pulls from
     // their owners, and every ghost that pulls.
     static void take_every_ghosts_pull(const Mesh &m, MeshState &s) {
@@ -1028,49 +1045,51 @@ private:
 
     // The owned cells of `faces`, each once, into `cells`.
     static void owned_cells_of(const Mesh &m, MeshState &s, const std::vector<std::int64_t> &faces,
-                               std::vector<std::int64_t> &cells) {
-        const std::uint32_t listed = next_stamp(s);
+                               std::vector<std::int64_t> &cells, int threads) {
         cells.clear();
-        for (const std::int64_t f : faces)
+        s.cell_set.reserve(m.cells);
+        for_each_item(faces, threads, [&](std::int64_t f) {
             for (const std::int64_t e : {m.face_a[f], m.face_b[f]})
-                if (e >= 0 && e < m.owned && s.cell_seen[e] != listed) {
-                    s.cell_seen[e] = listed;
-                    cells.push_back(e);
-                }
+                if (e >= 0 && e < m.owned) s.cell_set.add(e);
+        });
+        s.cell_set.take(cells);
     }
 
     // The cells a sparse sub-step updates, each once, into update_cells: the
     // owned cells of its faces that carried sand and, with sources at every
     // sub-step (not lazy), every source cell; whether a face carried sand,
     // and the largest excess slope of those that did.
-    static void list_updates(const Mesh &m, MeshState &s, bool &moved, double &max_excess) {
-        const std::uint32_t listed = next_stamp(s);
+    static void list_updates(const Mesh &m, MeshState &s, bool &moved, double &max_excess, int threads) {
         s.update_cells.clear();
-        const auto to_update = [&](std::int64_t c) {
-            if (c < m.owned && s.cell_seen[c] != listed) {
-                s.cell_seen[c] = listed;
-                s.update_cells.push_back(c);
-            }
-        };
-        for (const std::int64_t f : s.faces) {
+        s.cell_set.reserve(m.cells);
+        const std::int64_t count = static_cast<std::int64_t>(s.faces.size());
+        const std::int64_t *faces = s.faces.data();
+        bool any = false;
+        double largest = max_excess;
+        const bool parallel = threads > 1 && count >= kListItemsForThreads;
+#pragma omp parallel for num_threads(threads) if (parallel) schedule(static) reduction(|| : any) reduction(max : largest)
+        for (std::int64_t k = 0; k < count; ++k) {
+            const std::int64_t f = faces[k];
             if (s.flux[f] == 0.0) continue;
-            moved = true;
-            max_excess = std::max(max_excess, s.excess[f]);
+            any = true;
+            largest = std::max(largest, s.excess[f]);
             for (const std::int64_t e : {m.face_a[f], m.face_b[f]})
-                if (e >= 0) to_update(e);
+                if (e >= 0 && e < m.owned) s.cell_set.add(e);
         }
         if (!s.lazy)
-            for (const std::int64_t c : s.source_cells) to_update(c);
+            for (const std::int64_t c : s.source_cells)
+                if (c < m.owned) s.cell_set.add(c);
+        s.cell_set.take(s.update_cells);
+        moved = moved || any;
+        max_excess = largest;
     }
 
     // The cells a sparse sub-step's passes read or wrote, each once.
-    static double cells_visited(MeshState &s) {
-        const std::uint32_t counted = next_stamp(s);
-        double cells = 0.0;
+    static double cells_visited(const Mesh &m, MeshState &s, int threads) {
+        s.cell_set.reserve(m.cells);
         for (const std::vector<std::int64_t> *list : {&s.gradient_cells, &s.pull_cells, &s.limit_cells, &s.update_cells})
-            for (const std::int64_t c : *list)
-                if (s.cell_seen[c] != counted) s.cell_seen[c] = counted, cells += 1.0;
-        return cells;
+            for_each_item(*list, threads, [&](std::int64_t c) { s.cell_set.add(c); });
+        return static_cast<double>(s.cell_set.take_count());
     }
 
     // What went into sinks in a sub-step, face by face in one order whatever
@@ -1322,7 +1341,7 @@ private:
             for (int l = 0; l <= level; ++l)
                 for (const std::int64_t f : s.steep_by_level[static_cast<std::size_t>(l)])
                     if (steep[f]) due.push_back(f);
-            owned_cells_of(m, s, due, s.pull_cells);
+            owned_cells_of(m, s, due, s.pull_cells, threads);
             for_each_item(s.pull_cells, threads, [&](std::int64_t c) { pull_of(m, law, pull, c, pull_x, pull_y); });
             if (parts) list_pulling_ghosts(s);
             const std::uint32_t carrying = next_stamp(s);
@@ -1339,13 +1358,13 @@ private:
                     for (std::int64_t k = m.cell_face_start[c]; k < m.cell_face_start[c + 1]; ++k) carry(m.cell_faces[k]);
             s.faces.swap(faces);
             flow_over(s.faces.data(), count_of(s.faces));
-            owned_cells_of(m, s, s.faces, s.limit_cells);
+            owned_cells_of(m, s, s.faces, s.limit_cells, threads);
             for_each_item(s.limit_cells, threads, limit);
             if (parts) exchange_ghost_limits(s);
             limited_over(s.faces.data(), count_of(s.faces));
-            list_updates(m, s, did.moved, did.max_excess_slope);
+            list_updates(m, s, did.moved, did.max_excess_slope, threads);
             for_each_item(s.update_cells, threads, [&](std::int64_t c) { update_cell(c); });
-            visited = cells_visited(s);
+            visited = cells_visited(m, s, threads);
             if (parts) exchange_ghost_heights(grid, s, &s.update_cells, changed_ghosts);
             watch_near_moves(m, s, s.update_cells);
             watch_near_moves(m, s, changed_ghosts);

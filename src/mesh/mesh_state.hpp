@@ -8,6 +8,7 @@
 #include <memory>
 #include <vector>
 
+#include "mesh/index_set.hpp"
 #include "mesh/ghost_exchange.hpp"
 #include "mesh/step_classes.hpp"
 #include "model/engine.hpp"
@@ -48,6 +49,11 @@ struct MeshActivity {
         wake(c);
         for (std::int64_t k = mesh.grad_start[c]; k < mesh.grad_start[c + 1]; ++k) wake(mesh.grad_cells[k]);
     }
+    // After cool_all: the cells of a set hot, listed in cell order (the set empties).
+    void wake_set(IndexSet &woken) {
+        woken.take(hot_list);
+        for (const std::int64_t c : hot_list) hot[c] = 1;
+    }
     bool may_move() const { return all_hot || !hot_list.empty(); }
 };
 
@@ -83,6 +89,7 @@ struct MeshState final : EngineState {
     std::vector<std::int64_t> pull_cells, limit_cells;
     std::vector<std::int64_t> pulling_ghosts;  // a part's ghosts whose pulls are not 0
     std::vector<std::uint32_t> face_seen, cell_seen;
+    IndexSet cell_set, face_set;  // the sparse passes' lists, built in index order
     std::uint32_t stamp = 0;
     std::vector<std::int64_t> faces, gradient_cells, update_cells;
     std::vector<std::int64_t> changed_ghosts;  // a part's ghosts whose owners sent new values
