@@ -5,10 +5,12 @@
 // it ("the owned cells of these faces"), listed in increasing order: in the
 // mesh's Hilbert order, so that the passes over the list read memory near
 // where they read last. A byte marks each index and a byte each block of
-// indices, so that listing reads only the blocks something was added to.
+// 512 indices, so that listing reads only the blocks something was added to.
 // Adding from several threads at once is safe (relaxed atomic stores of the
-// same value); listing empties the set.
+// same value); listing empties the set, the blocks shared between the
+// threads in order, so that the list is the same on any number of them.
 
+#include <algorithm>
 #include <cstdint>
 #include <cstring>
 #include <vector>
@@ -33,38 +35,82 @@ public:
         if (!__atomic_load_n(&block, __ATOMIC_RELAXED)) __atomic_store_n(&block, std::uint8_t{1}, __ATOMIC_RELAXED);
     }
 
-    // Appends the set's indices to `out` in increasing order and empties it.
-    void take(std::vector<std::int64_t> &out) {
-        empty_into([&](std::int64_t i) { out.push_back(i); });
+    // Appends the set's indices to `out` in increasing order and empties
+    // it; the blocks shared between the threads where there are many.
+    void take(std::vector<std::int64_t> &out, int threads) {
+        list_blocks();
+        const int shares = shares_for(threads);
+        if (shares == 1) {
+            for (const std::size_t b : dirty_) empty_block(b, [&](std::int64_t i) { out.push_back(i); });
+            return;
+        }
+        parts_.resize(static_cast<std::size_t>(shares));
+#pragma omp parallel for num_threads(shares) schedule(static)
+        for (int r = 0; r < shares; ++r) {
+            std::vector<std::int64_t> &part = parts_[static_cast<std::size_t>(r)];
+            part.clear();
+            for_share(r, shares, [&](std::size_t b) { empty_block(b, [&](std::int64_t i) { part.push_back(i); }); });
+        }
+        for (const std::vector<std::int64_t> &part : parts_) out.insert(out.end(), part.begin(), part.end());
     }
 
     // The number of indices in the set; empties it.
-    std::int64_t take_count() {
+    std::int64_t take_count(int threads) {
+        list_blocks();
+        const int shares = shares_for(threads);
         std::int64_t count = 0;
-        empty_into([&](std::int64_t) { ++count; });
+        const auto count_share = [&](int r) {
+            std::int64_t in_share = 0;
+            for_share(r, shares, [&](std::size_t b) { empty_block(b, [&](std::int64_t) { ++in_share; }); });
+            return in_share;
+        };
+        if (shares == 1) return count_share(0);
+#pragma omp parallel for num_threads(shares) schedule(static) reduction(+ : count)
+        for (int r = 0; r < shares; ++r) count += count_share(r);
         return count;
     }
 
 private:
-    static constexpr int kShift = 12;
+    // Blocks of 512: a small set (a pile of a few hundred cells) reads a
+    // few blocks of 64 words; a large one reads its blocks' flags a word at
+    // a time.
+    static constexpr int kShift = 9;
     static constexpr std::size_t kBlock = std::size_t{1} << kShift;
+    // Below this many blocks to read out, one thread does.
+    static constexpr std::size_t kBlocksForThreads = 64;
     std::vector<std::uint8_t> marks_, blocks_;
+    std::vector<std::size_t> dirty_;                 // the blocks being read out
+    std::vector<std::vector<std::int64_t>> parts_;  // a thread's share of the list
 
-    // Calls visit(i) for every index of the set in increasing order, emptying it.
+    void list_blocks() {
+        dirty_.clear();
+        for (std::size_t w = 0; w < blocks_.size(); w += 8) {
+            std::uint64_t word = 0;
+            std::memcpy(&word, blocks_.data() + w, std::min<std::size_t>(8, blocks_.size() - w));
+            if (!word) continue;
+            for (std::size_t b = w; b < std::min(w + 8, blocks_.size()); ++b)
+                if (blocks_[b]) blocks_[b] = 0, dirty_.push_back(b);
+        }
+    }
+    int shares_for(int threads) const { return threads > 1 && dirty_.size() >= kBlocksForThreads ? threads : 1; }
     template <class Visit>
-    void empty_into(const Visit &visit) {
-        for (std::size_t b = 0; b < blocks_.size(); ++b) {
-            if (!blocks_[b]) continue;
-            blocks_[b] = 0;
-            std::uint8_t *mark = marks_.data() + (b << kShift);
-            for (std::size_t w = 0; w < kBlock; w += 8) {
-                std::uint64_t word;
-                std::memcpy(&word, mark + w, 8);
-                if (!word) continue;
-                for (std::size_t k = 0; k < 8; ++k)
-                    if (mark[w + k]) visit(static_cast<std::int64_t>((b << kShift) + w + k));
-                std::memset(mark + w, 0, 8);
-            }
+    void for_share(int r, int shares, const Visit &visit) const {
+        const std::size_t n = dirty_.size();
+        for (std::size_t k = n * static_cast<std::size_t>(r) / static_cast<std::size_t>(shares);
+             k < n * static_cast<std::size_t>(r + 1) / static_cast<std::size_t>(shares); ++k)
+            visit(dirty_[k]);
+    }
+    // Calls visit(i) for every index of block b in increasing order, emptying it.
+    template <class Visit>
+    void empty_block(std::size_t b, const Visit &visit) {
+        std::uint8_t *mark = marks_.data() + (b << kShift);
+        for (std::size_t w = 0; w < kBlock; w += 8) {
+            std::uint64_t word;
+            std::memcpy(&word, mark + w, 8);
+            if (!word) continue;
+            for (std::size_t k = 0; k < 8; ++k)
+                if (mark[w + k]) visit(static_cast<std::int64_t>((b << kShift) + w + k));
+            std::memset(mark + w, 0, 8);
         }
     }
 };

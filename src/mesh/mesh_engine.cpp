@@ -25,9 +25,10 @@ constexpr std::int64_t kCellsForThreads = 32768;
 // thread, runs the plain passes over every cell: the lists would cost more
 // than they save. A cell on the lists costs about three cells of the plain
 // passes (measured on the column collapse: 2.5 times at 16k cells, 3.5 at
-// 65k), and the lists are read out on one thread (mesh/index_set.hpp) while
-// the plain passes share the threads, so with more threads the share falls
-// in proportion.
+// 65k), and the lists ran on one thread while the plain passes shared the
+// threads, so with more threads the share falls in proportion. (Since then
+// the lists are built on the threads, mesh/index_set.hpp; the share was
+// not measured again.)
 constexpr double kDenseShareOnOneThread = 0.25;
 
 // The threads a pass over every cell of `cells` runs on.
@@ -47,8 +48,13 @@ constexpr std::int64_t kListItemsForThreads = 4096;
 // depend on the threads.
 template <class Work>
 void for_each_place(const std::int64_t *items, std::int64_t count, int threads, const Work &work) {
-    const bool parallel = threads > 1 && count >= kListItemsForThreads;
-#pragma omp parallel for num_threads(threads) if (parallel) schedule(static)
+    // Not even a team of one where the list is short: a sparse sub-step
+    // makes a dozen passes, and a small pile's take microseconds.
+    if (threads < 2 || count < kListItemsForThreads) {
+        for (std::int64_t k = 0; k < count; ++k) work(k, items[k]);
+        return;
+    }
+#pragma omp parallel for num_threads(threads) schedule(static)
     for (std::int64_t k = 0; k < count; ++k) work(k, items[k]);
 }
 template <class Work>
@@ -68,9 +74,12 @@ void for_each_item(const std::vector<std::int64_t> &list, int threads, const Wor
 // on one thread where it is short): the passes in lanes over a list.
 template <class Work>
 void for_each_share(const std::int64_t *items, std::int64_t count, int threads, const Work &work) {
-    const bool parallel = threads > 1 && count >= kListItemsForThreads;
-    const int shares = parallel ? threads : 1;
-#pragma omp parallel for num_threads(threads) if (parallel) schedule(static)
+    if (threads < 2 || count < kListItemsForThreads) {
+        work(items, count);
+        return;
+    }
+    const int shares = threads;
+#pragma omp parallel for num_threads(threads) schedule(static)
     for (int r = 0; r < shares; ++r) {
         const std::int64_t begin = count * r / shares, end = count * (r + 1) / shares;
         work(items + begin, end - begin);
@@ -835,7 +844,8 @@ private:
             s.faces.clear();
             s.gradient_cells.clear();
             const auto look_at_faces_of = [&](std::int64_t c) { look_at_faces(m, s, c, stamp, nullptr, 0); };
-            look_at_faces_of_hot(m, s, stamp, exchanges, threads);
+            mark_faces_of(m, s, act.hot_list, nullptr, 0, threads);
+            list_looked_at(m, s, stamp, exchanges, threads);
             clear_passes(m, s);
             if (law.isotropic) {
                 for_each_item(s.gradient_cells, threads,
@@ -869,7 +879,7 @@ private:
                     if (steep[f]) s.face_set.add(f);
                 });
             steep_faces.clear();
-            s.face_set.take(steep_faces);
+            s.face_set.take(steep_faces, threads);
             // The steep faces not looked at again: as they were, with this sub-step's terms.
             for_each_item(steep_faces, threads, [&](std::int64_t f) {
                 if (s.face_seen[f] != stamp) face_terms(f);
@@ -880,15 +890,7 @@ private:
             if (exchanges) list_pulling_ghosts(s);
             // The gradient flow's flux: the steep faces and the faces of the pulling cells.
             s.faces.clear();
-            s.face_set.reserve(m.faces);
-            const auto carry_faces_of = [&](std::int64_t c) {
-                for (std::int64_t k = m.cell_face_start[c]; k < m.cell_face_start[c + 1]; ++k)
-                    if (m.cell_faces[k] < m.live_faces) s.face_set.add(m.cell_faces[k]);
-            };
-            for_each_item(steep_faces, threads, [&](std::int64_t f) { s.face_set.add(f); });
-            for_each_item(s.pull_cells, threads, carry_faces_of);
-            for (const std::int64_t c : s.pulling_ghosts) carry_faces_of(c);
-            s.face_set.take(s.faces);
+            carrying_faces(m, s, steep_faces, threads);
             if (!s.switches.scalar_mesh)
                 for_each_share(s.faces, threads, [&](const std::int64_t *faces, std::int64_t count) {
                     flow_fluxes_in_lanes(flow_lanes, faces, count);
@@ -926,7 +928,7 @@ private:
             for (const std::int64_t c : changed_ghosts) wake_around(c);
             if (s.lazy)  // else the sources' cells are among those updated
                 for_each_item(s.watched_cells, threads, [&](std::int64_t c) { s.cell_set.add(c); });
-            act.wake_set(s.cell_set);
+            act.wake_set(s.cell_set, threads);
             for (const std::int64_t c : s.pull_cells) pull_x[c] = pull_y[c] = 0.0;
             for (const std::int64_t c : s.limit_cells) limit_in[c] = limit_out[c] = 1.0;
         }
@@ -978,23 +980,31 @@ private:
         }
     }
 
-    // look_at_faces for every hot cell: the faces in face order, their cells
-    // in cell order; the cells marked with the stamp too where more will be
-    // looked at (a part's ghosts).
-    static void look_at_faces_of_hot(const Mesh &m, MeshState &s, std::uint32_t stamp, bool more, int threads) {
+    // look_at_faces on the threads for the cells of a list: their faces
+    // (with classes given, those of a class at most `level`) marked in
+    // s.face_set, for list_looked_at.
+    static void mark_faces_of(const Mesh &m, MeshState &s, const std::vector<std::int64_t> &cells,
+                              const std::uint8_t *face_class, int level, int threads) {
         s.face_set.reserve(m.faces);
-        s.cell_set.reserve(m.cells);
-        for_each_item(s.activity.hot_list, threads, [&](std::int64_t c) {
-            for (std::int64_t k = m.cell_face_start[c]; k < m.cell_face_start[c + 1]; ++k)
-                if (m.cell_faces[k] < m.live_faces) s.face_set.add(m.cell_faces[k]);
+        for_each_item(cells, threads, [&](std::int64_t c) {
+            for (std::int64_t k = m.cell_face_start[c]; k < m.cell_face_start[c + 1]; ++k) {
+                const std::int64_t f = m.cell_faces[k];
+                if (f < m.live_faces && (!face_class || face_class[f] <= level)) s.face_set.add(f);
+            }
         });
-        s.face_set.take(s.faces);
+    }
+    // The faces marked into s.faces in face order, each with the stamp, and
+    // their owned cells into s.gradient_cells in cell order; the cells
+    // stamped too where more will be looked at (a part's ghosts).
+    static void list_looked_at(const Mesh &m, MeshState &s, std::uint32_t stamp, bool more, int threads) {
+        s.face_set.take(s.faces, threads);
+        s.cell_set.reserve(m.cells);
         for_each_item(s.faces, threads, [&](std::int64_t f) {
             s.face_seen[f] = stamp;
             for (const std::int64_t e : {m.face_a[f], m.face_b[f]})
                 if (e >= 0 && e < m.owned) s.cell_set.add(e);
         });
-        s.cell_set.take(s.gradient_cells);
+        s.cell_set.take(s.gradient_cells, threads);
         if (more)
             for (const std::int64_t c : s.gradient_cells) s.cell_seen[c] = stamp;
     }
@@ -1043,6 +1053,24 @@ private:
         s.flux_clean = true;
     }
 
+    // The faces that carry the gradient flow's flux, each once, into
+    // s.faces: the steep ones and those of the cells that pull (owned, and
+    // a part's ghosts).
+    static void carrying_faces(const Mesh &m, MeshState &s, const std::vector<std::int64_t> &steep_faces,
+                               int threads) {
+        s.face_set.reserve(m.faces);
+        const auto carry_faces_of = [&](std::int64_t c) {
+            for (std::int64_t k = m.cell_face_start[c]; k < m.cell_face_start[c + 1]; ++k)
+                if (m.cell_faces[k] < m.live_faces) s.face_set.add(m.cell_faces[k]);
+        };
+        for_each_item(steep_faces, threads, [&](std::int64_t f) {
+            if (f < m.live_faces) s.face_set.add(f);
+        });
+        for_each_item(s.pull_cells, threads, carry_faces_of);
+        for (const std::int64_t c : s.pulling_ghosts) carry_faces_of(c);
+        s.face_set.take(s.faces, threads);
+    }
+
     // The owned cells of `faces`, each once, into `cells`.
     static void owned_cells_of(const Mesh &m, MeshState &s, const std::vector<std::int64_t> &faces,
                                std::vector<std::int64_t> &cells, int threads) {
@@ -1052,7 +1080,7 @@ private:
             for (const std::int64_t e : {m.face_a[f], m.face_b[f]})
                 if (e >= 0 && e < m.owned) s.cell_set.add(e);
         });
-        s.cell_set.take(cells);
+        s.cell_set.take(cells, threads);
     }
 
     // The cells a sparse sub-step updates, each once, into update_cells: the
@@ -1066,20 +1094,24 @@ private:
         const std::int64_t *faces = s.faces.data();
         bool any = false;
         double largest = max_excess;
-        const bool parallel = threads > 1 && count >= kListItemsForThreads;
-#pragma omp parallel for num_threads(threads) if (parallel) schedule(static) reduction(|| : any) reduction(max : largest)
-        for (std::int64_t k = 0; k < count; ++k) {
-            const std::int64_t f = faces[k];
-            if (s.flux[f] == 0.0) continue;
-            any = true;
-            largest = std::max(largest, s.excess[f]);
+        const auto carried = [&](std::int64_t f) {
+            if (s.flux[f] == 0.0) return false;
             for (const std::int64_t e : {m.face_a[f], m.face_b[f]})
                 if (e >= 0 && e < m.owned) s.cell_set.add(e);
+            return true;
+        };
+        if (threads < 2 || count < kListItemsForThreads) {
+            for (std::int64_t k = 0; k < count; ++k)
+                if (carried(faces[k])) any = true, largest = std::max(largest, s.excess[faces[k]]);
+        } else {
+#pragma omp parallel for num_threads(threads) schedule(static) reduction(|| : any) reduction(max : largest)
+            for (std::int64_t k = 0; k < count; ++k)
+                if (carried(faces[k])) any = true, largest = std::max(largest, s.excess[faces[k]]);
         }
         if (!s.lazy)
             for (const std::int64_t c : s.source_cells)
                 if (c < m.owned) s.cell_set.add(c);
-        s.cell_set.take(s.update_cells);
+        s.cell_set.take(s.update_cells, threads);
         moved = moved || any;
         max_excess = largest;
     }
@@ -1089,7 +1121,7 @@ private:
         s.cell_set.reserve(m.cells);
         for (const std::vector<std::int64_t> *list : {&s.gradient_cells, &s.pull_cells, &s.limit_cells, &s.update_cells})
             for_each_item(*list, threads, [&](std::int64_t c) { s.cell_set.add(c); });
-        return static_cast<double>(s.cell_set.take_count());
+        return static_cast<double>(s.cell_set.take_count(threads));
     }
 
     // What went into sinks in a sub-step, face by face in one order whatever
@@ -1290,9 +1322,9 @@ private:
             };
             for (int l = 0; l <= level; ++l) {
                 std::vector<std::int64_t> &hot = s.hot_by_level[static_cast<std::size_t>(l)];
+                mark_faces_of(m, s, hot, sc.face_class.data(), level, threads);
                 std::size_t kept = 0;
                 for (const std::int64_t c : hot) {
-                    look_at_due_faces_of(c);
                     if (sc.coarsest[c] <= level)
                         act.hot[c] = 0;
                     else
@@ -1300,6 +1332,7 @@ private:
                 }
                 hot.resize(kept);
             }
+            list_looked_at(m, s, stamp, parts, threads);
             if (law.isotropic) {
                 for_each_item(s.gradient_cells, threads, gradient);
                 if (parts) {
@@ -1344,19 +1377,8 @@ private:
             owned_cells_of(m, s, due, s.pull_cells, threads);
             for_each_item(s.pull_cells, threads, [&](std::int64_t c) { pull_of(m, law, pull, c, pull_x, pull_y); });
             if (parts) list_pulling_ghosts(s);
-            const std::uint32_t carrying = next_stamp(s);
-            std::vector<std::int64_t> &faces = s.update_cells;  // scratch until the updates' list
-            faces.clear();
-            const auto carry = [&](std::int64_t f) {
-                if (f >= m.live_faces || s.face_seen[f] == carrying) return;
-                s.face_seen[f] = carrying;
-                faces.push_back(f);
-            };
-            for (const std::int64_t f : due) carry(f);
-            for (const std::vector<std::int64_t> *cells : {&s.pull_cells, &s.pulling_ghosts})
-                for (const std::int64_t c : *cells)
-                    for (std::int64_t k = m.cell_face_start[c]; k < m.cell_face_start[c + 1]; ++k) carry(m.cell_faces[k]);
-            s.faces.swap(faces);
+            s.faces.clear();
+            carrying_faces(m, s, due, threads);
             flow_over(s.faces.data(), count_of(s.faces));
             owned_cells_of(m, s, s.faces, s.limit_cells, threads);
             for_each_item(s.limit_cells, threads, limit);

@@ -50,8 +50,8 @@ struct MeshActivity {
         for (std::int64_t k = mesh.grad_start[c]; k < mesh.grad_start[c + 1]; ++k) wake(mesh.grad_cells[k]);
     }
     // After cool_all: the cells of a set hot, listed in cell order (the set empties).
-    void wake_set(IndexSet &woken) {
-        woken.take(hot_list);
+    void wake_set(IndexSet &woken, int threads) {
+        woken.take(hot_list, threads);
         for (const std::int64_t c : hot_list) hot[c] = 1;
     }
     bool may_move() const { return all_hot || !hot_list.empty(); }
