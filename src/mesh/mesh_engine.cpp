@@ -921,8 +921,7 @@ private:
             act.cool_all();
             s.cell_set.reserve(m.cells);
             const auto wake_around = [&](std::int64_t c) {
-                s.cell_set.add(c);
-                for (std::int64_t k = m.grad_start[c]; k < m.grad_start[c + 1]; ++k) s.cell_set.add(m.grad_cells[k]);
+                MeshActivity::for_each_around(m, c, [&](std::int64_t e) { s.cell_set.add(e); });
             };
             for_each_item(s.update_cells, threads, wake_around);
             for (const std::int64_t c : changed_ghosts) wake_around(c);
@@ -998,13 +997,8 @@ private:
     // stamped too where more will be looked at (a part's ghosts).
     static void list_looked_at(const Mesh &m, MeshState &s, std::uint32_t stamp, bool more, int threads) {
         s.face_set.take(s.faces, threads);
-        s.cell_set.reserve(m.cells);
-        for_each_item(s.faces, threads, [&](std::int64_t f) {
-            s.face_seen[f] = stamp;
-            for (const std::int64_t e : {m.face_a[f], m.face_b[f]})
-                if (e >= 0 && e < m.owned) s.cell_set.add(e);
-        });
-        s.cell_set.take(s.gradient_cells, threads);
+        for_each_item(s.faces, threads, [&](std::int64_t f) { s.face_seen[f] = stamp; });
+        owned_cells_of(m, s, s.faces, s.gradient_cells, threads);
         if (more)
             for (const std::int64_t c : s.gradient_cells) s.cell_seen[c] = stamp;
     }
@@ -1489,8 +1483,7 @@ private:
         s.hot_by_level[s.classes->finest[c]].push_back(c);
     }
     static void wake_local_around(const Mesh &m, MeshState &s, std::int64_t c) {
-        wake_local(s, c);
-        for (std::int64_t k = m.grad_start[c]; k < m.grad_start[c + 1]; ++k) wake_local(s, m.grad_cells[k]);
+        MeshActivity::for_each_around(m, c, [&](std::int64_t e) { wake_local(s, e); });
     }
 
     // Before the first tick of a step with local time steps: the classes

@@ -44,10 +44,14 @@ struct MeshActivity {
     }
     // A cell that changed and the cells whose gradients read it: a face
     // reads its cells' heights and gradients.
+    template <class Visit>
+    static void for_each_around(const Mesh &mesh, std::int64_t c, const Visit &visit) {
+        visit(c);
+        for (std::int64_t k = mesh.grad_start[c]; k < mesh.grad_start[c + 1]; ++k) visit(mesh.grad_cells[k]);
+    }
     void wake_around(const Mesh &mesh, std::int64_t c) {
         if (all_hot) return;
-        wake(c);
-        for (std::int64_t k = mesh.grad_start[c]; k < mesh.grad_start[c + 1]; ++k) wake(mesh.grad_cells[k]);
+        for_each_around(mesh, c, [&](std::int64_t e) { wake(e); });
     }
     // After cool_all: the cells of a set hot, listed in cell order (the set empties).
     void wake_set(IndexSet &woken, int threads) {
