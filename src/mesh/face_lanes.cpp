@@ -108,6 +108,41 @@ void face_terms_in_lanes(const FaceLanes &lanes, const std::int64_t *faces, std:
     terms_for_scene<true>(lanes, faces, 0, count);
 }
 
+// FaceLaw::slope and may_be_steep's arithmetic, in their order; with
+// kListed, the faces list[begin, end), else faces [begin, end).
+template <bool kListed>
+__attribute__((always_inline)) inline void steep_in_lanes(const SteepLanes &lanes, const std::int64_t *list,
+                                                          std::int64_t begin, std::int64_t end) {
+    const std::int64_t *__restrict face_a = lanes.face_a, *__restrict face_b = lanes.face_b;
+    const double *__restrict tangent_x = lanes.tangent_x, *__restrict tangent_y = lanes.tangent_y;
+    const double *__restrict distances = lanes.distance;
+    const double *__restrict h = lanes.h, *__restrict gx = lanes.gx, *__restrict gy = lanes.gy;
+    std::uint8_t *__restrict steep = lanes.steep;
+    const double threshold = lanes.tan_theta * (1.0 + lanes.tolerance);
+#pragma omp simd
+    for (std::int64_t i = begin; i < end; ++i) {
+        const std::int64_t f = kListed ? list[i] : i;
+        const std::int64_t a = face_a[f], b_or_edge = face_b[f], b = b_or_edge < 0 ? a : b_or_edge;
+        const double ha = h[a], hb = h[b], distance = distances[f];
+        const double tangential =
+            0.5 * ((gx[a] + gx[b]) * tangent_x[f] + (gy[a] + gy[b]) * tangent_y[f]);
+        const double normal = (ha - hb) / distance;
+        const double s = std::sqrt(normal * normal + tangential * tangential);
+        const double band = 1e-9 * threshold + kRoundOff * (std::fabs(ha) + std::fabs(hb)) / distance;
+        steep[f] = s > threshold - band;
+    }
+}
+
+LANE_COPIES
+void may_be_steep_in_lanes(const SteepLanes &lanes, std::int64_t begin, std::int64_t end) {
+    steep_in_lanes<false>(lanes, nullptr, begin, end);
+}
+
+LANE_COPIES
+void may_be_steep_in_lanes(const SteepLanes &lanes, const std::int64_t *faces, std::int64_t count) {
+    steep_in_lanes<true>(lanes, faces, 0, count);
+}
+
 template <bool kListed>
 __attribute__((always_inline)) inline void flow_in_lanes(const FlowLanes &lanes, const std::int64_t *list,
                                                          std::int64_t begin, std::int64_t end) {

@@ -55,6 +55,23 @@ void face_terms_in_lanes(const FaceLanes &lanes, std::int64_t begin, std::int64_
 // The same for the `count` faces of a list, each listed once (a sparse sub-step's).
 void face_terms_in_lanes(const FaceLanes &lanes, const std::int64_t *faces, std::int64_t count);
 
+// Whether each of `count` listed faces (each once) may be steep, as
+// FaceLaw::may_be_steep finds it (its slope within a band of rounding below
+// its threshold counts), into steep[f]: on a plain scene whose heights lag
+// no source, each face as if it carried sand between two cells (the caller
+// then passes the others to FaceLaw::may_be_steep). The look under the
+// sources (mesh/mesh_engine.cpp) asks it of every face a source moves.
+struct SteepLanes {
+    const std::int64_t *face_a, *face_b;
+    const double *tangent_x, *tangent_y, *distance;
+    const double *h, *gx, *gy;
+    double tan_theta, tolerance;
+    std::uint8_t *steep;
+};
+void may_be_steep_in_lanes(const SteepLanes &lanes, const std::int64_t *faces, std::int64_t count);
+// The same over faces [begin, end).
+void may_be_steep_in_lanes(const SteepLanes &lanes, std::int64_t begin, std::int64_t end);
+
 // The gradient flow's flux over faces [begin, end), any scene: high holds
 // each face's two-point part and takes its flux, as gradient_flow_flux.
 struct FlowLanes {

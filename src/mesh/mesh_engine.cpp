@@ -1,6 +1,7 @@
 #include "mesh/mesh_engine.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <limits>
 #include <vector>
@@ -1663,13 +1664,50 @@ private:
         const std::int64_t *faces = s.source_faces.data();
         std::uint8_t *steep = s.look_steep.data();
         bool any_first = false, any_second = false;
+        if (looks_in_lanes(at_second, s) && (!both || looks_in_lanes(at_first, s))) {
+            // Each face in lanes as if it carried sand between two cells, the others as FaceLaw finds them.
+            s.look_steep_earlier.resize(static_cast<std::size_t>(m.faces), 0);
+            std::uint8_t *steep_then = s.look_steep_earlier.data();
+            std::atomic<bool> found_first{false}, found_second{false};
+            // Where the sources move every face the list is the faces in order, read as a range.
+            const bool every_face = count == m.live_faces;
+            const auto find_in_lanes = [&](const FaceLaw &law, std::uint8_t *into, const std::int64_t *list,
+                                           std::int64_t listed) {
+                const SteepLanes lanes = steep_lanes(m, law, into);
+                if (every_face && listed > 0)
+                    may_be_steep_in_lanes(lanes, list[0], list[0] + listed);
+                else
+                    may_be_steep_in_lanes(lanes, list, listed);
+            };
+            for_each_share(s.source_faces, threads, [&](const std::int64_t *list, std::int64_t listed) {
+                find_in_lanes(at_second, steep, list, listed);
+                if (both) find_in_lanes(at_first, steep_then, list, listed);
+                bool first_here = false, second_here = false;
+                for (std::int64_t k = 0; k < listed; ++k) {
+                    const std::int64_t f = list[k];
+                    if (off_lanes(m, at_second.carrying, f)) {
+                        steep[f] = at_second.may_be_steep(f);
+                        if (both) steep_then[f] = at_first.may_be_steep(f);
+                    }
+                    const bool then = both && steep_then[f], later = steep[f];
+                    steep[f] = then || later;
+                    first_here = first_here || then;
+                    second_here = second_here || later;
+                }
+                if (first_here) found_first = true;
+                if (second_here) found_second = true;
+            });
+            any_first = found_first;
+            any_second = found_second;
+        } else {
 #pragma omp parallel for num_threads(threads) if (threads_in_use(threads, count) > 1) schedule(static) \
     reduction(|| : any_first, any_second)
-        for (std::int64_t k = 0; k < count; ++k) {
-            const bool then = both && at_first.may_be_steep(faces[k]), later = at_second.may_be_steep(faces[k]);
-            steep[faces[k]] = then || later;
-            any_first = any_first || then;
-            any_second = any_second || later;
+            for (std::int64_t k = 0; k < count; ++k) {
+                const bool then = both && at_first.may_be_steep(faces[k]), later = at_second.may_be_steep(faces[k]);
+                steep[faces[k]] = then || later;
+                any_first = any_first || then;
+                any_second = any_second || later;
+            }
         }
         if (watch && (any_first || any_second))
             for (const std::int64_t f : s.source_faces)
@@ -1810,6 +1848,16 @@ private:
                       m.pair_bx.data(), m.pair_by.data(), pull_x, pull_y, high},
             LimitLanes{m.face_a.data(), m.face_b.data(), low, high, excess, s.limit_in.data(), s.limit_out.data(),
                        s.flux.data()}};
+    }
+
+    // Whether the look under the sources finds a law's steep faces in lanes
+    // (may_be_steep_in_lanes): on a plain scene whose heights it found once.
+    static bool looks_in_lanes(const FaceLaw &law, const MeshState &s) {
+        return !s.switches.scalar_mesh && law.isotropic && !law.tan_field && !law.moving && !law.h.q;
+    }
+    static SteepLanes steep_lanes(const Mesh &m, const FaceLaw &law, std::uint8_t *steep) {
+        return SteepLanes{m.face_a.data(), m.face_b.data(), m.tangent_x.data(), m.tangent_y.data(), m.distance.data(),
+                          law.h.h, law.gx, law.gy, law.tan_theta, law.tolerance, steep};
     }
 
     // A face whose terms the lanes do not take (FaceLaw::terms does): on the

@@ -128,9 +128,10 @@ struct MeshState final : EngineState {
     // A sub-step moved sand since the last look at whether a source may
     // still make a face steep before the step ends; that look's answer.
     bool moved_since_look = false, source_may_steepen = false;
-    // Scratch of that look: per cell, gradients at two times; per face, steep at either.
+    // Scratch of that look: per cell, gradients at two times; per face, steep
+    // at either (look_steep), and at the first (look_steep_earlier).
     std::vector<double> look_gx, look_gy, look_gx_later, look_gy_later;
-    std::vector<std::uint8_t> look_steep;
+    std::vector<std::uint8_t> look_steep, look_steep_earlier;
 
     // What the host's masks, sources and edges make of the mesh, found again
     // after the host changed them (lists_current false).
