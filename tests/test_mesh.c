@@ -1260,14 +1260,15 @@ static void test_face_pass_in_lanes_same_bits(void **state) {
  * the same as with every cell visited. And the sparse step visits what moves
  * (issue 34): over the sub-steps, the cells visited at most 2.5 times those
  * whose heights changed. */
-static void ridges_on(const mesh_scene *s, int threads, int calls, double *h_out, double *visited, double *changed) {
+static void ridges_on(const mesh_scene *s, int threads, int calls, double spacing, double *h_out, double *visited,
+                      double *changed) {
     dpsm_grid *g = NULL;
     CHECK_OK(NULL, scene_create(s, &g));
     CHECK_OK(g, dpsm_set_repose_angle(g, 30.0 * kDeg));
     CHECK_OK(g, dpsm_set_threads(g, threads));
     double *h = calloc((size_t)s->cells, sizeof(double)), *after = calloc((size_t)s->cells, sizeof(double));
     for (int64_t c = 0; c < s->cells; ++c)
-        if (fabs(fabs(s->cy[c]) - 0.5) < 0.02) h[c] = 0.05; /* two ridges */
+        if (fabs(remainder(s->cy[c] - 0.5, spacing)) < 0.02) h[c] = 0.05; /* ridges `spacing` apart through y = 0.5 */
     CHECK_OK(g, dpsm_set_heights(g, h));
     double dt = 0.0;
     CHECK_OK(g, dpsm_stable_dt(g, &dt));
@@ -1299,15 +1300,15 @@ static void test_sparse_step_on_threads(void **state) {
         const size_t n = (size_t)s.cells;
         double *one = calloc(n, sizeof(double)), *two = calloc(n, sizeof(double)), *all = calloc(n, sizeof(double));
         double visited = 0.0, changed = 0.0, v2 = 0.0, c2 = 0.0, va = 0.0, ca = 0.0;
-        ridges_on(&s, 1, calls, one, &visited, &changed);
-        ridges_on(&s, 2, calls, two, &v2, &c2);
+        ridges_on(&s, 1, calls, 1.0, one, &visited, &changed);
+        ridges_on(&s, 2, calls, 1.0, two, &v2, &c2);
         setenv("DPSM_VISIT_ALL_CELLS", "1", 1);
-        ridges_on(&s, 2, calls, all, &va, &ca);
+        ridges_on(&s, 2, calls, 1.0, all, &va, &ca);
         unsetenv("DPSM_VISIT_ALL_CELLS");
         const char *name = scene_name(kinds[k]);
-        /* The lists long enough for the threads, and the step sparse on two
-         * threads too (it then takes the plain passes over an eighth of the cells). */
-        REQUIRE(v2 / calls > 4096.0 && v2 / calls < 0.125 * (double)n,
+        /* The lists long enough for the threads, and the step sparse (it
+         * takes the plain passes over a quarter of the cells). */
+        REQUIRE(v2 / calls > 4096.0 && v2 / calls < 0.25 * (double)n,
                 "%s, %lld cells: %.0f cells visited a sub-step on two threads; the test wants the sparse step "
                 "over more than 4096", name, (long long)s.cells, v2 / calls);
         REQUIRE(visited == v2, "%s: %.0f cells visited on one thread, %.0f on two", name, visited, v2);
@@ -1324,6 +1325,27 @@ static void test_sparse_step_on_threads(void **state) {
         free(one), free(two), free(all);
         scene_free(&s);
     }
+    /* Ridges closer together: a sub-step looks at more than an eighth of the
+     * cells, and takes the lists on any number of threads where they are
+     * fewer than a quarter (mesh_engine.cpp, kDenseShare), as the plain
+     * passes do: the same cells visited on two threads as on one. */
+    mesh_scene s = scene_make(SCENE_TRIANGLES, 200, 1.0, 11u);
+    const size_t n = (size_t)s.cells;
+    double *one = calloc(n, sizeof(double)), *two = calloc(n, sizeof(double));
+    double visited = 0.0, changed = 0.0, v2 = 0.0, c2 = 0.0;
+    ridges_on(&s, 1, calls, 0.5, one, &visited, &changed);
+    ridges_on(&s, 2, calls, 0.5, two, &v2, &c2);
+    print_message("ridges 0.5 apart, %lld cells: %.0f cells visited a sub-step on one thread (%.3f of the cells), "
+                  "%.0f on two\n", (long long)s.cells, visited / calls, visited / calls / (double)n, v2 / calls);
+    REQUIRE(visited / calls > 0.125 * (double)n && visited / calls < 0.25 * (double)n,
+            "ridges 0.5 apart: %.0f of %zu cells visited a sub-step; the test wants between an eighth and a quarter",
+            visited / calls, n);
+    REQUIRE(visited == v2, "ridges 0.5 apart: %.0f cells visited on one thread, %.0f on two", visited, v2);
+    for (size_t c = 0; c < n; ++c)
+        REQUIRE(memcmp(&one[c], &two[c], sizeof(double)) == 0, "ridges 0.5 apart: cell %zu: %.17g on two threads, "
+                "%.17g on one", c, two[c], one[c]);
+    free(one), free(two);
+    scene_free(&s);
 }
 
 /* What a cell's sums read is ordered by the host's cell numbers (and on the

@@ -22,22 +22,19 @@ namespace {
 
 // Below this many cells in a pass the threads cost more than they save.
 constexpr std::int64_t kCellsForThreads = 32768;
-// A sub-step over more hot cells than this share of the mesh, on one
-// thread, runs the plain passes over every cell: the lists would cost more
-// than they save. A cell on the lists costs about three cells of the plain
-// passes (measured on the column collapse: 2.5 times at 16k cells, 3.5 at
-// 65k), and the lists ran on one thread while the plain passes shared the
-// threads, so with more threads the share falls in proportion. (Since then
-// the lists are built on the threads, mesh/index_set.hpp; the share was
-// not measured again.)
-constexpr double kDenseShareOnOneThread = 0.25;
+// A sub-step over more hot cells than this share of the mesh runs the
+// plain passes over every cell: the lists would cost more than they save. A
+// cell on the lists costs about three cells of the plain passes (measured
+// on the column collapse: 2.5 times at 16k cells, 3.5 at 65k). The same
+// share on any number of threads: the lists are built and passed on the
+// threads as the plain passes are (mesh/index_set.hpp). Until they were, it
+// fell in proportion to the threads; on two threads the column collapse on
+// 33,800 triangles then updated 4.3 times the cells and took longer in 8 of
+// 10 runs (docs/performance.md, "The dense share on two threads").
+constexpr double kDenseShare = 0.25;
 
 // The threads a pass over every cell of `cells` runs on.
 inline int threads_in_use(int threads, std::int64_t cells) { return cells >= kCellsForThreads ? threads : 1; }
-
-inline double dense_share(int threads, std::int64_t cells) {
-    return kDenseShareOnOneThread / threads_in_use(threads, cells);
-}
 
 // Below this many items a pass over a list runs on one thread: an item of
 // a list costs several cells of a plain pass (its data lies scattered).
@@ -662,9 +659,8 @@ private:
         // (mesh/mesh_parts.hpp), or in a batch it steps them too, densely.
         const bool parts = s.exchange != nullptr, exchanges = parts && !in_batch;
         const int threads = grid.step_threads();
-        const double share = dense_share(threads, m.owned);
         const bool dense = (in_batch && m.cells > m.owned) || physics || act.all_hot || s.switches.visit_all_cells ||
-                           static_cast<double>(act.hot_list.size()) > share * static_cast<double>(m.owned);
+                           static_cast<double>(act.hot_list.size()) > kDenseShare * static_cast<double>(m.owned);
         std::vector<std::int64_t> &changed_ghosts = s.changed_ghosts;
         changed_ghosts.clear();
         std::vector<double> &h = grid.heights_for_stepping();
@@ -817,7 +813,7 @@ private:
             // The next sub-step looks at the cells that changed and those whose
             // gradients read them, and the cells a source keeps hot; where that
             // is most of the mesh, at all.
-            const std::size_t most = static_cast<std::size_t>(share * static_cast<double>(n));
+            const std::size_t most = static_cast<std::size_t>(kDenseShare * static_cast<double>(n));
             if (static_cast<std::size_t>(changed_cells) + kept_hot_by_sources(s) > most) {
                 act.wake_all();
             } else {
@@ -1288,7 +1284,7 @@ private:
             visited = static_cast<double>(taking_n);
             // Where every face has fired and few cells changed, the ticks
             // after look at those cells and the steep faces alone.
-            const double most = dense_share(threads, m.owned) * static_cast<double>(m.owned);
+            const double most = kDenseShare * static_cast<double>(m.owned);
             if (level == sc.top && !s.switches.visit_all_cells && !bed && !grid.hysteresis() &&
                 static_cast<double>(changed_cells + kept_hot_by_sources(s)) <= most) {
                 act.all_hot = false;
@@ -1396,7 +1392,7 @@ private:
             std::size_t hot_cells = 0;
             for (const std::vector<std::int64_t> &hot : s.hot_by_level) hot_cells += hot.size();
             pending = hot_cells > 0 || waits_for_sources(s);
-            if (static_cast<double>(hot_cells) > dense_share(threads, m.owned) * static_cast<double>(m.owned)) {
+            if (static_cast<double>(hot_cells) > kDenseShare * static_cast<double>(m.owned)) {
                 // Each hot cell would cool at the first tick whose level reaches its coarsest face.
                 for (std::vector<std::int64_t> &hot : s.hot_by_level) {
                     for (const std::int64_t c : hot) {
@@ -1634,7 +1630,7 @@ private:
         // dense sub-step does; a few source cells are not worth a pass over all.
         const bool every_owned_cell = s.exchange && !steps_ghosts(grid);
         const bool most_cells = every_owned_cell || static_cast<double>(s.source_face_cells.size()) >
-                                                        dense_share(threads, m.owned) * static_cast<double>(m.owned);
+                                                        kDenseShare * static_cast<double>(m.owned);
         if (most_cells && !s.switches.scalar_mesh) {
             at_second.h = heights_found_once(m, at_second.h, threads, s.heights_read);
             if (both) at_first.h = heights_found_once(m, at_first.h, threads, s.heights_read_earlier);
