@@ -279,7 +279,7 @@ static const command kCommands[] = {
     {"mesh-accuracy", cmd_mesh_accuracy,
      "[threads [levels [mesh]]]  column collapse (a = 0.5, 30 deg) to rest on quadrilaterals, jittered triangles, hexagons,"
      " the median dual (and a gmsh disk) at about 4,000, 16,000, 65,000, 262,000 cells (levels, 4): L1 error, order, runout,"
-     " rest time, beside the 2D grid of the same cell size and the mesh turned by 30 degrees; the cone on triangles;"
+     " rest time, settled time, beside the 2D grid of the same cell size and the mesh turned by 30 degrees; the cone on triangles;"
      " mesh `ridge`: a ridge between walls (64 cells a side, doubled each level) against the exact triangle and the grid;"
      " mesh `slope`: the same walls holding a triangle 1 % steeper than repose (the rest tail alone)"},
     {"mesh-graded", cmd_mesh_graded,

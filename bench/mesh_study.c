@@ -4,9 +4,11 @@
  * degrees, open table, the exact deposit a truncated cone) on every mesh
  * kind of mesh_scenes.h at four refinements, stepped in time to rest: the
  * L1 difference over the column's volume, the observed order, the runout in
- * 16 directions against the exact foot, the time at which it rested; beside
- * each, the same column on the 2D grid of squares of the same mean size (the
- * grid engine's error and rest time) and, at the two coarsest levels, on the
+ * 16 directions against the exact foot, the time at which it rested and the
+ * time from which its deposit stayed within 1 % of the grid's error of where
+ * it rested (settled); beside each, the same column on the 2D grid of
+ * squares of the same mean size (the grid engine's error, rest time and
+ * settled time) and, at the two coarsest levels, on the
  * same mesh turned by 30 degrees (the deposits' difference, cell by cell,
  * against the error); and the cone (40 high, slope 1.5, 33 degrees) on
  * jittered triangles, its top against 22.89. With `ridge` for the mesh: a
@@ -54,12 +56,63 @@ typedef struct {
      * by cell, over the L1 error; NAN where not run). */
     int64_t grid_cells;
     double grid_l1, grid_rest_time, rotated;
+    /* When the deposit settled (settled_time below), here and on the grid. */
+    double settled_time, grid_settled_time;
 } mesh_result;
+
+/* The L1 difference of two deposits on cells of these areas. */
+static double l1_difference(const double *a, const double *b, const double *area, int64_t cells) {
+    double difference = 0.0;
+    for (int64_t c = 0; c < cells; ++c) difference += fabs(a[c] - b[c]) * area[c];
+    return difference;
+}
+
+/* The heights after every call of a run to rest, for settled_time. */
+typedef struct {
+    int64_t cells, calls, capacity;
+    double *heights; /* calls x cells */
+    double *times;   /* the time at the end of each call */
+} deposit_track;
+
+static void track_call(dpsm_grid *g, deposit_track *track, double t) {
+    if (track->calls == track->capacity) {
+        track->capacity = track->capacity ? 2 * track->capacity : 64;
+        track->heights = realloc(track->heights, (size_t)(track->capacity * track->cells) * sizeof(double));
+        track->times = realloc(track->times, (size_t)track->capacity * sizeof(double));
+        if (!track->heights || !track->times) {
+            fprintf(stderr, DPSM_TOOL_NAME ": out of memory\n");
+            exit(1);
+        }
+    }
+    CHECK(g, dpsm_get_heights(g, track->heights + track->calls * track->cells));
+    track->times[track->calls++] = t;
+}
+
+/* The time from which the deposit stays within `tolerance` (an L1
+ * difference over `volume`) of where it rests: when the flow ends to the
+ * accuracy asked, whatever the rest tolerance makes the tail below it
+ * last. */
+static double settled_time(const deposit_track *track, const double *area, double volume, double tolerance) {
+    if (track->calls == 0) return NAN;
+    const double *rest = track->heights + (track->calls - 1) * track->cells;
+    double settled = track->times[track->calls - 1];
+    for (int64_t k = track->calls - 2; k >= 0; --k) {
+        if (l1_difference(track->heights + k * track->cells, rest, area, track->cells) > tolerance * volume) break;
+        settled = track->times[k];
+    }
+    return settled;
+}
+
+static void track_free(deposit_track *track) {
+    free(track->heights);
+    free(track->times);
+}
 
 static double column_foot(double alpha) { return (0.5 + sqrt(4.0 * alpha * alpha - 0.25 / 3.0)) / (2.0 * alpha); }
 
-/* Steps in calls of dt until the surface rests or t_end passes. */
-static void step_to_rest(dpsm_grid *g, double dt, double t_end, mesh_result *out) {
+/* Steps in calls of dt until the surface rests or t_end passes; with a
+ * track, keeps the heights after every call. */
+static void step_to_rest(dpsm_grid *g, double dt, double t_end, mesh_result *out, deposit_track *track) {
     double t = 0.0;
     out->at_rest = 0;
     out->cell_updates = 0.0;
@@ -71,6 +124,7 @@ static void step_to_rest(dpsm_grid *g, double dt, double t_end, mesh_result *out
         CHECK(g, dpsm_get_step_info(g, DPSM_INFO_CELL_UPDATES, &updates));
         out->cell_updates += updates;
         t += integrated;
+        if (track) track_call(g, track, t);
         if (at_rest > 0.0) {
             out->at_rest = 1;
             break;
@@ -127,14 +181,24 @@ static void score_column(const mesh_scene *s, const double *h, mesh_result *r) {
     for (int k = 0; k < 16; ++k) r->runout_error = fmax(r->runout_error, fabs(runout[k] - foot));
 }
 
-/* The column on the scene's mesh, stepped to rest; the deposit in h. */
+/* A column's deposit settled when it stays within 1 % of the grid engine's
+ * error (its L1 difference from the exact deposit on as many squares) of
+ * where it rests: the same yardstick for the mesh and the grid. */
+static const double kSettledShare = 0.01;
+
+/* The column on the scene's mesh, stepped to rest; the deposit in h, scored
+ * (its settled time against r->grid_l1, so the grid's column runs first). */
 static void collapse_on_mesh(const mesh_scene *s, int threads, double *h, mesh_result *r) {
     double *poured = poured_column(s);
+    deposit_track track = {.cells = s->cells};
     const double t0 = now_seconds();
     dpsm_grid *g = open_mesh(s, kColumnTheta, threads, poured);
-    step_to_rest(g, 0.1, 20.0, r);
+    step_to_rest(g, 0.1, 20.0, r, &track);
     CHECK(g, dpsm_get_heights(g, h));
     r->seconds = now_seconds() - t0;
+    score_column(s, h, r);
+    r->settled_time = settled_time(&track, s->area, kPi * 0.5, kSettledShare * r->grid_l1);
+    track_free(&track);
     dpsm_destroy(g);
     free(poured);
 }
@@ -161,12 +225,15 @@ static void collapse_on_grid(int n, int threads, mesh_result *r) {
     mesh_result grid;
     memset(&grid, 0, sizeof grid);
     grid.size = 2.0 * column_half() / n;
-    step_to_rest(g, 0.1, 20.0, &grid);
+    deposit_track track = {.cells = squares.cells};
+    step_to_rest(g, 0.1, 20.0, &grid, &track);
     CHECK(g, dpsm_get_heights(g, h));
     score_column(&squares, h, &grid);
     r->grid_cells = squares.cells;
     r->grid_l1 = grid.l1;
     r->grid_rest_time = grid.rest_time;
+    r->grid_settled_time = settled_time(&track, squares.area, kPi * 0.5, kSettledShare * grid.l1);
+    track_free(&track);
     dpsm_destroy(g);
     free(h);
     scene_free(&squares);
@@ -182,9 +249,9 @@ static mesh_result column_on(scene_kind kind, int n, int threads, int turned) {
     if (s.cells == 0) return r; /* gmsh or its .geo not found */
     r.cells = s.cells;
     r.size = scene_mean_size(&s);
+    collapse_on_grid((int)lround(2.0 * column_half() / r.size), threads, &r);
     double *h = xcalloc((size_t)s.cells, sizeof(double));
     collapse_on_mesh(&s, threads, h, &r);
-    score_column(&s, h, &r);
     if (turned) {
         /* A turned copy of a mesh is the same mesh: only a choice bound to
          * the axes could make its deposit differ beyond rounding. */
@@ -193,13 +260,10 @@ static mesh_result column_on(scene_kind kind, int n, int threads, int turned) {
         double *ht = xcalloc((size_t)t.cells, sizeof(double));
         mesh_result rt = r;
         collapse_on_mesh(&t, threads, ht, &rt);
-        double difference = 0.0;
-        for (int64_t c = 0; c < s.cells; ++c) difference += fabs(h[c] - ht[c]) * s.area[c];
-        r.rotated = difference / (kPi * 0.5) / r.l1;
+        r.rotated = l1_difference(h, ht, s.area, s.cells) / (kPi * 0.5) / r.l1;
         free(ht);
         scene_free(&t);
     }
-    collapse_on_grid((int)lround(2.0 * column_half() / r.size), threads, &r);
     free(h);
     scene_free(&s);
     return r;
@@ -217,7 +281,7 @@ static mesh_result cone_on(scene_kind kind, int n, int threads) {
     r.size = scene_mean_size(&s);
     const double t0 = now_seconds();
     dpsm_grid *g = open_mesh(&s, theta, threads, h);
-    step_to_rest(g, 10.0, 1e5, &r);
+    step_to_rest(g, 10.0, 1e5, &r, NULL);
     CHECK(g, dpsm_get_heights(g, h));
     r.seconds = now_seconds() - t0;
     int64_t highest = 0;
@@ -300,7 +364,7 @@ static mesh_result ridge_on(scene_kind kind, int n, int threads, double (*height
     const double t0 = now_seconds();
     dpsm_grid *g = open_mesh(&s, kColumnTheta, threads, h);
     CHECK(g, dpsm_set_boundary(g, DPSM_MESH_EDGE, DPSM_WALL));
-    step_to_rest(g, 0.1, 40.0, &r);
+    step_to_rest(g, 0.1, 40.0, &r, NULL);
     CHECK(g, dpsm_get_heights(g, h));
     r.seconds = now_seconds() - t0;
     score_ridge(s.cx, s.area, s.cells, h, volume, &r);
@@ -314,7 +378,7 @@ static mesh_result ridge_on(scene_kind kind, int n, int threads, double (*height
     g = square_grid(m, kRidgeHalf, threads, DPSM_WALL, h);
     mesh_result grid;
     memset(&grid, 0, sizeof grid);
-    step_to_rest(g, 0.1, 40.0, &grid);
+    step_to_rest(g, 0.1, 40.0, &grid, NULL);
     CHECK(g, dpsm_get_heights(g, h));
     score_ridge(squares.cx, squares.area, squares.cells, h, volume, &grid);
     r.grid_cells = squares.cells;
@@ -337,7 +401,7 @@ static void ridge_rows(int threads, int levels, const char *scene, double (*heig
         for (int level = 0; level < levels; ++level) {
             const mesh_result r = ridge_on(kinds[k], 64 << level, threads, height);
             const double order = level > 0 ? log2(previous / r.l1) : NAN;
-            printf("%s,%s,%lld,%.5f,%.4e,%.2f,%.2f,%d,%.3f,%.4g,%.3f,%lld,%.4e,%.3f,%.3f,\n", scene,
+            printf("%s,%s,%lld,%.5f,%.4e,%.2f,%.2f,%d,%.3f,%.4g,%.3f,%lld,%.4e,%.3f,%.3f,,,,\n", scene,
                    scene_name(kinds[k]), (long long)r.cells, r.size, r.l1, order, r.runout_error / r.size, r.at_rest,
                    r.rest_time, r.cell_updates, r.seconds, (long long)r.grid_cells, r.grid_l1, r.grid_rest_time,
                    r.rest_time / r.grid_rest_time);
@@ -361,7 +425,8 @@ int cmd_mesh_accuracy(int argc, char **argv) {
     fprintf(stderr, "mesh-accuracy: column collapse a = 0.5, 30 deg, open edges; exact foot %.4f; threads %d\n",
             column_foot(tan(kColumnTheta)), threads);
     printf("scene,mesh,cells,mean_size,l1_error,order,runout_error_cells,at_rest,rest_time,cell_updates,seconds,"
-           "grid_cells,grid_l1_error,grid_rest_time,rest_time_ratio,turned_difference\n");
+           "grid_cells,grid_l1_error,grid_rest_time,rest_time_ratio,turned_difference,settled_time,grid_settled_time,"
+           "settled_time_ratio\n");
     fflush(stdout);
     if (only && strcmp(only, "ridge") == 0) {
         ridge_rows(threads, levels, "ridge_between_walls", ridge_height);
@@ -384,10 +449,11 @@ int cmd_mesh_accuracy(int argc, char **argv) {
                 break;
             }
             const double order = level > 0 ? log2(previous / r.l1) : NAN;
-            printf("column,%s,%lld,%.5f,%.4e,%.2f,%.2f,%d,%.3f,%.4g,%.3f,%lld,%.4e,%.3f,%.3f,%.2e\n",
+            printf("column,%s,%lld,%.5f,%.4e,%.2f,%.2f,%d,%.3f,%.4g,%.3f,%lld,%.4e,%.3f,%.3f,%.2e,%.2f,%.2f,%.3f\n",
                    scene_name(kinds[k].kind), (long long)r.cells, r.size, r.l1, order, r.runout_error / r.size,
                    r.at_rest, r.rest_time, r.cell_updates, r.seconds, (long long)r.grid_cells, r.grid_l1,
-                   r.grid_rest_time, r.rest_time / r.grid_rest_time, r.rotated);
+                   r.grid_rest_time, r.rest_time / r.grid_rest_time, r.rotated, r.settled_time, r.grid_settled_time,
+                   r.settled_time / r.grid_settled_time);
             fflush(stdout);
             previous = r.l1;
         }
@@ -395,7 +461,7 @@ int cmd_mesh_accuracy(int argc, char **argv) {
     if (only && strcmp(only, "cone") != 0) return 0;
     const mesh_result cone = cone_on(SCENE_TRIANGLES, 72, threads);
     printf("cone,%s,%lld,%.5f,top %.4f against 22.89 (%+.3f %%); its cell %.3f off the axis where the exact cone is "
-           "%.4f (%+.3f %%),,,%d,%.3f,%.4g,%.3f,,,,,\n",
+           "%.4f (%+.3f %%),,,%d,%.3f,%.4g,%.3f,,,,,,,,\n",
            scene_name(SCENE_TRIANGLES), (long long)cone.cells, cone.size, cone.top, 100.0 * (cone.top / 22.89 - 1.0),
            cone.top_radius, cone.exact_at_top, 100.0 * (cone.top / cone.exact_at_top - 1.0),
            cone.at_rest, cone.rest_time, cone.cell_updates, cone.seconds);
