@@ -1657,54 +1657,45 @@ private:
             }
         }
         const std::int64_t count = static_cast<std::int64_t>(s.source_faces.size());
-        const std::int64_t *faces = s.source_faces.data();
         std::uint8_t *steep = s.look_steep.data();
-        bool any_first = false, any_second = false;
-        if (looks_in_lanes(at_second, s) && (!both || looks_in_lanes(at_first, s))) {
-            // Each face in lanes as if it carried sand between two cells, the others as FaceLaw finds them.
-            s.look_steep_earlier.resize(static_cast<std::size_t>(m.faces), 0);
-            std::uint8_t *steep_then = s.look_steep_earlier.data();
-            std::atomic<bool> found_first{false}, found_second{false};
-            // Where the sources move every face the list is the faces in order, read as a range.
-            const bool every_face = count == m.live_faces;
-            const auto find_in_lanes = [&](const FaceLaw &law, std::uint8_t *into, const std::int64_t *list,
-                                           std::int64_t listed) {
-                const SteepLanes lanes = steep_lanes(m, law, into);
-                if (every_face && listed > 0)
-                    may_be_steep_in_lanes(lanes, list[0], list[0] + listed);
-                else
-                    may_be_steep_in_lanes(lanes, list, listed);
-            };
-            for_each_share(s.source_faces, threads, [&](const std::int64_t *list, std::int64_t listed) {
+        // The faces in lanes as if each carried sand between two cells where
+        // the laws allow, the others (and every face where they do not) as
+        // FaceLaw finds them; a face is kept if steep at either time.
+        const bool lanes = looks_in_lanes(at_second, s) && (!both || looks_in_lanes(at_first, s));
+        s.look_steep_earlier.resize(static_cast<std::size_t>(m.faces), 0);
+        std::uint8_t *steep_then = s.look_steep_earlier.data();
+        std::atomic<bool> found_first{false}, found_second{false};
+        // Where the sources move every face the list is the faces in order, read as a range.
+        const bool every_face = count == m.live_faces;
+        const auto find_in_lanes = [&](const FaceLaw &law, std::uint8_t *into, const std::int64_t *list,
+                                       std::int64_t listed) {
+            const SteepLanes steep_lanes_of = steep_lanes(m, law, into);
+            if (every_face && listed > 0)
+                may_be_steep_in_lanes(steep_lanes_of, list[0], list[0] + listed);
+            else
+                may_be_steep_in_lanes(steep_lanes_of, list, listed);
+        };
+        for_each_share(s.source_faces, threads, [&](const std::int64_t *list, std::int64_t listed) {
+            if (lanes) {
                 find_in_lanes(at_second, steep, list, listed);
                 if (both) find_in_lanes(at_first, steep_then, list, listed);
-                bool first_here = false, second_here = false;
-                for (std::int64_t k = 0; k < listed; ++k) {
-                    const std::int64_t f = list[k];
-                    if (off_lanes(m, at_second.carrying, f)) {
-                        steep[f] = at_second.may_be_steep(f);
-                        if (both) steep_then[f] = at_first.may_be_steep(f);
-                    }
-                    const bool then = both && steep_then[f], later = steep[f];
-                    steep[f] = then || later;
-                    first_here = first_here || then;
-                    second_here = second_here || later;
-                }
-                if (first_here) found_first = true;
-                if (second_here) found_second = true;
-            });
-            any_first = found_first;
-            any_second = found_second;
-        } else {
-#pragma omp parallel for num_threads(threads) if (threads_in_use(threads, count) > 1) schedule(static) \
-    reduction(|| : any_first, any_second)
-            for (std::int64_t k = 0; k < count; ++k) {
-                const bool then = both && at_first.may_be_steep(faces[k]), later = at_second.may_be_steep(faces[k]);
-                steep[faces[k]] = then || later;
-                any_first = any_first || then;
-                any_second = any_second || later;
             }
-        }
+            bool first_here = false, second_here = false;
+            for (std::int64_t k = 0; k < listed; ++k) {
+                const std::int64_t f = list[k];
+                if (!lanes || off_lanes(m, at_second.carrying, f)) {
+                    steep[f] = at_second.may_be_steep(f);
+                    if (both) steep_then[f] = at_first.may_be_steep(f);
+                }
+                const bool then = both && steep_then[f], later = steep[f];
+                steep[f] = then || later;
+                first_here = first_here || then;
+                second_here = second_here || later;
+            }
+            if (first_here) found_first = true;
+            if (second_here) found_second = true;
+        });
+        const bool any_first = found_first, any_second = found_second;
         if (watch && (any_first || any_second))
             for (const std::int64_t f : s.source_faces)
                 if (steep[f])
