@@ -186,19 +186,15 @@ static void score_column(const mesh_scene *s, const double *h, mesh_result *r) {
  * where it rests: the same yardstick for the mesh and the grid. */
 static const double kSettledShare = 0.01;
 
-/* The column on the scene's mesh, stepped to rest; the deposit in h, scored
- * (its settled time against r->grid_l1, so the grid's column runs first). */
-static void collapse_on_mesh(const mesh_scene *s, int threads, double *h, mesh_result *r) {
+/* The column on the scene's mesh, stepped to rest; the deposit in h (with a
+ * track, the heights after every call too). */
+static void collapse_on_mesh(const mesh_scene *s, int threads, double *h, mesh_result *r, deposit_track *track) {
     double *poured = poured_column(s);
-    deposit_track track = {.cells = s->cells};
     const double t0 = now_seconds();
     dpsm_grid *g = open_mesh(s, kColumnTheta, threads, poured);
-    step_to_rest(g, 0.1, 20.0, r, &track);
+    step_to_rest(g, 0.1, 20.0, r, track);
     CHECK(g, dpsm_get_heights(g, h));
     r->seconds = now_seconds() - t0;
-    score_column(s, h, r);
-    r->settled_time = settled_time(&track, s->area, kPi * 0.5, kSettledShare * r->grid_l1);
-    track_free(&track);
     dpsm_destroy(g);
     free(poured);
 }
@@ -251,7 +247,12 @@ static mesh_result column_on(scene_kind kind, int n, int threads, int turned) {
     r.size = scene_mean_size(&s);
     collapse_on_grid((int)lround(2.0 * column_half() / r.size), threads, &r);
     double *h = xcalloc((size_t)s.cells, sizeof(double));
-    collapse_on_mesh(&s, threads, h, &r);
+    deposit_track track = {.cells = s.cells};
+    collapse_on_mesh(&s, threads, h, &r, &track);
+    score_column(&s, h, &r);
+    /* against the grid's error: its column ran first */
+    r.settled_time = settled_time(&track, s.area, kPi * 0.5, kSettledShare * r.grid_l1);
+    track_free(&track);
     if (turned) {
         /* A turned copy of a mesh is the same mesh: only a choice bound to
          * the axes could make its deposit differ beyond rounding. */
@@ -259,7 +260,7 @@ static mesh_result column_on(scene_kind kind, int n, int threads, int turned) {
         scene_rotate(&t, 30.0 * kPi / 180.0);
         double *ht = xcalloc((size_t)t.cells, sizeof(double));
         mesh_result rt = r;
-        collapse_on_mesh(&t, threads, ht, &rt);
+        collapse_on_mesh(&t, threads, ht, &rt, NULL);
         r.rotated = l1_difference(h, ht, s.area, s.cells) / (kPi * 0.5) / r.l1;
         free(ht);
         scene_free(&t);
