@@ -351,8 +351,16 @@ inline double gradient_flow_flux(const Mesh &m, const FaceLaw &law, std::int64_t
 // over the monotone flux (high - low) that may enter and leave it, so that
 // its height stays within its own and its neighbours' (open edges' levels
 // included; with a bed, not below it) after the monotone update.
-inline void limits_of(const Mesh &m, const FaceLaw &law, const double *low, const double *high, const double *bed,
-                      std::int64_t c, double *limit_in, double *limit_out) {
+//
+// A cell at rest in a hollow (no face of it steep, no neighbour lower) takes
+// none of the excess. The pair terms of its neighbours' stencils reach it
+// across faces that are not steep, and beyond the toe of a slope they would
+// lay films of sand (1e-5 of the column's height, a cell past the toe on the
+// median dual) where the exact deposit has none; such a cell fills as the
+// model's own flux reaches it, once a face of it is steep.
+inline void limits_of(const Mesh &m, const FaceLaw &law, const double *low, const double *high,
+                      const std::uint8_t *steep, const double *bed, std::int64_t c, double *limit_in,
+                      double *limit_out) {
     limit_in[c] = limit_out[c] = 1.0;
     if (law.kind[c] != kSand) return;
     if (law.available && law.bare(c)) {
@@ -364,9 +372,11 @@ inline void limits_of(const Mesh &m, const FaceLaw &law, const double *low, cons
     // The monotone update's rate, summed over every face in the cell's face
     // order as net_rate does (the faces that carry nothing add 0).
     double rate = 0.0, highest = h, lowest = h, entering = 0.0, leaving = 0.0;
+    bool any_steep = false;
     for (std::int64_t k = m.cell_face_start[c]; k < m.cell_face_start[c + 1]; ++k) {
         const std::int64_t f = m.cell_faces[k];
         rate += m.into[k] * low[f];
+        any_steep = any_steep || steep[f];
         if (!law.carries(f)) continue;
         const std::int64_t o = m.other[k];
         const double v = o >= 0 ? law.h[o] : (law.edge_level ? law.edge_level[f] : 0.0);
@@ -379,11 +389,12 @@ inline void limits_of(const Mesh &m, const FaceLaw &law, const double *low, cons
             leaving -= enters;
     }
     const double monotone = h + law.dt * (rate / m.area[c]);
+    const bool resting_in_hollow = !any_steep && lowest >= h;
     if (bed) lowest = std::max(lowest, bed[c]);
     // A hair short of the bounds, so that the update's rounding does not cross them.
     const double room = kLimiterRoom * m.area[c] / law.dt;
     const double room_up = (highest - monotone) * room, room_down = (monotone - lowest) * room;
-    if (entering > 0.0) limit_in[c] = std::min(1.0, std::max(0.0, room_up / entering));
+    if (entering > 0.0) limit_in[c] = resting_in_hollow ? 0.0 : std::min(1.0, std::max(0.0, room_up / entering));
     if (leaving > 0.0) limit_out[c] = std::min(1.0, std::max(0.0, room_down / leaving));
 }
 
@@ -754,7 +765,7 @@ private:
                     high[f] = gradient_flow_flux(m, law, f, high[f], pull_x, pull_y);
             }
 #pragma omp parallel for num_threads(threads) if (parallel) schedule(static)
-            for (std::int64_t c = 0; c < pass_cells; ++c) limits_of(m, law, low, high, bed, c, limit_in, limit_out);
+            for (std::int64_t c = 0; c < pass_cells; ++c) limits_of(m, law, low, high, steep, bed, c, limit_in, limit_out);
             if (parts && !in_batch) exchange_ghost_limits(s);
             if (!s.switches.scalar_mesh && !law.available) {
                 double largest = -1.0;
@@ -898,7 +909,7 @@ private:
             // Limiters: the owned cells of those faces.
             owned_cells_of(m, s, s.faces, s.limit_cells, threads);
             for_each_item(s.limit_cells, threads,
-                          [&](std::int64_t c) { limits_of(m, law, low, high, bed, c, limit_in, limit_out); });
+                          [&](std::int64_t c) { limits_of(m, law, low, high, steep, bed, c, limit_in, limit_out); });
             if (exchanges) exchange_ghost_limits(s);
             if (!s.switches.scalar_mesh && !law.available)
                 for_each_share(s.faces, threads, [&](const std::int64_t *faces, std::int64_t count) {
@@ -1178,7 +1189,7 @@ private:
         };
         const auto gradient = [&](std::int64_t c) { gradient_of(m, law.h, kind.data(), c, s.gx.data(), s.gy.data()); };
         const auto flow = [&](std::int64_t f) { high[f] = gradient_flow_flux(m, law, f, high[f], pull_x, pull_y); };
-        const auto limit = [&](std::int64_t c) { limits_of(m, law, low, high, bed, c, limit_in, limit_out); };
+        const auto limit = [&](std::int64_t c) { limits_of(m, law, low, high, steep, bed, c, limit_in, limit_out); };
         const auto limited = [&](std::int64_t f) { flux[f] = limited_flux(m, law, f, low[f], high[f], limit_in, limit_out); };
         // The three face passes over a list of faces (each listed once), in
         // lanes where a sub-step's would be: the faces' terms on a plain
