@@ -902,12 +902,16 @@ static void test_turned_mesh_same_deposit(void **state) {
     }
 }
 
-/* The column (radius 1, height 0.5, 30 degrees, open edge) on the scene's
- * mesh stepped to rest: its L1 difference from the exact deposit (a
- * truncated cone whose foot keeps the volume) over the column's volume. */
-static double column_error(const mesh_scene *s) {
-    const double pi = 3.14159265358979323846, alpha = tan(30.0 * kDeg);
-    const double foot = (0.5 + sqrt(4.0 * alpha * alpha - 0.25 / 3.0)) / (2.0 * alpha);
+/* The foot of the exact deposit of the column (radius 1, height 0.5, 30
+ * degrees): a truncated cone that keeps the volume. */
+static double column_foot(void) {
+    const double alpha = tan(30.0 * kDeg);
+    return (0.5 + sqrt(4.0 * alpha * alpha - 0.25 / 3.0)) / (2.0 * alpha);
+}
+
+/* The column (open edge) on the scene's mesh stepped to rest: its heights,
+ * which the caller frees. */
+static double *column_at_rest(const mesh_scene *s) {
     dpsm_grid *g = column_mesh(s, 1, 0);
     int rested = 0;
     for (int call = 0; call < 400 && !rested; ++call) {
@@ -915,12 +919,20 @@ static double column_error(const mesh_scene *s) {
         rested = step_info_of(g, DPSM_INFO_AT_REST) > 0.0;
     }
     REQUIRE(rested, "%s, %lld cells: the column did not rest by t = 20", scene_name(s->kind), (long long)s->cells);
-    double *h = calloc((size_t)s->cells, sizeof(double)), error = 0.0;
+    double *h = calloc((size_t)s->cells, sizeof(double));
     CHECK_OK(g, dpsm_get_heights(g, h));
+    dpsm_destroy(g);
+    return h;
+}
+
+/* The column at rest: its L1 difference from the exact deposit over the
+ * column's volume. */
+static double column_error(const mesh_scene *s) {
+    const double pi = 3.14159265358979323846, alpha = tan(30.0 * kDeg), foot = column_foot();
+    double *h = column_at_rest(s), error = 0.0;
     for (int64_t c = 0; c < s->cells; ++c)
         error += fabs(h[c] - fmin(0.5, fmax(0.0, alpha * (foot - hypot(s->cx[c], s->cy[c]))))) * s->area[c];
     free(h);
-    dpsm_destroy(g);
     return error / (pi * 0.5);
 }
 
@@ -962,20 +974,11 @@ static void test_no_sand_beyond_the_toe(void **state) {
      * under AddressSanitizer in every other column of this file. */
     skip();
 #endif
-    const double alpha = tan(30.0 * kDeg);
-    const double foot = (0.5 + sqrt(4.0 * alpha * alpha - 0.25 / 3.0)) / (2.0 * alpha);
+    const double foot = column_foot();
     const scene_kind kinds[4] = {SCENE_QUADS, SCENE_TRIANGLES, SCENE_HEXAGONS, SCENE_DUAL};
     for (int k = 0; k < 4; ++k) {
         mesh_scene s = scene_make(kinds[k], 24, 2.5, 7u);
-        dpsm_grid *g = column_mesh(&s, 1, 0);
-        int rested = 0;
-        for (int call = 0; call < 400 && !rested; ++call) {
-            CHECK_OK(g, dpsm_step(g, 0.05));
-            rested = step_info_of(g, DPSM_INFO_AT_REST) > 0.0;
-        }
-        REQUIRE(rested, "%s: the column did not rest by t = 20", scene_name(kinds[k]));
-        double *h = calloc((size_t)s.cells, sizeof(double));
-        CHECK_OK(g, dpsm_get_heights(g, h));
+        double *h = column_at_rest(&s);
         const double size = scene_mean_size(&s);
         double farthest = -1e300, film = 0.0;
         for (int64_t c = 0; c < s.cells; ++c) {
@@ -986,7 +989,6 @@ static void test_no_sand_beyond_the_toe(void **state) {
         REQUIRE(farthest <= 0.5, "%s: sand of %.3g lies %.2f cells beyond the foot", scene_name(kinds[k]), film,
                 farthest);
         free(h);
-        dpsm_destroy(g);
         scene_free(&s);
     }
 }

@@ -355,9 +355,9 @@ inline double gradient_flow_flux(const Mesh &m, const FaceLaw &law, std::int64_t
 // A cell at rest in a hollow (no face of it steep, no neighbour lower) takes
 // none of the excess. The pair terms of its neighbours' stencils reach it
 // across faces that are not steep, and beyond the toe of a slope they would
-// lay films of sand (1e-5 of the column's height, a cell past the toe on the
-// median dual) where the exact deposit has none; such a cell fills as the
-// model's own flux reaches it, once a face of it is steep.
+// lay films of sand where the exact deposit has none (docs/guarantees.md,
+// "No new extremum"); such a cell fills as the model's own flux reaches it,
+// once a face of it is steep.
 inline void limits_of(const Mesh &m, const FaceLaw &law, const double *low, const double *high,
                       const std::uint8_t *steep, const double *bed, std::int64_t c, double *limit_in,
                       double *limit_out) {
