@@ -87,6 +87,8 @@ int cmd_mesh_wind(int argc, char **argv);     /* mesh_study.c */
 int cmd_lts(int argc, char **argv);           /* lts_study.c */
 int cmd_mesh_graded(int argc, char **argv);   /* lts_study.c */
 int cmd_lts_compare(int argc, char **argv);   /* lts_study.c */
+int cmd_mesh_energies(int argc, char **argv); /* energy_study.c */
+int cmd_mesh_plane(int argc, char **argv);    /* energy_study.c */
 /* A plane three times steeper than repose with ripples, n x n cells of width 1 (speed.c). */
 void steep_surface(double *h, int64_t n);
 

@@ -282,6 +282,13 @@ static const command kCommands[] = {
      " rest time, settled time, beside the 2D grid of the same cell size and the mesh turned by 30 degrees; the cone on triangles;"
      " mesh `ridge`: a ridge between walls (64 cells a side, doubled each level) against the exact triangle and the grid;"
      " mesh `slope`: the same walls holding a triangle 1 % steeper than repose (the rest tail alone)"},
+    {"mesh-plane", cmd_mesh_plane,
+     "mesh n  a plane 1 % steeper than repose on n cells a side of the mesh (quadrilaterals, jittered_triangles,"
+     " hexagons, median_dual): how fast one stable sub-step moves its inside, against the plane's flux over the cell size"},
+    {"mesh-energies", cmd_mesh_energies,
+     "mesh n energy [jitter]  the column collapse of mesh-accuracy under the gradient flow of one face or cell energy"
+     " (faces: the library's; node-diamond; on median_dual also triangle-tangents, triangles), explicit, no limiter, to"
+     " rest: rest time and L1 error (not the library: a copy of its flow to try energies beside it)"},
     {"mesh-graded", cmd_mesh_graded,
      "[levels [coarse_across [seconds]]]  issue 34's graded mesh: squares from h to 2^levels h (9: 512 h), piles on the"
      " fine cells, on the coarse ones (and on a uniform mesh of them) and straddling the grading, each to rest or for"

@@ -99,14 +99,14 @@ static void make_lattice_polygons(mesh_scene *s, int n, int triangles) {
     s->cell_start[p] = k;
 }
 
-/* Triangles over the lattice jittered by up to 0.3 of the spacing along each
+/* Triangles over the lattice jittered by up to `jitter` of the spacing along each
  * axis, each square split along its shorter diagonal (as a Delaunay
  * triangulation would); a node of a triangle with less than a quarter of the
  * unjittered area moves halfway back to its lattice place until none is
  * left, as a mesh generator keeps its triangles from slivers (whose small
  * sub-step would set the pace of the whole mesh). */
-static void jittered_triangles(mesh_scene *s, int n, double half, unsigned seed) {
-    lattice_nodes(s, n, half, 0.3, seed);
+static void jittered_triangles(mesh_scene *s, int n, double half, double jitter, unsigned seed) {
+    lattice_nodes(s, n, half, jitter, seed);
     const double h = 2.0 * half / n;
     for (int round = 0; round < 20; ++round) {
         free(s->cell_start), free(s->cell_nodes);
@@ -242,6 +242,10 @@ mesh_scene scene_read_msh(const char *path) {
 }
 
 mesh_scene scene_make(scene_kind kind, int n, double half, unsigned seed) {
+    return scene_make_jittered(kind, n, half, 0.3, seed);
+}
+
+mesh_scene scene_make_jittered(scene_kind kind, int n, double half, double jitter, unsigned seed) {
     mesh_scene s;
     memset(&s, 0, sizeof s);
     s.kind = kind;
@@ -265,7 +269,7 @@ mesh_scene scene_make(scene_kind kind, int n, double half, unsigned seed) {
             polygon_cells(&s);
             break;
         case SCENE_TRIANGLES:
-            jittered_triangles(&s, n, half, seed);
+            jittered_triangles(&s, n, half, jitter, seed);
             polygon_cells(&s);
             break;
         case SCENE_HEXAGONS:
@@ -273,7 +277,7 @@ mesh_scene scene_make(scene_kind kind, int n, double half, unsigned seed) {
             polygon_cells(&s);
             break;
         case SCENE_DUAL: {
-            jittered_triangles(&s, n, half, seed);
+            jittered_triangles(&s, n, half, jitter, seed);
             /* triangles as 3 nodes each, cell_start unused by the dual */
             dual_cells(&s);
             break;

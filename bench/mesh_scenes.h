@@ -30,6 +30,9 @@ typedef struct {
  * gmsh with triangles of size 7 / n (gmsh must be on the PATH and
  * DPSM_DISK_GEO name the .geo file; an empty scene, cells == 0, otherwise). */
 mesh_scene scene_make(scene_kind kind, int n, double half, unsigned seed);
+/* The same with the lattice's inner nodes of the triangles and the dual
+ * jittered by up to `jitter` of the spacing (scene_make: 0.3). */
+mesh_scene scene_make_jittered(scene_kind kind, int n, double half, double jitter, unsigned seed);
 /* Reads the triangles of a gmsh file in the MSH 2.2 ASCII format. */
 mesh_scene scene_read_msh(const char *path);
 /* Creates the dpsm mesh of the scene (dpsm_create_mesh or dpsm_create_dual_mesh). */
