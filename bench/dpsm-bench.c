@@ -287,7 +287,7 @@ static const command kCommands[] = {
      " hexagons, median_dual): how fast one stable sub-step moves its inside, against the plane's flux over the cell size"},
     {"mesh-energies", cmd_mesh_energies,
      "mesh n energy [jitter]  the column collapse of mesh-accuracy under the gradient flow of one face or cell energy"
-     " (faces: the library's; node-diamond; on median_dual also triangle-tangents, triangles), explicit, no limiter, to"
+     " (faces: the library's; node-diamond; on median_dual also triangle-tangents, triangles, faces-and-triangles), explicit, no limiter, to"
      " rest: rest time and L1 error (not the library: a copy of its flow to try energies beside it)"},
     {"mesh-graded", cmd_mesh_graded,
      "[levels [coarse_across [seconds]]]  issue 34's graded mesh: squares from h to 2^levels h (9: 512 h), piles on the"

@@ -7,7 +7,7 @@
  * size. A consistent step leaves a plane's inside as it is.
  *
  * dpsm-bench mesh-energies KIND N ENERGY [JITTER]: the column collapse of
- * mesh-accuracy (a = 0.5, 30 degrees) under the gradient flow of one of four
+ * mesh-accuracy (a = 0.5, 30 degrees) under the gradient flow of one of five
  * face or cell energies, explicit, with no limiter, to rest: when it rests
  * and its L1 difference from the exact deposit at the cells' centres over
  * the volume. Not the library: a small copy of its flow that runs in seconds,
@@ -25,7 +25,9 @@
  *   triangle-tangents the median dual only: as `faces`, the part across the
  *                     face from the two triangles' own linear gradients;
  *   triangles         the median dual only: per triangle, the linear
- *                     interpolant's gradient (finite elements, lumped mass).
+ *                     interpolant's gradient (finite elements, lumped mass);
+ *   faces-and-triangles  the median dual only: half of `faces` and half of
+ *                     `triangles`.
  * JITTER (0.3, the benchmark's) moves the lattice's inner nodes of the
  * triangles and the dual. Faces on the domain edge carry nothing here: the
  * column never reaches it. */
@@ -41,8 +43,16 @@ static const double kPi = 3.14159265358979323846;
 static const double kTheta = 30.0 * 3.14159265358979323846 / 180.0;
 static const double kTolerance = 1e-6;
 
-typedef enum { ENERGY_FACES, ENERGY_NODE_DIAMOND, ENERGY_TRIANGLE_TANGENTS, ENERGY_TRIANGLES } energy_kind;
-static const char *const kEnergyNames[] = {"faces", "node-diamond", "triangle-tangents", "triangles"};
+typedef enum {
+    ENERGY_FACES,
+    ENERGY_NODE_DIAMOND,
+    ENERGY_TRIANGLE_TANGENTS,
+    ENERGY_TRIANGLES,
+    ENERGY_FACES_AND_TRIANGLES
+} energy_kind;
+static const char *const kEnergyNames[] = {"faces", "node-diamond", "triangle-tangents", "triangles",
+                                           "faces-and-triangles"};
+enum { kEnergies = 5 };
 
 /* A face between cells a and b: e the unit vector from a to b, t across it,
  * d the distance, n the normal times the length (from a to b), orthogonal =
@@ -232,15 +242,18 @@ static double energy_derivative(const study_mesh *m, energy_kind energy, const d
     const mesh_scene *s = &m->s;
     double worst = -1.0;
     memset(de, 0, (size_t)s->cells * sizeof(double));
-    if (energy == ENERGY_TRIANGLES) {
+    /* faces-and-triangles: half of each energy, so that a plane's is still exact */
+    const double share = energy == ENERGY_FACES_AND_TRIANGLES ? 0.5 : 1.0;
+    if (energy == ENERGY_TRIANGLES || energy == ENERGY_FACES_AND_TRIANGLES) {
         for (int64_t t = 0; t < s->npolygons; ++t) {
             double bx[3], by[3], area, gx = 0.0, gy = 0.0;
             triangle_basis(s, t, bx, by, &area);
             for (int i = 0; i < 3; ++i) gx += h[s->cell_nodes[3 * t + i]] * bx[i], gy += h[s->cell_nodes[3 * t + i]] * by[i];
             const double g = law(hypot(gx, gy), &worst);
-            for (int i = 0; i < 3; ++i) de[s->cell_nodes[3 * t + i]] += area * g * (gx * bx[i] + gy * by[i]);
+            for (int i = 0; i < 3; ++i) de[s->cell_nodes[3 * t + i]] += share * area * g * (gx * bx[i] + gy * by[i]);
         }
-        return worst;
+        if (energy == ENERGY_TRIANGLES) return worst;
+        energy = ENERGY_FACES;
     }
     for (int64_t c = 0; c < s->cells; ++c) {
         double x = 0.0, y = 0.0;
@@ -275,7 +288,7 @@ static double energy_derivative(const study_mesh *m, energy_kind energy, const d
         const double g = law(hypot(along, across), &worst);
         if (g == 0.0) continue;
         /* dE_f/d(along) and dE_f/d(across), E_f = V Phi, V = orthogonal d / 2 */
-        const double volume = 0.5 * f->orthogonal * f->d, by_along = volume * g * along, by_across = volume * g * across;
+        const double volume = share * 0.5 * f->orthogonal * f->d, by_along = volume * g * along, by_across = volume * g * across;
         if (energy == ENERGY_NODE_DIAMOND) {
             const double skewed = by_across * (f->nx * f->tx + f->ny * f->ty) / (f->orthogonal * f->d);
             de[f->b] += by_along / f->d + skewed, de[f->a] -= by_along / f->d + skewed;
@@ -323,11 +336,11 @@ int cmd_mesh_energies(int argc, char **argv) {
     }
     const int n = atoi(argv[1]);
     int energy = -1;
-    for (int e = 0; e < 4; ++e)
+    for (int e = 0; e < kEnergies; ++e)
         if (strcmp(argv[2], kEnergyNames[e]) == 0) energy = e;
     if (n < 4 || energy < 0 || (energy >= ENERGY_TRIANGLE_TANGENTS && kind != SCENE_DUAL)) {
         fprintf(stderr, "mesh-energies: N at least 4; ENERGY faces, node-diamond, or on median_dual also "
-                        "triangle-tangents, triangles\n");
+                        "triangle-tangents, triangles, faces-and-triangles\n");
         return 2;
     }
     const double jitter = argc > 3 ? atof(argv[3]) : 0.3;
