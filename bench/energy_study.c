@@ -344,7 +344,7 @@ int cmd_mesh_energies(int argc, char **argv) {
         return 2;
     }
     const double jitter = argc > 3 ? atof(argv[3]) : 0.3;
-    const double alpha = tan(kTheta), foot = (0.5 + sqrt(4.0 * alpha * alpha - 0.25 / 3.0)) / (2.0 * alpha);
+    const double alpha = tan(kTheta), foot = scene_column_foot(alpha);
     study_mesh m;
     memset(&m, 0, sizeof m);
     m.s = scene_make_jittered(kind, n, 1.25 * fmax(2.0, foot), jitter, 12345u);

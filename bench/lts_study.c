@@ -182,8 +182,6 @@ typedef struct {
     int classes[4];      /* cells per class: sub-step 1, 2, 4, 8+ times the smallest */
 } lts_result;
 
-static double column_foot(double alpha) { return (0.5 + sqrt(4.0 * alpha * alpha - 0.25 / 3.0)) / (2.0 * alpha); }
-
 /* Each cell's sub-step class: the largest power of two k with k times the
  * mesh's sub-step within the cell's own bound (capped at 64). */
 static void own_classes(const mesh_scene *s, dpsm_grid *g, double *klass, double *ratio) {
@@ -228,7 +226,7 @@ static lts_result run(const char *name, const mesh_scene *s, int relaxation) {
         r.smallest = fmin(r.smallest, sqrt(s->area[c]));
         r.largest = fmax(r.largest, sqrt(s->area[c]));
     }
-    const double theta = 30.0 * kPi / 180.0, alpha = tan(theta), foot = column_foot(alpha);
+    const double theta = 30.0 * kPi / 180.0, alpha = tan(theta), foot = scene_column_foot(alpha);
     double *h = xcalloc((size_t)s->cells, sizeof(double)), *before = xcalloc((size_t)s->cells, sizeof(double));
     double *klass = xcalloc((size_t)s->cells, sizeof(double));
     unsigned char *active = xcalloc((size_t)s->cells, 1);

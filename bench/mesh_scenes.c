@@ -286,6 +286,8 @@ mesh_scene scene_make_jittered(scene_kind kind, int n, double half, double jitte
     return s;
 }
 
+double scene_column_foot(double alpha) { return (0.5 + sqrt(4.0 * alpha * alpha - 0.25 / 3.0)) / (2.0 * alpha); }
+
 int scene_create(const mesh_scene *s, dpsm_grid **out) {
     if (s->kind == SCENE_DUAL) return dpsm_create_dual_mesh(s->nnodes, s->node_xy, s->npolygons, s->cell_nodes, out);
     return dpsm_create_mesh(s->nnodes, s->node_xy, s->npolygons, s->cell_start, s->cell_nodes, out);

@@ -37,6 +37,10 @@ mesh_scene scene_make_jittered(scene_kind kind, int n, double half, double jitte
 mesh_scene scene_read_msh(const char *path);
 /* Creates the dpsm mesh of the scene (dpsm_create_mesh or dpsm_create_dual_mesh). */
 int scene_create(const mesh_scene *s, dpsm_grid **out);
+/* The column collapse's exact deposit (a column of radius 1 and height 0.5
+ * slid to rest at slope alpha): the foot of the truncated cone that keeps
+ * the column's volume. */
+double scene_column_foot(double alpha);
 /* The share of every cell inside the disk of radius r about the origin. */
 void scene_disk_fractions(const mesh_scene *s, double r, double *share);
 /* Turns the scene by `angle` radians about the origin: its nodes and its

@@ -108,7 +108,6 @@ static void track_free(deposit_track *track) {
     free(track->times);
 }
 
-static double column_foot(double alpha) { return (0.5 + sqrt(4.0 * alpha * alpha - 0.25 / 3.0)) / (2.0 * alpha); }
 
 /* Steps in calls of dt until the surface rests or t_end passes; with a
  * track, keeps the heights after every call. */
@@ -147,7 +146,7 @@ static dpsm_grid *open_mesh(const mesh_scene *s, double theta, int threads, cons
 /* The column (a = 0.5, 30 degrees, radius 1 about the origin) poured on the
  * scene's cells as cell averages; the square it stands on. */
 static const double kColumnTheta = 30.0 * 3.14159265358979323846 / 180.0;
-static double column_half(void) { return 1.25 * fmax(2.0, column_foot(tan(kColumnTheta))); }
+static double column_half(void) { return 1.25 * fmax(2.0, scene_column_foot(tan(kColumnTheta))); }
 static double *poured_column(const mesh_scene *s) {
     double *h = xcalloc((size_t)s->cells, sizeof(double));
     scene_disk_fractions(s, 1.0, h);
@@ -158,7 +157,7 @@ static double *poured_column(const mesh_scene *s) {
 /* The L1 error of the deposit h on the scene's cells over the column's
  * volume, its runout in 16 directions against the exact foot, its top. */
 static void score_column(const mesh_scene *s, const double *h, mesh_result *r) {
-    const double alpha = tan(kColumnTheta), foot = column_foot(alpha);
+    const double alpha = tan(kColumnTheta), foot = scene_column_foot(alpha);
     double err = 0.0, top = 0.0, runout[16] = {0};
     for (int64_t c = 0; c < s->cells; ++c) {
         const double radius = hypot(s->cx[c], s->cy[c]);
@@ -424,7 +423,7 @@ int cmd_mesh_accuracy(int argc, char **argv) {
         int n;
     } kinds[] = {{SCENE_QUADS, 64}, {SCENE_TRIANGLES, 45}, {SCENE_HEXAGONS, 59}, {SCENE_DUAL, 64}, {SCENE_GMSH_DISK, 64}};
     fprintf(stderr, "mesh-accuracy: column collapse a = 0.5, 30 deg, open edges; exact foot %.4f; threads %d\n",
-            column_foot(tan(kColumnTheta)), threads);
+            scene_column_foot(tan(kColumnTheta)), threads);
     printf("scene,mesh,cells,mean_size,l1_error,order,runout_error_cells,at_rest,rest_time,cell_updates,seconds,"
            "grid_cells,grid_l1_error,grid_rest_time,rest_time_ratio,turned_difference,settled_time,grid_settled_time,"
            "settled_time_ratio\n");

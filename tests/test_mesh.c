@@ -905,8 +905,7 @@ static void test_turned_mesh_same_deposit(void **state) {
 /* The foot of the exact deposit of the column (radius 1, height 0.5, 30
  * degrees): a truncated cone that keeps the volume. */
 static double column_foot(void) {
-    const double alpha = tan(30.0 * kDeg);
-    return (0.5 + sqrt(4.0 * alpha * alpha - 0.25 / 3.0)) / (2.0 * alpha);
+    return scene_column_foot(tan(30.0 * kDeg));
 }
 
 /* The column (open edge) on the scene's mesh stepped to rest: its heights,
