@@ -8,6 +8,7 @@
 
 #include "mesh/face_lanes.hpp"
 #include "mesh/ghost_exchange.hpp"
+#include "mesh/list_passes.hpp"
 #include "mesh/mesh_parts.hpp"
 #include "mesh/mesh_state.hpp"
 #include "model/distribution.hpp"
@@ -35,58 +36,6 @@ constexpr double kDenseShare = 0.25;
 
 // The threads a pass over every cell of `cells` runs on.
 inline int threads_in_use(int threads, std::int64_t cells) { return cells >= kCellsForThreads ? threads : 1; }
-
-// Below this many items a pass over a list runs on one thread: an item of
-// a list costs several cells of a plain pass (its data lies scattered).
-constexpr std::int64_t kListItemsForThreads = 4096;
-
-// Calls work(k, item) for every item of a list and its place k in it, on the
-// threads where the list is long enough. Each item's work must write only
-// its own item's values (every pass is a gather), so the results do not
-// depend on the threads.
-template <class Work>
-void for_each_place(const std::int64_t *items, std::int64_t count, int threads, const Work &work) {
-    // Not even a team of one where the list is short: a sparse sub-step
-    // makes a dozen passes, and a small pile's take microseconds.
-    if (threads < 2 || count < kListItemsForThreads) {
-        for (std::int64_t k = 0; k < count; ++k) work(k, items[k]);
-        return;
-    }
-#pragma omp parallel for num_threads(threads) schedule(static)
-    for (std::int64_t k = 0; k < count; ++k) work(k, items[k]);
-}
-template <class Work>
-void for_each_place(const std::vector<std::int64_t> &list, int threads, const Work &work) {
-    for_each_place(list.data(), static_cast<std::int64_t>(list.size()), threads, work);
-}
-// The same, work(item) alone.
-template <class Work>
-void for_each_item(const std::int64_t *items, std::int64_t count, int threads, const Work &work) {
-    for_each_place(items, count, threads, [&](std::int64_t, std::int64_t item) { work(item); });
-}
-template <class Work>
-void for_each_item(const std::vector<std::int64_t> &list, int threads, const Work &work) {
-    for_each_item(list.data(), static_cast<std::int64_t>(list.size()), threads, work);
-}
-// Calls work(items, count) for a share of a list a thread (the whole list
-// on one thread where it is short): the passes in lanes over a list.
-template <class Work>
-void for_each_share(const std::int64_t *items, std::int64_t count, int threads, const Work &work) {
-    if (threads < 2 || count < kListItemsForThreads) {
-        work(items, count);
-        return;
-    }
-    const int shares = threads;
-#pragma omp parallel for num_threads(threads) schedule(static)
-    for (int r = 0; r < shares; ++r) {
-        const std::int64_t begin = count * r / shares, end = count * (r + 1) / shares;
-        work(items + begin, end - begin);
-    }
-}
-template <class Work>
-void for_each_share(const std::vector<std::int64_t> &list, int threads, const Work &work) {
-    for_each_share(list.data(), static_cast<std::int64_t>(list.size()), threads, work);
-}
 
 // The share of the room to its bounds a cell's limiter lets the gradient
 // flow's excess fill.
@@ -828,7 +777,7 @@ private:
             if (static_cast<std::size_t>(changed_cells) + kept_hot_by_sources(s) > most) {
                 act.wake_all();
             } else {
-                act.cool_all();
+                act.cool_all(threads);
                 for (std::int64_t c = 0; c < n && !act.all_hot; ++c)
                     if (changed[c]) {
                         act.wake_around(m, c);
@@ -926,7 +875,7 @@ private:
             watch_near_moves(m, s, s.update_cells);
             watch_near_moves(m, s, changed_ghosts);
             // The next sub-step's hot cells (MeshActivity::wake_around), woken on the threads.
-            act.cool_all();
+            act.cool_all(threads);
             s.cell_set.reserve(m.cells);
             const auto wake_around = [&](std::int64_t c) {
                 MeshActivity::for_each_around(m, c, [&](std::int64_t e) { s.cell_set.add(e); });
@@ -936,8 +885,8 @@ private:
             if (s.lazy)  // else the sources' cells are among those updated
                 for_each_item(s.watched_cells, threads, [&](std::int64_t c) { s.cell_set.add(c); });
             act.wake_set(s.cell_set, threads);
-            for (const std::int64_t c : s.pull_cells) pull_x[c] = pull_y[c] = 0.0;
-            for (const std::int64_t c : s.limit_cells) limit_in[c] = limit_out[c] = 1.0;
+            for_each_item(s.pull_cells, threads, [&](std::int64_t c) { pull_x[c] = pull_y[c] = 0.0; });
+            for_each_item(s.limit_cells, threads, [&](std::int64_t c) { limit_in[c] = limit_out[c] = 1.0; });
         }
         into_sinks(m, s, kind.data(), did);
         if (record) {
@@ -950,7 +899,7 @@ private:
             }
         }
         if (!dense)
-            for (const std::int64_t f : s.faces) flux[f] = low[f] = high[f] = pull[f] = 0.0;
+            for_each_item(s.faces, threads, [&](std::int64_t f) { flux[f] = low[f] = high[f] = pull[f] = 0.0; });
         did.moved = moved;
         did.max_excess_slope = max_excess;
         return did;
@@ -1396,7 +1345,7 @@ private:
             for (const std::int64_t c : changed_ghosts) wake_local_around(m, s, c);
             if (s.lazy)
                 for (const std::int64_t c : s.watched_cells) wake_local(s, c);
-            for (const std::int64_t c : s.limit_cells) limit_in[c] = limit_out[c] = 1.0;
+            for_each_item(s.limit_cells, threads, [&](std::int64_t c) { limit_in[c] = limit_out[c] = 1.0; });
             written_faces = s.faces.data(), written_count = static_cast<std::int64_t>(s.faces.size());
             pulled_cells = s.pull_cells.data(), pulled_count = static_cast<std::int64_t>(s.pull_cells.size());
             // Most of the mesh hot: the ticks run over the classes' lists until every face has fired.

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "mesh/index_set.hpp"
+#include "mesh/list_passes.hpp"
 #include "mesh/ghost_exchange.hpp"
 #include "mesh/step_classes.hpp"
 #include "model/engine.hpp"
@@ -32,8 +33,8 @@ struct MeshActivity {
         all_hot = true;
     }
     // Starts a list of hot cells from none.
-    void cool_all() {
-        for (const std::int64_t c : hot_list) hot[c] = 0;
+    void cool_all(int threads = 1) {
+        for_each_item(hot_list, threads, [&](std::int64_t c) { hot[c] = 0; });
         hot_list.clear();
         all_hot = false;
     }
@@ -56,7 +57,7 @@ struct MeshActivity {
     // After cool_all: the cells of a set hot, listed in cell order (the set empties).
     void wake_set(IndexSet &woken, int threads) {
         woken.take(hot_list, threads);
-        for (const std::int64_t c : hot_list) hot[c] = 1;
+        for_each_item(hot_list, threads, [&](std::int64_t c) { hot[c] = 1; });
     }
     bool may_move() const { return all_hot || !hot_list.empty(); }
 };
