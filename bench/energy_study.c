@@ -7,7 +7,7 @@
  * size. A consistent step leaves a plane's inside as it is.
  *
  * dpsm-bench mesh-energies KIND N ENERGY [JITTER]: the column collapse of
- * mesh-accuracy (a = 0.5, 30 degrees) under the gradient flow of one of five
+ * mesh-accuracy (a = 0.5, 30 degrees) under the gradient flow of one of seven
  * face or cell energies, explicit, with no limiter, to rest: when it rests
  * and its L1 difference from the exact deposit at the cells' centres over
  * the volume. Not the library: a small copy of its flow that runs in seconds,
@@ -27,7 +27,9 @@
  *   triangles         the median dual only: per triangle, the linear
  *                     interpolant's gradient (finite elements, lumped mass);
  *   faces-and-triangles  the median dual only: half of `faces` and half of
- *                     `triangles`.
+ *                     `triangles`;
+ *   cells             per cell, its area, G = its least-squares gradient;
+ *   faces-and-cells   half of `faces` and half of `cells`.
  * JITTER (0.3, the benchmark's) moves the lattice's inner nodes of the
  * triangles and the dual. Faces on the domain edge carry nothing here: the
  * column never reaches it. */
@@ -48,11 +50,13 @@ typedef enum {
     ENERGY_NODE_DIAMOND,
     ENERGY_TRIANGLE_TANGENTS,
     ENERGY_TRIANGLES,
-    ENERGY_FACES_AND_TRIANGLES
+    ENERGY_FACES_AND_TRIANGLES,
+    ENERGY_CELLS,
+    ENERGY_FACES_AND_CELLS
 } energy_kind;
 static const char *const kEnergyNames[] = {"faces", "node-diamond", "triangle-tangents", "triangles",
-                                           "faces-and-triangles"};
-enum { kEnergies = 5 };
+                                           "faces-and-triangles", "cells", "faces-and-cells"};
+enum { kEnergies = 7 };
 
 /* A face between cells a and b: e the unit vector from a to b, t across it,
  * d the distance, n the normal times the length (from a to b), orthogonal =
@@ -242,8 +246,9 @@ static double energy_derivative(const study_mesh *m, energy_kind energy, const d
     const mesh_scene *s = &m->s;
     double worst = -1.0;
     memset(de, 0, (size_t)s->cells * sizeof(double));
-    /* faces-and-triangles: half of each energy, so that a plane's is still exact */
-    const double share = energy == ENERGY_FACES_AND_TRIANGLES ? 0.5 : 1.0;
+    /* faces-and-triangles, faces-and-cells: half of each energy, so that a plane's is still exact */
+    const double share = energy == ENERGY_FACES_AND_TRIANGLES || energy == ENERGY_FACES_AND_CELLS ? 0.5 : 1.0;
+    const int cells_too = energy == ENERGY_CELLS || energy == ENERGY_FACES_AND_CELLS;
     if (energy == ENERGY_TRIANGLES || energy == ENERGY_FACES_AND_TRIANGLES) {
         for (int64_t t = 0; t < s->npolygons; ++t) {
             double bx[3], by[3], area, gx = 0.0, gy = 0.0;
@@ -255,6 +260,7 @@ static double energy_derivative(const study_mesh *m, energy_kind energy, const d
         if (energy == ENERGY_TRIANGLES) return worst;
         energy = ENERGY_FACES;
     }
+    if (energy == ENERGY_FACES_AND_CELLS) energy = ENERGY_FACES;
     for (int64_t c = 0; c < s->cells; ++c) {
         double x = 0.0, y = 0.0;
         for (int64_t k = m->grad_start[c]; k < m->grad_start[c + 1]; ++k) {
@@ -268,7 +274,7 @@ static double energy_derivative(const study_mesh *m, energy_kind energy, const d
         for (int64_t k = m->end_start[v]; k < m->end_start[v + 1]; ++k) x += m->end_weight[k] * h[m->end_cell[k]];
         w->end_h[v] = x, w->end_pull[v] = 0.0;
     }
-    for (int64_t k = 0; k < m->faces; ++k) {
+    for (int64_t k = 0; k < m->faces && energy != ENERGY_CELLS; ++k) {
         const study_face *f = &m->face[k];
         const double along = (h[f->b] - h[f->a]) / f->d;
         double across = 0.0, b1x[3], b1y[3], b2x[3], b2y[3], area;
@@ -307,7 +313,13 @@ static double energy_derivative(const study_mesh *m, energy_kind energy, const d
             }
         }
     }
-    if (energy == ENERGY_FACES)
+    /* A cell's part of E asks of its own gradient what a face's asks of its cells' along t. */
+    if (cells_too)
+        for (int64_t c = 0; c < s->cells; ++c) {
+            const double g = law(hypot(w->gx[c], w->gy[c]), &worst), volume = share * s->area[c];
+            w->pull_x[c] += volume * g * w->gx[c], w->pull_y[c] += volume * g * w->gy[c];
+        }
+    if (energy == ENERGY_FACES || energy == ENERGY_CELLS)
         for (int64_t c = 0; c < s->cells; ++c)
             for (int64_t k = m->grad_start[c]; k < m->grad_start[c + 1]; ++k) {
                 const double p = m->grad_wx[k] * w->pull_x[c] + m->grad_wy[k] * w->pull_y[c];
@@ -338,9 +350,10 @@ int cmd_mesh_energies(int argc, char **argv) {
     int energy = -1;
     for (int e = 0; e < kEnergies; ++e)
         if (strcmp(argv[2], kEnergyNames[e]) == 0) energy = e;
-    if (n < 4 || energy < 0 || (energy >= ENERGY_TRIANGLE_TANGENTS && kind != SCENE_DUAL)) {
-        fprintf(stderr, "mesh-energies: N at least 4; ENERGY faces, node-diamond, or on median_dual also "
-                        "triangle-tangents, triangles, faces-and-triangles\n");
+    const int dual_only = energy >= ENERGY_TRIANGLE_TANGENTS && energy <= ENERGY_FACES_AND_TRIANGLES;
+    if (n < 4 || energy < 0 || (dual_only && kind != SCENE_DUAL)) {
+        fprintf(stderr, "mesh-energies: N at least 4; ENERGY faces, node-diamond, cells, faces-and-cells, or on "
+                        "median_dual also triangle-tangents, triangles, faces-and-triangles\n");
         return 2;
     }
     const double jitter = argc > 3 ? atof(argv[3]) : 0.3;
