@@ -41,7 +41,6 @@
 #include "bench_util.h"
 #include "mesh_scenes.h"
 
-static const double kPi = 3.14159265358979323846;
 static const double kTheta = 30.0 * 3.14159265358979323846 / 180.0;
 static const double kTolerance = 1e-6;
 
@@ -379,20 +378,16 @@ int cmd_mesh_energies(int argc, char **argv) {
     study_scratch w = {xcalloc((size_t)s->cells, sizeof(double)), xcalloc((size_t)s->cells, sizeof(double)),
                        xcalloc((size_t)s->cells, sizeof(double)), xcalloc((size_t)s->cells, sizeof(double)),
                        xcalloc((size_t)m.ends, sizeof(double)),   xcalloc((size_t)m.ends, sizeof(double))};
-    scene_disk_fractions(s, 1.0, h);
-    for (int64_t c = 0; c < s->cells; ++c) h[c] *= 0.5;
+    scene_pour_column(s, h);
     double t = 0.0;
     long steps = 0;
     while (energy_derivative(&m, (energy_kind)energy, h, de, &w) > 0.0 && t < 20.0) {
         for (int64_t c = 0; c < s->cells; ++c) h[c] -= dt * de[c] / s->area[c];
         t += dt, ++steps;
     }
-    double error = 0.0;
-    for (int64_t c = 0; c < s->cells; ++c)
-        error += fabs(h[c] - fmin(0.5, fmax(0.0, alpha * (foot - hypot(s->cx[c], s->cy[c]))))) * s->area[c];
     printf("mesh,cells,energy,jitter,at_rest,rest_time,steps,l1_error\n");
     printf("%s,%lld,%s,%.2f,%d,%.3f,%ld,%.4e\n", scene_name(kind), (long long)s->cells, kEnergyNames[energy], jitter,
-           t < 20.0, t, steps, error / (kPi * 0.5));
+           t < 20.0, t, steps, scene_column_l1(s, h, alpha));
     free(conductance), free(h), free(de);
     free(w.gx), free(w.gy), free(w.pull_x), free(w.pull_y), free(w.end_h), free(w.end_pull);
     free(m.face), free(m.end_x), free(m.end_y), free(m.end_start), free(m.end_cell), free(m.end_weight);

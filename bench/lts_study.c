@@ -226,12 +226,11 @@ static lts_result run(const char *name, const mesh_scene *s, int relaxation) {
         r.smallest = fmin(r.smallest, sqrt(s->area[c]));
         r.largest = fmax(r.largest, sqrt(s->area[c]));
     }
-    const double theta = 30.0 * kPi / 180.0, alpha = tan(theta), foot = scene_column_foot(alpha);
+    const double theta = 30.0 * kPi / 180.0, alpha = tan(theta);
     double *h = xcalloc((size_t)s->cells, sizeof(double)), *before = xcalloc((size_t)s->cells, sizeof(double));
     double *klass = xcalloc((size_t)s->cells, sizeof(double));
     unsigned char *active = xcalloc((size_t)s->cells, 1);
-    scene_disk_fractions(s, 1.0, h);
-    for (int64_t c = 0; c < s->cells; ++c) h[c] *= 0.5;
+    scene_pour_column(s, h);
     dpsm_grid *g = NULL;
     CHECK(NULL, scene_create(s, &g));
     CHECK(g, dpsm_set_threads(g, 1));
@@ -274,12 +273,7 @@ static lts_result run(const char *name, const mesh_scene *s, int relaxation) {
         if (at_rest > 0.0) break;
     }
     r.seconds = seconds;
-    double err = 0.0;
-    for (int64_t c = 0; c < s->cells; ++c) {
-        const double exact = fmin(0.5, fmax(0.0, alpha * (foot - hypot(s->cx[c], s->cy[c]))));
-        err += fabs(h[c] - exact) * s->area[c];
-    }
-    r.l1 = err / (kPi * 0.5);
+    r.l1 = scene_column_l1(s, h, alpha);
     dpsm_destroy(g);
     free(h), free(before), free(klass), free(active), free(faces);
     return r;

@@ -288,6 +288,20 @@ mesh_scene scene_make_jittered(scene_kind kind, int n, double half, double jitte
 
 double scene_column_foot(double alpha) { return (0.5 + sqrt(4.0 * alpha * alpha - 0.25 / 3.0)) / (2.0 * alpha); }
 
+double scene_column_height(double alpha, double r) { return fmin(0.5, fmax(0.0, alpha * (scene_column_foot(alpha) - r))); }
+
+void scene_pour_column(const mesh_scene *s, double *h) {
+    scene_disk_fractions(s, 1.0, h);
+    for (int64_t c = 0; c < s->cells; ++c) h[c] *= 0.5;
+}
+
+double scene_column_l1(const mesh_scene *s, const double *h, double alpha) {
+    double err = 0.0;
+    for (int64_t c = 0; c < s->cells; ++c)
+        err += fabs(h[c] - scene_column_height(alpha, hypot(s->cx[c], s->cy[c]))) * s->area[c];
+    return err / (3.14159265358979323846 * 0.5);
+}
+
 int scene_create(const mesh_scene *s, dpsm_grid **out) {
     if (s->kind == SCENE_DUAL) return dpsm_create_dual_mesh(s->nnodes, s->node_xy, s->npolygons, s->cell_nodes, out);
     return dpsm_create_mesh(s->nnodes, s->node_xy, s->npolygons, s->cell_start, s->cell_nodes, out);

@@ -41,6 +41,12 @@ int scene_create(const mesh_scene *s, dpsm_grid **out);
  * slid to rest at slope alpha): the foot of the truncated cone that keeps
  * the column's volume. */
 double scene_column_foot(double alpha);
+/* That deposit's height at radius r. */
+double scene_column_height(double alpha, double r);
+/* The column poured on the scene's cells as cell averages, into h. */
+void scene_pour_column(const mesh_scene *s, double *h);
+/* The L1 difference of h on the scene's cells from the exact deposit, over the column's volume. */
+double scene_column_l1(const mesh_scene *s, const double *h, double alpha);
 /* The share of every cell inside the disk of radius r about the origin. */
 void scene_disk_fractions(const mesh_scene *s, double r, double *share);
 /* Turns the scene by `angle` radians about the origin: its nodes and its

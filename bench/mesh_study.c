@@ -108,7 +108,6 @@ static void track_free(deposit_track *track) {
     free(track->times);
 }
 
-
 /* Steps in calls of dt until the surface rests or t_end passes; with a
  * track, keeps the heights after every call. */
 static void step_to_rest(dpsm_grid *g, double dt, double t_end, mesh_result *out, deposit_track *track) {
@@ -149,8 +148,7 @@ static const double kColumnTheta = 30.0 * 3.14159265358979323846 / 180.0;
 static double column_half(void) { return 1.25 * fmax(2.0, scene_column_foot(tan(kColumnTheta))); }
 static double *poured_column(const mesh_scene *s) {
     double *h = xcalloc((size_t)s->cells, sizeof(double));
-    scene_disk_fractions(s, 1.0, h);
-    for (int64_t c = 0; c < s->cells; ++c) h[c] *= 0.5;
+    scene_pour_column(s, h);
     return h;
 }
 
@@ -161,7 +159,7 @@ static void score_column(const mesh_scene *s, const double *h, mesh_result *r) {
     double err = 0.0, top = 0.0, runout[16] = {0};
     for (int64_t c = 0; c < s->cells; ++c) {
         const double radius = hypot(s->cx[c], s->cy[c]);
-        const double exact = fmin(0.5, fmax(0.0, alpha * (foot - radius)));
+        const double exact = scene_column_height(alpha, radius);
         err += fabs(h[c] - exact) * s->area[c];
         top = fmax(top, h[c]);
         if (h[c] > 1e-6) {
