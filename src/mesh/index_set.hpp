@@ -103,9 +103,9 @@ private:
     // Calls visit(i) for every index of block b in increasing order, emptying
     // it. A mark is the byte 1, so a word of eight marks read with byte k at
     // bits 8 k has bit 8 k set for each index k it holds: its set bits, lowest
-    // first, are its indices in order. Read so, without a branch per byte
-    // (which the scattered marks of a sparse sub-step's lists mispredict),
-    // the one-thread sparse sub-step takes about a fifth less time.
+    // first, are its indices in order: read so, without a branch per byte,
+    // which the scattered marks of a sparse sub-step's lists mispredict
+    // (docs/performance.md, "The lists read out by their bits").
     template <class Visit>
     void empty_block(std::size_t b, const Visit &visit) {
         std::uint8_t *mark = marks_.data() + (b << kShift);
