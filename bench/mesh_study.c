@@ -156,11 +156,8 @@ static double *poured_column(const mesh_scene *s) {
  * volume, its runout in 16 directions against the exact foot, its top. */
 static void score_column(const mesh_scene *s, const double *h, mesh_result *r) {
     const double alpha = tan(kColumnTheta), foot = scene_column_foot(alpha);
-    double err = 0.0, top = 0.0, runout[16] = {0};
+    double top = 0.0, runout[16] = {0};
     for (int64_t c = 0; c < s->cells; ++c) {
-        const double radius = hypot(s->cx[c], s->cy[c]);
-        const double exact = scene_column_height(alpha, radius);
-        err += fabs(h[c] - exact) * s->area[c];
         top = fmax(top, h[c]);
         if (h[c] > 1e-6) {
             const double angle = atan2(s->cy[c], s->cx[c]);
@@ -172,7 +169,7 @@ static void score_column(const mesh_scene *s, const double *h, mesh_result *r) {
             if (across <= r->size && along > runout[sector]) runout[sector] = along;
         }
     }
-    r->l1 = err / (kPi * 0.5);
+    r->l1 = scene_column_l1(s, h, alpha);
     r->top = top;
     r->runout_error = 0.0;
     for (int k = 0; k < 16; ++k) r->runout_error = fmax(r->runout_error, fabs(runout[k] - foot));
